@@ -1,0 +1,371 @@
+"""Element kernel of the MDR impact, in kernel units.
+
+Unit-free numba kernels; nothing here imports the user-facing layer.
+
+Kernel units (PHYSICS.md sections 2, 3, 7): indentation ``u`` and normal
+surface displacements ``w`` in units of the Hertz indentation ``d``; element
+positions ``xi`` in units of the Hertz radius ``a_H`` (so the MDR profile is
+``g = xi^2``); time in units of ``T = d / v_z0``; normal velocity in units of
+``v_z0``. The tangential problem is linear in ``v_c0`` (PHYSICS.md section 7),
+so tangential displacements and velocities are in units of ``v_c0 T`` and
+``v_c0``: the contact point starts with ``v_c = 1``. Forces are in units of
+``m v_z0 / T`` (normal) and ``m v_c0 / T`` (tangential); the element
+stiffness per unit length is then ``15/16`` (normal) and ``kappa * 15/16``
+(tangential) with ``kappa = c_t / c_n = 2 (1 - nu) / (2 - nu)``.
+
+Material (PHYSICS.md section 4), relative to the relaxed modulus ``G_inf``:
+``tau0 = eta0 / (G_inf T)`` (parallel dashpot), arms ``g_i = G_i / G_inf``
+with times ``tau_i / T``. Every arm is advanced with the exact exponential
+update for a linear displacement path over the step; nothing divides by a
+viscosity or a relaxation time.
+
+Integrators (the value of ``integrator``):
+
+``EULER``
+    the thesis's explicit Euler: ``u += h v``, ``v -= h F`` with the force of
+    the old state. First order.
+``VERLET``
+    generalized Stormer-Verlet (kick-drift-kick) with the dashpot force
+    implicit in the half-step velocity: ``v+ = (v - h/2 F_el) / (1 + h/2 C)``,
+    drift ``u += h v+``, elements follow the linear path of the drift (for
+    which the arm update is exact), then ``v = v+ - h/2 (F_el' + C' v+)``.
+    Second order for smooth forces, unconditionally stable for the dashpot.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import prange
+
+from .._jit import jit
+
+EULER = 0
+VERLET = 1
+
+# status codes written to OUT_STATUS
+STATUS_OK = 0
+STATUS_TIME_LIMIT = 1
+STATUS_ROW_EXCEEDED = 2
+STATUS_NON_FINITE = 3
+
+# columns of the per-impact output row
+OUT_VZ_END = 0  # normal velocity at the end / v_z0 (negative: rebound)
+OUT_VC_END = 1  # contact-point velocity at the end / v_c0
+OUT_T_CONTACT = 2  # contact time / T
+OUT_U_MAX = 3  # maximum indentation / d
+OUT_B_MAX = 4  # maximum contact half-width / a_H
+OUT_STATUS = 5
+OUT_STEPS = 6  # time steps taken
+N_OUT = 7
+
+# columns of a trajectory record
+REC_T, REC_U, REC_V, REC_VC, REC_FZ, REC_FX, REC_B = range(7)
+N_REC = 7
+
+ELEMENT_STIFFNESS = 15.0 / 16.0  # per unit length, both halves counted below
+
+
+@jit()
+def _arm_coefficient(tau, h):
+    """``(E, 1 - E, phi)`` of the exact arm update over a step ``h``.
+
+    For ``tau dq/dt = w - q`` with ``w`` linear from ``w0`` to ``w1``:
+    ``q1 = E q0 + (1 - E) w0 + phi (w1 - w0)`` with ``E = exp(-h/tau)`` and
+    ``phi = 1 - (tau/h)(1 - E)`` (PHYSICS.md section 4). Valid for ``tau = 0``
+    (the arm follows ``w``) and ``tau = inf`` (the arm is frozen).
+    """
+    x = h / tau if tau > 0.0 else np.inf
+    omE = -math.expm1(-x)
+    phi = x * (0.5 - x / 6.0) if x < 1e-5 else 1.0 - omE / x
+    return 1.0 - omE, omE, phi
+
+
+@jit()
+def arm_coefficients(tau, h):
+    """Arrays ``(E, 1 - E, phi)`` of :func:`_arm_coefficient` for every arm."""
+    n = tau.shape[0]
+    E = np.empty(n)
+    omE = np.empty(n)
+    phi = np.empty(n)
+    for i in range(n):
+        E[i], omE[i], phi[i] = _arm_coefficient(tau[i], h)
+    return E, omE, phi
+
+
+@jit()
+def _follow_over(w0, w1, qrow, g, tau, dt):
+    """Like :func:`_follow` over a part ``dt`` of a step (an element entering
+    contact within the step); coefficients computed here, entries are rare."""
+    acc = 0.0
+    for i in range(g.shape[0]):
+        E, omE, phi = _arm_coefficient(tau[i], dt)
+        qi = E * qrow[i] + omE * w0 + phi * (w1 - w0)
+        qrow[i] = qi
+        acc += g[i] * (w1 - qi)
+    return acc
+
+
+@jit()
+def _follow(w0, w1, qrow, g, E, omE, phi):
+    """Advance the arms of one element along ``w0 -> w1``; return ``sum g_i (w1 - q_i)``."""
+    acc = 0.0
+    for i in range(g.shape[0]):
+        qi = E[i] * qrow[i] + omE[i] * w0 + phi[i] * (w1 - w0)
+        qrow[i] = qi
+        acc += g[i] * (w1 - qi)
+    return acc
+
+
+@jit()
+def _relax(w0, qrow, g, E, omE, phi, tau0_h, den_free, decay0):
+    """Free surface relaxation under zero force over one step; returns the new ``w``.
+
+    Solves ``tau0 dw/dt + G_inf w + sum g_i (w - q_i) = 0`` (PHYSICS.md
+    section 5). Without arms the solution is exact (``w decay0``, or 0 for an
+    elastic element). With arms it is implicit in the end value (L-stable),
+    with the arms on the exact linear-path update.
+    """
+    n = g.shape[0]
+    if n == 0:
+        return w0 * decay0
+    num = tau0_h * w0
+    for i in range(n):
+        num += g[i] * (E[i] * qrow[i] + (omE[i] - phi[i]) * w0)
+    w1 = num / den_free
+    for i in range(n):
+        qrow[i] = E[i] * qrow[i] + omE[i] * w0 + phi[i] * (w1 - w0)
+    return w1
+
+
+@jit()
+def _free_rate(w, qrow, g, tau, tau0):
+    """Current ``dw/dt`` of a free surface element (kernel units)."""
+    n = g.shape[0]
+    r = w
+    for i in range(n):
+        r += g[i] * (w - qrow[i])
+    if tau0 > 0.0:
+        return -r / tau0
+    if n == 0:
+        return 0.0
+    G = 0.0
+    rate = 0.0
+    for i in range(n):
+        G += g[i]
+        if tau[i] > 0.0:
+            rate += g[i] * (w - qrow[i]) / tau[i]
+    return rate / (1.0 + G)
+
+
+@jit()
+def run_impact(tau0, g, tau, kappa, mu_t, tangential, memory, integrator,
+               h, n_elem, dxi, max_steps, rec, rec_every, out):
+    """Advance one impact to its end and write the results into ``out``.
+
+    Parameters (kernel units, see module docstring)
+    ----------
+    tau0 : parallel dashpot time ``eta0 / (G_inf T)``
+    g, tau : arm moduli ``G_i / G_inf`` and times ``tau_i / T`` (1-D, equal length)
+    kappa : ``c_t / c_n``
+    mu_t : inverse effective tangential mass times m: ``1 + m R^2 / Theta``
+    tangential : advance the tangential problem (False when ``v_c0 = 0``)
+    memory : 0 incremental (Maw-Barber-Fawcett), 1 seed (thesis eq. 4.16)
+    integrator : ``EULER`` or ``VERLET``
+    h : time step / T
+    n_elem, dxi : elements in the half row and their spacing / a_H
+    max_steps : time limit in steps
+    rec : (n_rec, N_REC) trajectory buffer (may have zero rows)
+    rec_every : record every this many steps (ignored without rows)
+    out : (N_OUT,) result row
+    """
+    n_arms = g.shape[0]
+    E, omE, phi = arm_coefficients(tau, h)
+    G = 0.0
+    sum_gphi = 0.0
+    for i in range(n_arms):
+        G += g[i]
+        sum_gphi += g[i] * phi[i]
+    tau0_h = tau0 / h
+    den_free = tau0_h + 1.0 + G - sum_gphi
+    decay0 = math.exp(-h / tau0) if tau0 > 0.0 else 0.0
+
+    k_el = 2.0 * ELEMENT_STIFFNESS * dxi  # both halves of the symmetric row
+    xi2 = np.empty(n_elem)
+    for j in range(n_elem):
+        xi = (j + 0.5) * dxi
+        xi2[j] = xi * xi
+    w = np.zeros(n_elem)
+    q = np.zeros((n_elem, n_arms))
+    s = np.zeros(n_elem)
+    p = np.zeros((n_elem, n_arms))
+    contact = np.zeros(n_elem, dtype=np.bool_)
+    f = np.zeros(n_elem)  # last normal force of each element in contact / (k_el)
+
+    u = 0.0
+    v = 1.0
+    uc = 0.0
+    vc = 1.0 if tangential else 0.0
+    F_el = 0.0  # position/history part of the normal force
+    C = 0.0  # dashpot coefficient of the normal force
+    Ft_el = 0.0
+    Ct = 0.0
+    active = 0  # elements [0, active) have ever been touched
+    t_exit = 0.0  # time the last element left (impact starts touching at t = 0)
+    u_max = 0.0
+    j_outer_max = -1
+    n_rec = rec.shape[0]
+    i_rec = 0
+    status = STATUS_TIME_LIMIT
+    step = 0
+    b_now = 0.0
+    while step < max_steps:
+        # ---- sphere: first half (or Euler) ----
+        if integrator == EULER:
+            v_test = v - h * (F_el + C * v)
+            u1 = u + h * v
+            vc_test = vc - h * mu_t * (Ft_el + Ct * vc)
+            uc1 = uc + h * vc
+        else:
+            v_test = (v - 0.5 * h * F_el) / (1.0 + 0.5 * h * C)
+            u1 = u + h * v_test
+            vc_test = (vc - 0.5 * h * mu_t * Ft_el) / (1.0 + 0.5 * h * mu_t * Ct)
+            uc1 = uc + h * vc_test
+        duc = uc1 - uc
+        # ---- elements ----
+        while active < n_elem and xi2[active] <= u1:
+            active += 1
+        sum_r = 0.0
+        sum_rt = 0.0
+        t_leave = 0.0
+        n_c = 0
+        j_outer = -1
+        for j in range(active):
+            w0 = w[j]
+            w1 = u1 - xi2[j]
+            was_in = contact[j]
+            theta = 1.0
+            if was_in:
+                r = w1 + _follow(w0, w1, q[j], g, E, omE, phi)
+            else:
+                wf = _relax(w0, q[j], g, E, omE, phi, tau0_h, den_free, decay0)
+                if tangential:
+                    s[j] = _relax(s[j], p[j], g, E, omE, phi, tau0_h, den_free, decay0)
+                if w1 < wf:
+                    w[j] = wf
+                    continue
+                # (re-)entry: the sphere reached the relaxed surface at the
+                # fraction 1 - theta of the step; the element follows it from
+                # there (the arms see a ramp wf -> w1 over theta h, not a jump)
+                theta = (w1 - wf) / (w1 - wf + w0 + xi2[j] - u)
+                r = w1 + _follow_over(wf, w1, q[j], g, tau, theta * h)
+            w[j] = w1
+            if r + tau0 * v_test <= 0.0:  # force would pull: element leaves
+                if was_in:  # interpolate its force to zero within the step
+                    f1 = r + tau0 * v_test
+                    t_leave = max(t_leave, (step + f[j] / (f[j] - f1)) * h)
+                contact[j] = False
+                continue
+            contact[j] = True
+            f[j] = r + tau0 * v_test
+            n_c += 1
+            j_outer = j
+            sum_r += r
+            if tangential:
+                s0 = s[j]
+                if memory == 1:  # seed: total displacement of the contact point
+                    s1 = uc1
+                elif was_in:  # incremental: only displacement since entry loads it
+                    s1 = s0 + duc
+                else:  # incremental, entering: relaxed state plus the part of
+                    # the step after the surface was reached
+                    s1 = s0 + duc * theta
+                if was_in:
+                    sum_rt += s1 + _follow(s0, s1, p[j], g, E, omE, phi)
+                else:
+                    sum_rt += s1 + _follow_over(s0, s1, p[j], g, tau, theta * h)
+                s[j] = s1
+        if n_c == 0 and t_leave > 0.0:
+            t_exit = t_leave  # the last elements left within this step
+        F_el1 = k_el * sum_r
+        C1 = k_el * tau0 * n_c
+        Ft_el1 = k_el * kappa * sum_rt
+        Ct1 = k_el * kappa * tau0 * n_c
+        # ---- sphere: second half ----
+        if integrator == EULER:
+            v = v_test
+            vc = vc_test
+        else:
+            v = v_test - 0.5 * h * (F_el1 + C1 * v_test)
+            vc = vc_test - 0.5 * h * mu_t * (Ft_el1 + Ct1 * vc_test)
+        u = u1
+        uc = uc1
+        F_el, C, Ft_el, Ct = F_el1, C1, Ft_el1, Ct1
+        step += 1
+        t = step * h
+        if not (math.isfinite(u) and math.isfinite(v) and math.isfinite(vc)):
+            status = STATUS_NON_FINITE
+            break
+        if u > u_max:
+            u_max = u
+        b_now = (j_outer + 1) * dxi if n_c > 0 else 0.0
+        if j_outer > j_outer_max:
+            j_outer_max = j_outer
+        if n_rec > 0 and step % rec_every == 0 and i_rec < n_rec:
+            rec[i_rec, REC_T] = t
+            rec[i_rec, REC_U] = u
+            rec[i_rec, REC_V] = v
+            rec[i_rec, REC_VC] = vc
+            rec[i_rec, REC_FZ] = F_el + C * v
+            rec[i_rec, REC_FX] = Ft_el + Ct * vc
+            rec[i_rec, REC_B] = b_now
+            i_rec += 1
+        if j_outer_max >= n_elem - 1:
+            status = STATUS_ROW_EXCEEDED
+            break
+        # ---- end of impact: no contact, moving away, no free surface can catch up ----
+        if n_c == 0 and v < 0.0:
+            caught = False
+            for j in range(active):
+                if _free_rate(w[j], q[j], g, tau, tau0) < v * (1.0 + 1e-9):
+                    caught = True
+                    break
+            if not caught:
+                status = STATUS_OK
+                break
+    # a final record marks the end state
+    if n_rec > 0 and i_rec < n_rec:
+        rec[i_rec, REC_T] = step * h
+        rec[i_rec, REC_U] = u
+        rec[i_rec, REC_V] = v
+        rec[i_rec, REC_VC] = vc
+        rec[i_rec, REC_FZ] = F_el + C * v
+        rec[i_rec, REC_FX] = Ft_el + Ct * vc
+        rec[i_rec, REC_B] = b_now
+        i_rec += 1
+    out[OUT_VZ_END] = v
+    out[OUT_VC_END] = vc if tangential else 0.0
+    out[OUT_T_CONTACT] = t_exit
+    out[OUT_U_MAX] = u_max
+    out[OUT_B_MAX] = (j_outer_max + 1) * dxi
+    out[OUT_STATUS] = status
+    out[OUT_STEPS] = step
+    return i_rec
+
+
+@jit(parallel=True)
+def run_batch(tau0, g, tau, n_arms, kappa, mu_t, tangential, memory, integrator,
+              h, n_elem, dxi, max_steps, out):
+    """Run many impacts in parallel; one row of ``out`` per parameter set.
+
+    ``g`` and ``tau`` are ``(n, max_arms)``, padded; set ``i`` uses its first
+    ``n_arms[i]`` columns. Other per-set arrays have length ``n``; numerics
+    (``integrator``, ``h``, ``n_elem``, ``dxi``) are shared.
+    """
+    n = tau0.shape[0]
+    no_rec = np.zeros((0, N_REC))
+    for i in prange(n):
+        k = n_arms[i]
+        run_impact(tau0[i], g[i, :k], tau[i, :k], kappa[i], mu_t[i], tangential[i],
+                   memory[i], integrator, h, n_elem, dxi, max_steps[i], no_rec, 1, out[i])
