@@ -23,8 +23,9 @@ class Numerics:
     row_width : length of the half row, in units of ``a_H`` (>= 1; the
         contact of a passive material never exceeds ``a_H``, and reaching
         the end of the row stops the run with status ``row_exceeded``)
-    max_time : time limit in units of ``t_H + 10 eta0 / G_inf``; an impact
-        still running then ends with status ``time_limit``
+    max_time : time limit in units of ``t_H (1 + 10 t_v / T)`` with the
+        viscous time ``t_v = (eta0 + sum G_i tau_i) / G_inf`` (capped at 1e4);
+        an impact still running then ends with status ``time_limit``
     """
 
     integrator: str = "verlet"

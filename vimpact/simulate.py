@@ -63,7 +63,9 @@ def pack(scenes: Sequence[Scene], numerics: Numerics) -> dict[str, np.ndarray]:
         a["mu_t"][i] = 1.0 + 1.0 / s.theta_ratio
         a["tangential"][i] = s.v_c0 != 0.0
         a["memory"][i] = TANGENTIAL_MEMORY.index(s.tangential_memory)
-        limit = numerics.max_time * (HERTZ_TIME_FACTOR + 10.0 * a["tau0"][i])
+        # slow creep back: the dashpot time, or the viscous time g tau of the arms
+        viscous = a["tau0"][i] + float(np.dot(a["g"][i], a["tau"][i]))
+        limit = numerics.max_time * HERTZ_TIME_FACTOR * (1.0 + min(10.0 * viscous, 1e4))
         a["max_steps"][i] = int(math.ceil(limit / h))
     return a
 

@@ -78,7 +78,10 @@ def _arm_coefficient(tau, h):
     """
     x = h / tau if tau > 0.0 else np.inf
     omE = -math.expm1(-x)
-    phi = x * (0.5 - x / 6.0) if x < 1e-5 else 1.0 - omE / x
+    if x < 1e-3:  # series: the closed form cancels
+        phi = x * (0.5 - x * (1.0 / 6.0 - x * (1.0 / 24.0 - x / 120.0)))
+    else:
+        phi = 1.0 - omE / x
     return 1.0 - omE, omE, phi
 
 
