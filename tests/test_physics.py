@@ -156,3 +156,11 @@ def test_seed_memory_is_not_passive_for_elastic_nu0():
     incr = v.simulate(v.Scene(mat, R=0.05, m=0.05, v_z0=1.0, v_x0=1.0))
     assert seed.energy_ratio > 1.0 + 1e-3
     assert incr.energy_ratio < 1.0
+
+
+def test_thesis_table_4_1_explicit_euler():
+    """PHYSICS.md section 10: explicit Euler, elastic, 1.1254 % (500 steps), 0.5608 % (1000)."""
+    scene = v.Scene(v.Material.elastic(nu=0.5, E=5e10), R=0.2, m=10.0, v_z0=10.0)
+    for steps, percent in ((500, 1.1254), (1000, 0.5608)):
+        res = v.simulate(scene, v.Numerics(integrator="euler", steps=steps, elements=100))
+        assert 100 * abs(res.e_z - 1) == pytest.approx(percent, rel=0.02)
