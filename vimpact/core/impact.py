@@ -163,6 +163,21 @@ def _free_rate(w, qrow, g, tau, tau0):
 
 
 @jit()
+def _record(rec, i, t, u, v, vc, Fz, Fx, b):
+    """Write one trajectory row if there is room; return the next row index."""
+    if i >= rec.shape[0]:
+        return i
+    rec[i, REC_T] = t
+    rec[i, REC_U] = u
+    rec[i, REC_V] = v
+    rec[i, REC_VC] = vc
+    rec[i, REC_FZ] = Fz
+    rec[i, REC_FX] = Fx
+    rec[i, REC_B] = b
+    return i + 1
+
+
+@jit()
 def run_impact(tau0, g, tau, kappa, mu_t, tangential, memory, integrator,
                h, n_elem, dxi, max_steps, rec, rec_every, out):
     """Advance one impact to its end and write the results into ``out``.
@@ -315,15 +330,8 @@ def run_impact(tau0, g, tau, kappa, mu_t, tangential, memory, integrator,
         b_now = (j_outer + 1) * dxi if n_c > 0 else 0.0
         if j_outer > j_outer_max:
             j_outer_max = j_outer
-        if n_rec > 0 and step % rec_every == 0 and i_rec < n_rec:
-            rec[i_rec, REC_T] = t
-            rec[i_rec, REC_U] = u
-            rec[i_rec, REC_V] = v
-            rec[i_rec, REC_VC] = vc
-            rec[i_rec, REC_FZ] = F_el + C * v
-            rec[i_rec, REC_FX] = Ft_el + Ct * vc
-            rec[i_rec, REC_B] = b_now
-            i_rec += 1
+        if n_rec > 0 and step % rec_every == 0:
+            i_rec = _record(rec, i_rec, t, u, v, vc, F_el + C * v, Ft_el + Ct * vc, b_now)
         if j_outer_max >= n_elem - 1:
             status = STATUS_ROW_EXCEEDED
             break
@@ -338,15 +346,8 @@ def run_impact(tau0, g, tau, kappa, mu_t, tangential, memory, integrator,
                 status = STATUS_OK
                 break
     # a final record marks the end state
-    if n_rec > 0 and i_rec < n_rec:
-        rec[i_rec, REC_T] = step * h
-        rec[i_rec, REC_U] = u
-        rec[i_rec, REC_V] = v
-        rec[i_rec, REC_VC] = vc
-        rec[i_rec, REC_FZ] = F_el + C * v
-        rec[i_rec, REC_FX] = Ft_el + Ct * vc
-        rec[i_rec, REC_B] = b_now
-        i_rec += 1
+    if n_rec > 0:
+        i_rec = _record(rec, i_rec, step * h, u, v, vc, F_el + C * v, Ft_el + Ct * vc, b_now)
     out[OUT_VZ_END] = v
     out[OUT_VC_END] = vc if tangential else 0.0
     out[OUT_T_CONTACT] = t_exit
