@@ -20,6 +20,7 @@ from .numerics import PRESETS, Numerics
 from .result import STATUSES, UNITS, ImpactResult
 from .scene import Scene
 from .simulate import HalfSpaceError, simulate, simulate_batch
+from .table import RestitutionTable
 
 try:
     __version__ = version("vimpact")
@@ -28,6 +29,7 @@ except PackageNotFoundError:  # running from a source tree
 
 __all__ = [
     "HERTZ_TIME_FACTOR", "HalfSpaceError", "HertzScales", "ImpactResult", "MODELS",
-    "Material", "Numerics", "PRESETS", "STATUSES", "Scene", "UNITS", "hertz_scales",
+    "Material", "Numerics", "PRESETS", "RestitutionTable", "STATUSES", "Scene", "UNITS",
+    "hertz_scales",
     "simulate", "simulate_batch", "__version__",
 ]

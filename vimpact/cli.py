@@ -18,6 +18,8 @@ from .numerics import INTEGRATORS, PRESETS, Numerics
 from .result import STATUSES, UNITS
 from .scene import TANGENTIAL_MEMORY, Scene
 from .simulate import simulate
+from .sweep_cli import add_sweep_parser
+from .table_cli import add_plot_parser, add_table_parser
 
 
 class _Parser(argparse.ArgumentParser):
@@ -89,6 +91,9 @@ def _build_parser() -> argparse.ArgumentParser:
                         "FILE, CSV or Parquet by extension (.csv, .parquet)")
     g.add_argument("--json", action="store_true", help="print one JSON object")
     sim.set_defaults(func=_cmd_simulate)
+    add_sweep_parser(sub)
+    add_table_parser(sub)
+    add_plot_parser(sub)
     return parser
 
 
