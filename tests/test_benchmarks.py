@@ -12,3 +12,14 @@ def test_default_accuracy_quick(tmp_path):
     json.dumps(data)  # serializable
     assert set(data["presets"]) == {"fast", "default"}
     assert max(data["presets"]["default"]["e_z_error"]) < 1e-4
+
+
+def test_sweep_speedup_quick(tmp_path):
+    from benchmarks import sweep_speedup
+
+    spec = tmp_path / "tiny.toml"
+    spec.write_text('model = "kelvin_voigt"\nchunk_size = 4\n[numerics]\nsteps = 60\n'
+                    'elements = 12\n[grid]\nQ1 = [0.01, 0.1, 1.0]\nnu = [0.5]\n')
+    data = sweep_speedup.run(spec, repeats=1)
+    assert data["rows"] == 3 and data["speedup"] > 0
+    json.dumps(data)
