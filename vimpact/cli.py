@@ -13,7 +13,8 @@ import sys
 from pathlib import Path
 
 from . import __version__
-from .material import MODELS, Material
+from ._cli_material import add_material_arguments, material_from_args, missing
+from .material import MODELS
 from .numerics import INTEGRATORS, PRESETS, Numerics
 from .result import STATUSES, UNITS
 from .scene import TANGENTIAL_MEMORY, Scene
@@ -45,18 +46,7 @@ def _build_parser() -> argparse.ArgumentParser:
         epilog="Example: vimpact simulate --Q1 0.1 --nu 0.5 --json")
     g = sim.add_argument_group("material (physical input)")
     g.add_argument("--model", choices=MODELS, help="rheology (default: inferred)")
-    g.add_argument("--E", type=float, metavar="PA", help="Young's modulus, Pa (or --G)")
-    g.add_argument("--G", type=float, metavar="PA",
-                   help="shear modulus, Pa (relaxed modulus G_inf for --prony)")
-    g.add_argument("--nu", type=float, metavar="NU",
-                   help="Poisson ratio, dimensionless, in [0, 0.5] (required)")
-    g.add_argument("--eta", type=float, metavar="PA_S",
-                   help="viscosity, Pa s: Kelvin-Voigt dashpot, the standard solid's "
-                        "arm dashpot, or the parallel dashpot of --prony")
-    g.add_argument("--G1", type=float, metavar="PA", help="standard solid: parallel spring, Pa")
-    g.add_argument("--G2", type=float, metavar="PA", help="standard solid: arm spring, Pa")
-    g.add_argument("--prony", action="append", metavar="G_I:TAU_I",
-                   help="Prony arm 'modulus Pa:relaxation time s' (repeat for more arms)")
+    add_material_arguments(g, prony=True)
     g = sim.add_argument_group("sphere and impact (physical input)")
     g.add_argument("--R", type=float, metavar="M", help="sphere radius, m")
     g.add_argument("--m", type=float, metavar="KG", help="sphere mass, kg")
@@ -100,51 +90,6 @@ def _build_parser() -> argparse.ArgumentParser:
 _PHYSICAL = ("E", "G", "eta", "G1", "G2", "prony", "R", "m", "Theta", "vz0", "model")
 
 
-def _missing(name: str, why: str) -> ValueError:
-    return ValueError(f"--{name} is missing: {why}")
-
-
-def _material(a) -> Material:
-    if a.nu is None:
-        raise _missing("nu", "the Poisson ratio in [0, 0.5] is required")
-    model = a.model or ("prony" if a.prony else "standard_solid" if (a.G1 or a.G2) is not None
-                        else "kelvin_voigt" if a.eta is not None else "elastic")
-    if model == "standard_solid":
-        for name in ("G1", "G2", "eta"):
-            if getattr(a, name) is None:
-                raise _missing(name, "the standard solid needs --G1, --G2 (Pa) and --eta (Pa s)")
-        if a.E is not None or a.G is not None:
-            raise ValueError("--E/--G are not used by the standard solid: give --G1 and --G2")
-        return Material.standard_solid(nu=a.nu, G1=a.G1, G2=a.G2, eta=a.eta)
-    if a.G1 is not None or a.G2 is not None:
-        raise ValueError(f"--G1/--G2 belong to the standard solid, not --model {model}")
-    if a.E is None and a.G is None:
-        raise _missing("E", "give the modulus as --E or --G (Pa)")
-    if model == "prony":
-        if not a.prony:
-            raise _missing("prony", "a Prony series needs at least one --prony G_I:TAU_I")
-        if a.G is None:
-            raise _missing("G", "the Prony series needs its relaxed modulus --G (Pa)")
-        arms = []
-        for text in a.prony:
-            try:
-                G_i, tau_i = (float(x) for x in text.split(":"))
-            except ValueError:
-                raise ValueError(f"--prony = {text!r} is not allowed: must be "
-                                 "'modulus:time' in Pa:s, e.g. 1e6:1e-3") from None
-            arms.append((G_i, tau_i))
-        return Material.prony(nu=a.nu, G_inf=a.G, arms=arms, eta0=a.eta or 0.0)
-    if a.prony:
-        raise ValueError(f"--prony needs --model prony, not --model {model}")
-    if model == "kelvin_voigt":
-        if a.eta is None:
-            raise _missing("eta", "the Kelvin-Voigt body needs its viscosity (Pa s)")
-        return Material.kelvin_voigt(nu=a.nu, eta=a.eta, G=a.G, E=a.E)
-    if a.eta is not None:
-        raise ValueError("--eta is not used by --model elastic")
-    return Material.elastic(nu=a.nu, G=a.G, E=a.E)
-
-
 def scene_from_args(a) -> Scene:
     """The scene described by parsed ``simulate`` options."""
     if a.Q1 is not None:
@@ -154,16 +99,16 @@ def scene_from_args(a) -> Scene:
             raise ValueError(f"{', '.join(given)} cannot be combined with --Q1: give either "
                              "a dimensionless scene (--Q1 [--Q2] --nu) or a physical one")
         if a.nu is None:
-            raise _missing("nu", "the Poisson ratio in [0, 0.5] is required")
+            raise missing("nu", "the Poisson ratio in [0, 0.5] is required")
         return Scene.from_dimensionless(a.Q1, a.nu, a.Q2, theta_ratio=a.theta_ratio,
                                         tangential_memory=a.tangential_memory)
     if a.Q2 is not None:
-        raise _missing("Q1", "--Q2 is part of the dimensionless input --Q1 --Q2 --nu")
-    material = _material(a)
+        raise missing("Q1", "--Q2 is part of the dimensionless input --Q1 --Q2 --nu")
+    material = material_from_args(a)
     for name, what in (("R", "sphere radius, m"), ("m", "sphere mass, kg"),
                        ("vz0", "normal impact speed, m/s")):
         if getattr(a, name) is None:
-            raise _missing(name, f"the {what} is required (or use --Q1 --nu)")
+            raise missing(name, f"the {what} is required (or use --Q1 --nu)")
     theta = a.Theta
     if theta is None and a.theta_ratio != 0.4:
         theta = a.theta_ratio * a.m * a.R**2

@@ -16,6 +16,8 @@ import textwrap
 
 import numpy as np
 
+from ._cli_material import add_material_arguments, material_from_args
+
 __all__ = ["add_table_parser", "add_plot_parser"]
 
 
@@ -95,13 +97,7 @@ def add_table_parser(subparsers) -> argparse.ArgumentParser:
     exp.add_argument("table", metavar="TABLE", help="restitution table (.parquet)")
     exp.add_argument("--out", required=True, metavar="FILE", help="output CSV file (.csv)")
     g = exp.add_argument_group("material")
-    g.add_argument("--E", type=float, metavar="PA", help="Young's modulus, Pa (or --G)")
-    g.add_argument("--G", type=float, metavar="PA", help="shear modulus, Pa")
-    g.add_argument("--eta", type=float, metavar="PA_S",
-                   help="viscosity, Pa s (Kelvin-Voigt dashpot or the standard solid's arm dashpot)")
-    g.add_argument("--G1", type=float, metavar="PA", help="standard solid: parallel spring, Pa")
-    g.add_argument("--G2", type=float, metavar="PA", help="standard solid: arm spring, Pa")
-    g.add_argument("--nu", type=float, metavar="NU", help="Poisson ratio, dimensionless (required)")
+    add_material_arguments(g, prony=False)
     g = exp.add_argument_group("sphere and speeds")
     g.add_argument("--R", type=float, required=True, metavar="M", help="sphere radius, m")
     g.add_argument("--m", type=float, required=True, metavar="KG", help="sphere mass, kg")
@@ -171,8 +167,6 @@ _MATERIAL_OPTIONS = {
 
 
 def _cmd_export(a) -> int:
-    from .cli import _material  # lazy: cli imports this module
-
     require_n = a.n >= 1 and (a.n >= 2 or a.vz0_min == a.vz0_max)
     if not require_n:
         raise ValueError(f"--n = {a.n} is not allowed: must be an integer >= 2 "
@@ -183,8 +177,7 @@ def _cmd_export(a) -> int:
         raise ValueError(f"--vz0-max = {a.vz0_max!r} is not allowed: must be finite and "
                          f">= --vz0-min = {a.vz0_min!r} (m/s)")
     table = _open(a.table)
-    a.model, a.prony = None, None  # as in `vimpact simulate`: model inferred from the options
-    material = _material(a)
+    material = material_from_args(a)  # model inferred as in `vimpact simulate`
     if material.model != table.model:
         need = _MATERIAL_OPTIONS.get(table.model, f"a {table.model} material")
         raise ValueError(f"the material options give the model {material.model!r}, but the "
