@@ -101,6 +101,18 @@ class Scene:
         return self.Theta / (self.m * self.R**2)
 
     @property
+    def contact_mass_factor(self) -> float:
+        """``1 + m R^2 / Theta``: the contact point accelerates this much faster than
+        the centre under a tangential force (PHYSICS.md section 7), dimensionless."""
+        return 1.0 + 1.0 / self.theta_ratio
+
+    def tangential_end_state(self, vc_ratio):
+        """Centre velocity (m/s) and spin (rad/s) when the contact-point velocity
+        has become ``vc_ratio * v_c0`` (works on arrays)."""
+        impulse = (1.0 - vc_ratio) / self.contact_mass_factor * self.v_c0  # J / m, m/s
+        return self.v_x0 - impulse, self.omega0 - impulse * self.m * self.R / self.Theta
+
+    @property
     def E_star(self) -> float:
         """Effective (relaxed) modulus ``2 G_inf / (1 - nu)``, Pa."""
         return float(effective_modulus(self.material.G_inf, self.material.nu))

@@ -60,7 +60,7 @@ def pack(scenes: Sequence[Scene], numerics: Numerics) -> dict[str, np.ndarray]:
             a["tau"][i, k] = tau_k / T
         a["n_arms"][i] = len(mat.arms)
         a["kappa"][i] = 2.0 * (1.0 - mat.nu) / (2.0 - mat.nu)
-        a["mu_t"][i] = 1.0 + 1.0 / s.theta_ratio
+        a["mu_t"][i] = s.contact_mass_factor
         a["tangential"][i] = s.v_c0 != 0.0
         a["memory"][i] = TANGENTIAL_MEMORY.index(s.tangential_memory)
         # slow creep back: the dashpot time, or the viscous time g tau of the arms
@@ -85,10 +85,7 @@ def _result(s: Scene, row: np.ndarray, trajectory: pd.DataFrame | None = None) -
     if status == "ok":
         v_z_end = row[kernel.OUT_VZ_END] * s.v_z0
         vc_end = row[kernel.OUT_VC_END]  # / v_c0
-        mu_t = 1.0 + 1.0 / s.theta_ratio
-        impulse = (1.0 - vc_end) / mu_t * s.v_c0  # J / m, m/s
-        v_x_end = s.v_x0 - impulse
-        omega_end = s.omega0 - impulse * s.m * s.R / s.Theta
+        v_x_end, omega_end = s.tangential_end_state(vc_end)
         energy = 0.5 * (s.m * (v_z_end**2 + v_x_end**2) + s.Theta * omega_end**2)
         e_x = abs(vc_end) if s.v_c0 != 0.0 else nan
         beta_x = -vc_end if s.v_c0 != 0.0 else nan
@@ -158,15 +155,15 @@ def _trajectory(s: Scene, rec: np.ndarray) -> pd.DataFrame:
     """Physical time series from kernel records."""
     hz = s.hertz
     vc = rec[:, kernel.REC_VC]
-    impulse = (1.0 - vc) / (1.0 + 1.0 / s.theta_ratio) * s.v_c0  # / m, m/s
+    v_x, omega = s.tangential_end_state(vc)
     force_n = s.m * s.v_z0 / hz.T
     force_t = s.m * s.v_c0 / hz.T
     return pd.DataFrame({
         "t_s": rec[:, kernel.REC_T] * hz.T,
         "u_z_m": rec[:, kernel.REC_U] * hz.d,
         "v_z_m_s": rec[:, kernel.REC_V] * s.v_z0,
-        "v_x_m_s": s.v_x0 - impulse,
-        "omega_rad_s": s.omega0 - impulse * s.m * s.R / s.Theta,
+        "v_x_m_s": v_x,
+        "omega_rad_s": omega,
         "F_z_N": rec[:, kernel.REC_FZ] * force_n,
         "F_x_N": rec[:, kernel.REC_FX] * force_t,
         "a_m": rec[:, kernel.REC_B] * hz.a_H,

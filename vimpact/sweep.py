@@ -114,6 +114,7 @@ import tomllib
 from collections.abc import Callable
 from pathlib import Path
 
+import numba
 import numpy as np
 import pyarrow as pa
 import pyarrow.parquet as pq
@@ -121,7 +122,7 @@ import pyarrow.parquet as pq
 from . import __version__
 from .material import MODELS, Material, shear_modulus
 from .numerics import PRESETS, Numerics
-from .result import STATUSES
+from .result import FINISHED, STATUSES
 from .scene import TANGENTIAL_MEMORY, Scene
 from .simulate import simulate_batch
 
@@ -703,11 +704,7 @@ def _interleave(n: int, threads: int) -> np.ndarray:
 
 
 def _threads() -> int:
-    try:
-        import numba
-        return max(1, numba.get_num_threads())
-    except Exception:  # pragma: no cover - numba is a dependency
-        return 1
+    return max(1, numba.get_num_threads())
 
 
 def compute_chunk(spec: SweepSpec, params: dict, start: int, stop: int) -> pa.Table:
@@ -807,9 +804,8 @@ def _simulate(scenes: list[Scene], numerics: Numerics) -> list[tuple[dict | None
 def _guard_nan(cols: dict, status: list, error: list, vc0_zero: np.ndarray) -> None:
     """NaN only with a status that explains it: a NaN that no status explains
     turns its row into ``non_finite`` (all outputs NaN) with a message."""
-    finished = ("ok", "vc0_zero", "half_space")
     for k, st in enumerate(status):
-        if st not in finished:
+        if st not in FINISHED:
             continue
         bad = [c for c, v in cols.items()
                if c not in ("row", "status", "error") and not isinstance(v, list)

@@ -349,7 +349,7 @@ def run_impact(tau0, g, tau, kappa, mu_t, tangential, memory, integrator,
     if n_rec > 0:
         i_rec = _record(rec, i_rec, step * h, u, v, vc, F_el + C * v, Ft_el + Ct * vc, b_now)
     out[OUT_VZ_END] = v
-    out[OUT_VC_END] = vc if tangential else 0.0
+    out[OUT_VC_END] = vc  # stays 0 without tangential motion
     out[OUT_T_CONTACT] = t_exit
     out[OUT_U_MAX] = u_max
     out[OUT_B_MAX] = (j_outer_max + 1) * dxi
