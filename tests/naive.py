@@ -5,7 +5,8 @@ PHYSICS.md sections 3-7, written directly in metres, seconds, kilograms and
 pascals. It shares no code with :mod:`vimpact.core.impact` and does not
 nondimensionalize anything: it only takes the discretization (``t_H`` and
 ``a_H`` for the step and the element spacing) from
-:func:`vimpact.hertz.hertz_scales`. In particular it
+:func:`vimpact.hertz.hertz_scales` and the refinement rule from
+:func:`vimpact.paths.refinement`. In particular it
 
 - uses the element stiffnesses ``c_n G`` and ``c_t G`` per unit length with
   ``c_n = 2 / (1 - nu)``, ``c_t = 4 / (2 - nu)`` and the material moduli in Pa,
@@ -30,7 +31,9 @@ import math
 
 import numpy as np
 
+from vimpact import Numerics
 from vimpact.hertz import hertz_scales
+from vimpact.paths import choose_path, refinement
 
 #: PHYSICS.md section 1: the half-space model holds up to a = 0.2 R.
 HALF_SPACE_LIMIT = 0.2
@@ -149,7 +152,12 @@ def naive_impact(scene, steps, elements, row_width=1.05, max_time=100.0):
     R, m, Theta = float(scene.R), float(scene.m), float(scene.Theta)
 
     hz = hertz_scales(mat.G_inf, nu, R, m, scene.v_z0)
-    h = hz.t_H / steps  # s
+    # the discretization rule of the kernel (finer steps and elements for a
+    # stiffer tangential mode or a glassy contact): taken, not re-derived
+    numerics = Numerics(steps=steps, elements=elements, row_width=row_width, continuum=False)
+    time_factor, element_factor = refinement(scene, numerics, choose_path(scene, numerics).spec)
+    h = hz.t_H / steps / time_factor  # s
+    elements = int(math.ceil(elements * element_factor))
     dx = hz.a_H / elements  # m
     n = int(math.ceil(row_width * elements))
     x = (np.arange(n) + 0.5) * dx  # element positions, m

@@ -33,13 +33,47 @@ def test_elastic_normal_impact_matches_hertz():
     assert math.isnan(res.e_x) and math.isnan(res.beta_x)
 
 
-def test_thesis_euler_is_first_order():
-    """The thesis's explicit Euler (table 4.1): error about halves when steps double."""
-    errs = [abs(v.simulate(_elastic_scene(), v.Numerics(integrator="euler", steps=n,
-                                                         elements=50)).e_z - 1)
-            for n in (250, 500, 1000)]
-    for coarse, fine in zip(errs, errs[1:]):
-        assert 1.6 < coarse / fine < 2.5
+def _observed_order(errors, steps) -> float:
+    """Least-squares slope of -log(error) against log(steps)."""
+    return -np.polyfit(np.log(steps), np.log(errors), 1)[0]
+
+
+@pytest.mark.parametrize("integrator, observable, nominal", [
+    ("euler", "e_z", 1.0),  # thesis table 4.1: |e_z - 1| halves when the steps double
+    ("verlet", "t_contact", 2.0),  # e_z of verlet is exact up to rounding (time reversible)
+])
+def test_convergence_order_on_the_elastic_impact(integrator, observable, nominal):
+    """Observed order of the integrator on the elastic impact against the Hertz
+    closed forms (e_z = 1, t_contact = 2.94 t_H); elements fine enough that
+    the time step dominates."""
+    steps = (250, 500, 1000)
+    numerics = v.Numerics(integrator=integrator, elements=1600, continuum=False)
+    errors = []
+    for n in steps:
+        res = v.simulate(_elastic_scene(), numerics.with_(steps=n))
+        exact = 1.0 if observable == "e_z" else res.t_hertz
+        errors.append(abs(getattr(res, observable) - exact) / exact)
+    assert nominal - 0.25 < _observed_order(errors, steps) < nominal + 0.35, errors
+
+
+def test_symplectic_euler_order():
+    """Semi-implicit Euler: on the elastic impact its positions are Verlet's
+    (the force vanishes at the start and the end, so the staggered velocities
+    coincide there): same e_z and t_contact to rounding. With a dashpot (which
+    it treats implicitly over the whole step) it is first order against the
+    Kelvin-Voigt continuum."""
+    base = v.Numerics(elements=400, steps=500, continuum=False)
+    sym = v.simulate(_elastic_scene(), base.with_(integrator="symplectic_euler"))
+    ver = v.simulate(_elastic_scene(), base)
+    assert sym.e_z == pytest.approx(ver.e_z, abs=1e-12)
+    assert sym.t_contact == pytest.approx(ver.t_contact, rel=1e-12)
+    q1 = 0.3
+    exact = kelvin_voigt_continuum(q1).e_z
+    scene = v.Scene.from_dimensionless(q1, 0.5, tangential="none")
+    steps = (250, 500, 1000)
+    errors = [abs(v.simulate(scene, base.with_(integrator="symplectic_euler", steps=n,
+                                               elements=1600)).e_z - exact) for n in steps]
+    assert 0.75 < _observed_order(errors, steps) < 1.35, errors
 
 
 # ---- Kelvin-Voigt normal impact: continuum closed form -----------------------------
@@ -86,13 +120,19 @@ def test_restitution_decreases_with_damping():
 # ---- standard solid limits ----------------------------------------------------------
 
 def test_standard_solid_tends_to_elastic_for_large_q2():
+    """Q2 -> inf: the arm vanishes. The e_z gap falls like 1/Q2 (1 - e_z is
+    first order in the arm's weight); e_x, which an elastic impact already
+    has, comes within the default numerics' e_x accuracy (about 1e-4) and
+    no further, so it is checked against that band, not for monotony."""
     elastic = v.simulate(v.Scene.from_dimensionless(0.0, 0.5))
-    gaps = []
+    gaps_z, gaps_x = [], []
     for q2 in (1e2, 1e3, 1e4):
         r = v.simulate(v.Scene.from_dimensionless(0.3, 0.5, Q2=q2))
-        gaps.append(max(abs(r.e_z - elastic.e_z), abs(r.e_x - elastic.e_x)))
-    assert gaps[0] > gaps[1] > gaps[2]
-    assert gaps[2] < 2e-3
+        gaps_z.append(abs(r.e_z - elastic.e_z))
+        gaps_x.append(abs(r.e_x - elastic.e_x))
+    assert gaps_z[0] > 30 * gaps_z[1] > 900 * gaps_z[2]
+    assert gaps_z[2] < 1e-6
+    assert max(gaps_x) < 3e-4, gaps_x
 
 
 def test_standard_solid_tends_to_kelvin_voigt_for_small_q2():
@@ -162,5 +202,5 @@ def test_thesis_table_4_1_explicit_euler():
     """PHYSICS.md section 10: explicit Euler, elastic, 1.1254 % (500 steps), 0.5608 % (1000)."""
     scene = v.Scene(v.Material.elastic(nu=0.5, E=5e10), R=0.2, m=10.0, v_z0=10.0)
     for steps, percent in ((500, 1.1254), (1000, 0.5608)):
-        res = v.simulate(scene, v.Numerics(integrator="euler", steps=steps, elements=100))
+        res = v.simulate(scene, v.Numerics(integrator="euler", steps=steps, elements=100, continuum=False))
         assert 100 * abs(res.e_z - 1) == pytest.approx(percent, rel=0.02)

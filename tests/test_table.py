@@ -191,8 +191,10 @@ def test_interpolation_of_monotone_data_is_monotone(kv):
 def test_lookup_broadcasts(kv):
     res = kv.lookup(np.array([[0.02], [0.2]]), np.array([0.0, 0.25, 0.5]))
     assert res["e_z"].shape == res["e_x"].shape == res["nu"].shape == (2, 3)
-    # e_z does not depend on nu (PHYSICS.md section 8), so neither does its interpolation
-    np.testing.assert_allclose(res["e_z"], res["e_z"][:, :1] * np.ones((1, 3)), atol=1e-9)
+    # e_z does not depend on nu (PHYSICS.md section 8), so neither does its
+    # interpolation, up to the time step (refined for the tangential mode, which
+    # depends on nu): about 1e-4 at the coarse test numerics
+    np.testing.assert_allclose(res["e_z"], res["e_z"][:, :1] * np.ones((1, 3)), atol=1e-3)
     with pytest.raises(ValueError, match="broadcast"):
         kv.lookup([0.1, 0.2], [0.1, 0.2, 0.3])
 
@@ -280,7 +282,9 @@ def test_several_theta_ratios_need_one(tmp_path):
     with pytest.raises(ValueError, match="theta_ratio is missing.*0.4, 0.666667"):
         table.lookup(0.1, 0.5)
     thin, hollow = (table.lookup(0.1, 0.5, theta_ratio=t) for t in (0.4, 2 / 3))
-    assert thin["e_z"] == pytest.approx(hollow["e_z"], abs=1e-12)  # e_z does not depend on it
+    # e_z does not depend on it; the runs differ only by the time step (refined
+    # for the faster tangential mode), at the coarse test numerics about 2e-4
+    assert thin["e_z"] == pytest.approx(hollow["e_z"], abs=1e-3)
     assert thin["e_x"] != pytest.approx(hollow["e_x"], abs=1e-3)
     with pytest.raises(ValueError, match="theta_ratio = 0.5 is not allowed"):
         table.lookup(0.1, 0.5, theta_ratio=0.5)

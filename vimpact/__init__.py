@@ -19,7 +19,8 @@ from .material import MODELS, Material
 from .numerics import PRESETS, Numerics
 from .result import STATUSES, UNITS, ImpactResult
 from .scene import Scene
-from .simulate import HalfSpaceError, simulate, simulate_batch
+from .paths import Path, choose_path
+from .simulate import HalfSpaceError, explain, simulate, simulate_batch
 from .table import RestitutionTable
 
 try:
@@ -29,7 +30,7 @@ except PackageNotFoundError:  # running from a source tree
 
 __all__ = [
     "HERTZ_TIME_FACTOR", "HalfSpaceError", "HertzScales", "ImpactResult", "MODELS",
-    "Material", "Numerics", "PRESETS", "RestitutionTable", "STATUSES", "Scene", "UNITS",
-    "hertz_scales",
+    "Material", "Numerics", "PRESETS", "Path", "RestitutionTable", "STATUSES", "Scene", "UNITS",
+    "choose_path", "explain", "hertz_scales",
     "simulate", "simulate_batch", "__version__",
 ]

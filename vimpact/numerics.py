@@ -4,10 +4,12 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 
-from .core.impact import EULER, VERLET
+from .core.impact import EULER, SYMPLECTIC_EULER, VERLET
 from .validation import one_of, positive, require
 
-INTEGRATORS = {"euler": EULER, "verlet": VERLET}
+#: Integrators by name (see :mod:`vimpact.core.impact`) and their nominal order.
+INTEGRATORS = {"euler": EULER, "symplectic_euler": SYMPLECTIC_EULER, "verlet": VERLET}
+ORDER = {"euler": 1, "symplectic_euler": 1, "verlet": 2}
 
 
 @dataclass(frozen=True)
@@ -16,9 +18,12 @@ class Numerics:
 
     Attributes
     ----------
-    integrator : ``"verlet"`` (default: second order, dashpot implicit) or
-        ``"euler"`` (the thesis's explicit Euler, first order)
-    steps : time steps per Hertz contact time ``t_H`` (of the relaxed modulus)
+    integrator : ``"verlet"`` (default: second order, dashpot implicit),
+        ``"symplectic_euler"`` (first order, dashpot implicit) or ``"euler"``
+        (the thesis's explicit Euler, first order)
+    steps : time steps per Hertz contact time ``t_H`` (of the relaxed
+        modulus); the step is shortened further for a stiffer tangential
+        mode and for explicit Euler's stability (``vimpact.paths.refinement``)
     elements : elements per Hertz contact radius ``a_H`` on the half row
     row_width : length of the half row, in units of ``a_H`` (>= 1; the
         contact of a passive material never exceeds ``a_H``, and reaching
@@ -26,6 +31,9 @@ class Numerics:
     max_time : time limit in units of ``t_H (1 + 10 t_v / T)`` with the
         viscous time ``t_v = (eta0 + sum G_i tau_i) / G_inf`` (capped at 1e4);
         an impact still running then ends with status ``time_limit``
+    continuum : take the continuum 1-DOF path for Kelvin-Voigt and elastic
+        normal-only scenes (default ``True``; ``False`` forces elements)
+    rtol : relative tolerance of the adaptive continuum path
     """
 
     integrator: str = "verlet"
@@ -33,6 +41,8 @@ class Numerics:
     elements: int = 200
     row_width: float = 1.05
     max_time: float = 100.0
+    continuum: bool = True
+    rtol: float = 1e-8
 
     def __post_init__(self):
         one_of("integrator", self.integrator, tuple(INTEGRATORS))
@@ -41,6 +51,9 @@ class Numerics:
             require(name, value, isinstance(value, int) and value >= 4, "an integer >= 4")
         require("row_width", self.row_width, positive("row_width", self.row_width) >= 1.0, ">= 1")
         positive("max_time", self.max_time)
+        require("continuum", self.continuum, isinstance(self.continuum, bool), "True or False")
+        require("rtol", self.rtol, 1e-14 <= positive("rtol", self.rtol) <= 1e-2,
+                "between 1e-14 and 1e-2")
 
     @classmethod
     def preset(cls, name: str) -> "Numerics":

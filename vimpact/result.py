@@ -26,20 +26,28 @@ UNITS = {
     "v_x_end": "m/s",
     "omega_end": "rad/s",
     "status": "",
+    "n_steps": "1",
+    "path": "",
 }
 
 #: Meaning of each status value.
 STATUSES = {
     "ok": "finished; all outputs valid",
     "vc0_zero": "finished; v_c0 = 0, so no tangential force and e_x, beta_x are undefined (NaN)",
+    "normal_only": "finished; the scene asked for the normal impact only (tangential = 'none'): "
+                   "e_x, beta_x not computed (NaN)",
     "half_space": "finished, but the contact half-width exceeded 0.2 R: outside the half-space model",
     "time_limit": "the impact had not ended at the time limit (Numerics.max_time); outputs NaN",
     "row_exceeded": "the contact reached the end of the element row; outputs NaN",
     "non_finite": "the integration produced a non-finite value; outputs NaN",
+    "unstable": "the numerical solution gained energy (energy_ratio > 1 + 1e-6) although the "
+                "material and the incremental tangential rule are passive: the step was too "
+                "coarse for this scene; outputs NaN (refine: more steps or elements; "
+                "explicit Euler is exempt: it gains energy by construction)",
 }
 
 #: Statuses whose numbers are results (the others carry NaN).
-FINISHED = ("ok", "vc0_zero", "half_space")
+FINISHED = ("ok", "vc0_zero", "normal_only", "half_space")
 
 
 @dataclass(frozen=True)
@@ -61,6 +69,8 @@ class ImpactResult:
         Q2 NaN unless a standard solid)
     v_z_end, v_x_end, omega_end : end velocities, m/s, m/s, rad/s (v_z > 0 into the half-space)
     status : see ``STATUSES``
+    n_steps : time steps taken (element path) or accepted ODE steps (continuum path)
+    path : the kernel that ran (:mod:`vimpact.paths`), e.g. ``elements[verlet,dashpot]``
     trajectory : time series of the impact if asked for (``None`` otherwise)
     """
 
@@ -81,6 +91,8 @@ class ImpactResult:
     v_x_end: float
     omega_end: float
     status: str
+    n_steps: int = 0
+    path: str = ""
     trajectory: pd.DataFrame | None = field(default=None, repr=False, compare=False)
 
     def to_dict(self) -> dict:

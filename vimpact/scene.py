@@ -11,6 +11,12 @@ from .validation import finite, one_of, positive, require
 
 TANGENTIAL_MEMORY = ("incremental", "seed")
 
+#: What a scene asks of the tangential problem: ``auto`` (stick whenever
+#: ``v_c0 != 0``), ``stick`` (full stick, PHYSICS.md section 6) or ``none``
+#: (normal impact only: no tangential state at all, e_x and beta_x NaN).
+#: Slip is not modelled yet.
+TANGENTIAL_EFFECTS = ("auto", "stick", "none")
+
 #: The thesis's half-space limit: contact half-width at most this times R.
 HALF_SPACE_LIMIT = 0.2
 
@@ -32,6 +38,11 @@ class Scene:
         unstrained) or ``"seed"`` (thesis eq. 4.16: total displacement; not passive)
     allow_large_contact : accept a contact half-width above ``0.2 R`` (the
         half-space model is then outside its range; the thesis stops there)
+    tangential : ``"auto"`` (default: full stick whenever ``v_c0 != 0``),
+        ``"stick"`` or ``"none"`` (normal impact only; ``TANGENTIAL_EFFECTS``)
+    rotation : the sphere may spin (default). ``False`` is the limit
+        ``Theta -> inf``: the tangential force changes ``v_x`` only and
+        ``omega`` keeps ``omega0`` (``Theta`` is then not used)
     """
 
     material: Material
@@ -43,6 +54,8 @@ class Scene:
     Theta: float | None = None
     tangential_memory: str = "incremental"
     allow_large_contact: bool = False
+    tangential: str = "auto"
+    rotation: bool = True
     hertz: HertzScales = field(init=False, repr=False, compare=False)
 
     def __post_init__(self):
@@ -56,13 +69,15 @@ class Scene:
             object.__setattr__(self, "Theta", 0.4 * self.m * self.R**2)
         positive("Theta", self.Theta)
         one_of("tangential_memory", self.tangential_memory, TANGENTIAL_MEMORY)
+        one_of("tangential", self.tangential, TANGENTIAL_EFFECTS)
+        require("rotation", self.rotation, isinstance(self.rotation, bool), "True or False")
         mat = self.material
         object.__setattr__(self, "hertz", hertz_scales(mat.G_inf, mat.nu, self.R, self.m, self.v_z0))
 
     @classmethod
     def from_dimensionless(cls, Q1: float, nu: float, Q2: float | None = None, *,
                            theta_ratio: float = 0.4, tangential_memory: str = "incremental",
-                           ) -> "Scene":
+                           tangential: str = "auto", rotation: bool = True) -> "Scene":
         """A physical scene with the given dimensionless parameters.
 
         Kelvin-Voigt for ``Q2 = None``, standard solid otherwise. Restitution
@@ -87,7 +102,7 @@ class Scene:
             material = Material.standard_solid(nu=nu, G1=G, G2=G / Q2, eta=tau * G)
         return cls(material, R=R, m=m, v_z0=v_z0, v_x0=1.0, omega0=0.0,
                    Theta=positive("theta_ratio", theta_ratio) * m * R**2,
-                   tangential_memory=tangential_memory)
+                   tangential_memory=tangential_memory, tangential=tangential, rotation=rotation)
 
     # ---- derived quantities ------------------------------------------
     @property
@@ -101,16 +116,24 @@ class Scene:
         return self.Theta / (self.m * self.R**2)
 
     @property
+    def computes_tangential(self) -> bool:
+        """The tangential problem is solved: asked for (``tangential`` is not
+        ``"none"``) and not trivially zero (``v_c0 != 0``, PHYSICS.md section 7)."""
+        return self.tangential != "none" and self.v_c0 != 0.0
+
+    @property
     def contact_mass_factor(self) -> float:
-        """``1 + m R^2 / Theta``: the contact point accelerates this much faster than
-        the centre under a tangential force (PHYSICS.md section 7), dimensionless."""
-        return 1.0 + 1.0 / self.theta_ratio
+        """``1 + m R^2 / Theta`` (``1`` without rotation): the contact point
+        accelerates this much faster than the centre under a tangential force
+        (PHYSICS.md section 7), dimensionless."""
+        return 1.0 + 1.0 / self.theta_ratio if self.rotation else 1.0
 
     def tangential_end_state(self, vc_ratio):
         """Centre velocity (m/s) and spin (rad/s) when the contact-point velocity
         has become ``vc_ratio * v_c0`` (works on arrays)."""
         impulse = (1.0 - vc_ratio) / self.contact_mass_factor * self.v_c0  # J / m, m/s
-        return self.v_x0 - impulse, self.omega0 - impulse * self.m * self.R / self.Theta
+        spin = impulse * self.m * self.R / self.Theta if self.rotation else 0.0 * impulse
+        return self.v_x0 - impulse, self.omega0 - spin
 
     @property
     def E_star(self) -> float:
