@@ -122,12 +122,13 @@ import pyarrow.parquet as pq
 from . import __version__
 from .material import MODELS, Material, shear_modulus
 from .numerics import PRESETS, Numerics
+from .paths import choose_path
 from .result import FINISHED, STATUSES
-from .scene import TANGENTIAL_MEMORY, Scene
+from .scene import TANGENTIAL_EFFECTS, TANGENTIAL_MEMORY, Scene
 from .simulate import simulate_batch
 
 #: Version of the table layout (columns and metadata keys).
-SCHEMA_VERSION = 1
+SCHEMA_VERSION = 2
 
 #: Prefix of every key-value metadata key the sweep writes.
 META_PREFIX = "vimpact."
@@ -179,6 +180,7 @@ COLUMNS = {
     "v_z_end_m_s": ("m/s", "normal velocity at the end (negative: rebound)"),
     "v_x_end_m_s": ("m/s", "tangential velocity of the centre at the end"),
     "omega_end_rad_s": ("rad/s", "spin at the end"),
+    "path": ("", "the kernel that ran the row (vimpact.paths; why: the paths metadata)"),
     "status": ("", "outcome of the row, see the statuses metadata"),
     "error": ("", "why the row failed before or in the simulation (null otherwise)"),
 }
@@ -198,11 +200,13 @@ _OUTPUTS = ("e_z", "e_x", "beta_x", "energy_ratio", "t_contact_s", "u_max_m", "a
 #: Outputs that are NaN when v_c0 = 0 (no tangential force).
 _TANGENTIAL = ("e_x", "beta_x")
 _SCALES = ("t_hertz_s", "d_hertz_m", "a_hertz_m")
+#: String columns (null where not applicable: path of a row that never ran, error of a good row).
+_LABELS = ("path", "status", "error")
 
 # ---- spec keys --------------------------------------------------------------
 
 _TOP_KEYS = ("model", "description", "seed", "chunk_size", "output", "tangential_memory",
-             "numerics", "random", "grid")
+             "tangential", "rotation", "numerics", "random", "grid")
 _NUMERICS_KEYS = ("preset",) + tuple(f.name for f in dataclasses.fields(Numerics))
 
 _MATERIAL_KEYS = {
@@ -397,6 +401,8 @@ class SweepSpec:
     draws : random mode: input name -> :class:`Draw`, in drawing order
     arms : random mode, Prony series: one ``{"G_Pa": Draw, "tau_s": Draw}`` per arm
     axes : grid mode: axis name -> values, outermost first
+    tangential : ``"auto"``, ``"stick"`` or ``"none"`` (:class:`vimpact.Scene`)
+    rotation : the sphere may spin
     """
 
     path: Path
@@ -413,6 +419,8 @@ class SweepSpec:
     draws: dict = dataclasses.field(default_factory=dict)
     arms: tuple = ()
     axes: dict = dataclasses.field(default_factory=dict)
+    tangential: str = "auto"
+    rotation: bool = True
 
     @property
     def n_chunks(self) -> int:
@@ -456,7 +464,8 @@ class SweepSpec:
             Q1 = p.get("Q1", 0.0)
             scene = Scene.from_dimensionless(Q1, p["nu"], p.get("Q2"),
                                              theta_ratio=p["theta_ratio"],
-                                             tangential_memory=self.tangential_memory)
+                                             tangential_memory=self.tangential_memory,
+                                             tangential=self.tangential, rotation=self.rotation)
             if self.model == "elastic":
                 scene = dataclasses.replace(
                     scene, material=Material.elastic(nu=p["nu"], G=scene.material.G_inf))
@@ -476,7 +485,8 @@ class SweepSpec:
         R, m = p["R_m"], p["m_kg"]
         return Scene(mat, R=R, m=m, v_z0=p["v_z0_m_s"], v_x0=p["v_x0_m_s"],
                      omega0=p["omega0_rad_s"], Theta=p["theta_ratio"] * m * R**2,
-                     tangential_memory=self.tangential_memory, allow_large_contact=True)
+                     tangential_memory=self.tangential_memory, allow_large_contact=True,
+                     tangential=self.tangential, rotation=self.rotation)
 
     # ---- table layout -------------------------------------------------------
     def input_columns(self) -> list[str]:
@@ -496,7 +506,8 @@ class SweepSpec:
         """All columns of the table, in order."""
         dimensionless = ["nu", "theta_ratio"] if self.model == "prony" else \
             ["Q1", "Q2", "nu", "theta_ratio"]
-        return ["row"] + self.input_columns() + dimensionless + list(_OUTPUTS) + ["status", "error"]
+        return (["row"] + self.input_columns() + dimensionless + list(_OUTPUTS)
+                + ["path", "status", "error"])
 
     def units(self) -> dict[str, str]:
         """Unit of every column (``"1"`` dimensionless, ``""`` for labels)."""
@@ -505,9 +516,8 @@ class SweepSpec:
     def schema(self) -> pa.Schema:
         fields = []
         for c in self.columns():
-            kind = pa.int64() if c == "row" else pa.string() if c in ("status", "error") \
-                else pa.float64()
-            fields.append(pa.field(c, kind, nullable=(c == "error")))
+            kind = pa.int64() if c == "row" else pa.string() if c in _LABELS else pa.float64()
+            fields.append(pa.field(c, kind, nullable=(c in ("path", "error"))))
         return pa.schema(fields)
 
     def metadata(self) -> dict[str, str]:
@@ -521,6 +531,8 @@ class SweepSpec:
             "rows": str(self.rows),
             "numerics": json.dumps(dataclasses.asdict(self.numerics)),
             "tangential_memory": self.tangential_memory,
+            "tangential": self.tangential,
+            "rotation": json.dumps(self.rotation),
             "units": json.dumps(self.units()),
             "columns": json.dumps({c: _describe(c) for c in self.columns()}),
             "statuses": json.dumps(SWEEP_STATUSES),
@@ -577,6 +589,13 @@ def load_spec(path) -> SweepSpec:
     if memory not in TANGENTIAL_MEMORY:
         raise spec.bad("tangential_memory", memory,
                        "one of " + ", ".join(map(repr, TANGENTIAL_MEMORY)))
+    tangential = data.get("tangential", "auto")
+    if tangential not in TANGENTIAL_EFFECTS:
+        raise spec.bad("tangential", tangential,
+                       "one of " + ", ".join(map(repr, TANGENTIAL_EFFECTS)))
+    rotation = data.get("rotation", True)
+    if not isinstance(rotation, bool):
+        raise spec.bad("rotation", rotation, "true or false")
     chunk_size = spec.integer("chunk_size", data.get("chunk_size", DEFAULT_CHUNK_SIZE), 1)
     output = data.get("output", path.with_suffix(".parquet").name)
     if not isinstance(output, str) or not output.strip():
@@ -604,7 +623,8 @@ def load_spec(path) -> SweepSpec:
     return SweepSpec(path=path, text=text, model=model, mode=mode, seed=seed,
                      chunk_size=chunk_size, output=output, numerics=numerics,
                      tangential_memory=memory, description=description, rows=rows,
-                     draws=draws, arms=arms, axes=axes)
+                     draws=draws, arms=arms, axes=axes, tangential=tangential,
+                     rotation=rotation)
 
 
 def _numerics(spec: _Spec, table) -> Numerics:
@@ -716,10 +736,11 @@ def compute_chunk(spec: SweepSpec, params: dict, start: int, stop: int) -> pa.Ta
     n = stop - start
     cols: dict[str, np.ndarray | list] = {"row": np.arange(start, stop, dtype=np.int64)}
     for c in spec.columns():
-        if c not in ("row", "status", "error"):
+        if c not in ("row",) + _LABELS:
             cols[c] = np.full(n, np.nan)
     status: list[str] = ["invalid"] * n
     error: list[str | None] = [None] * n
+    path: list[str | None] = [None] * n
 
     scenes, index = [], []
     for k in range(n):
@@ -765,15 +786,15 @@ def compute_chunk(spec: SweepSpec, params: dict, start: int, stop: int) -> pa.Ta
         if res is None:
             status[k], error[k] = "failed", message
             continue
-        status[k] = res["status"]
+        status[k], path[k] = res["status"], res["path"]
         for name, source in _RESULTS.items():
             cols[name][k] = res[source]
         for name, (num, den) in _RELATIVE.items():
             cols[name][k] = cols[num][k] / cols[den][k]
 
     _guard_nan(cols, status, error, vc0_zero)
-    arrays = [pa.array(cols[c], type=f.type) if c not in ("status", "error") else
-              pa.array(status if c == "status" else error, type=pa.string())
+    labels = {"path": path, "status": status, "error": error}
+    arrays = [pa.array(labels[c] if c in labels else cols[c], type=f.type)
               for c, f in zip(spec.columns(), spec.schema())]
     return pa.Table.from_arrays(arrays, schema=spec.schema())
 
@@ -808,7 +829,7 @@ def _guard_nan(cols: dict, status: list, error: list, vc0_zero: np.ndarray) -> N
         if st not in FINISHED:
             continue
         bad = [c for c, v in cols.items()
-               if c not in ("row", "status", "error") and not isinstance(v, list)
+               if c not in ("row",) + _LABELS and not isinstance(v, list)
                and np.isnan(v[k])
                and not (c in _TANGENTIAL and vc0_zero[k])]
         if bad:
@@ -988,8 +1009,24 @@ def _combine(spec: SweepSpec, parts: Path, out: Path) -> None:
         raise ValueError(f"{parts}: the parts do not add up to rows 0..{spec.rows - 1}; "
                          f"remove {parts} to start over")
     out.parent.mkdir(parents=True, exist_ok=True)
-    _write_atomic(table.replace_schema_metadata(_meta(spec.metadata())), out)
+    meta = {**spec.metadata(), "paths": json.dumps(_paths_explained(spec, table))}
+    _write_atomic(table.replace_schema_metadata(_meta(meta)), out)
     shutil.rmtree(parts)
+
+
+def _paths_explained(spec: SweepSpec, table: pa.Table) -> dict:
+    """Each kernel path of the table: its row count and why it ran (from its first row)."""
+    names = table.column("path").to_pylist()
+    params = spec.parameters()
+    out: dict = {}
+    for i, name in enumerate(names):
+        if name is None:
+            continue
+        if name not in out:
+            reasons = choose_path(spec.scene(params, i), spec.numerics).reasons
+            out[name] = {"rows": 0, "first_row": i, "reasons": list(reasons)}
+        out[name]["rows"] += 1
+    return out
 
 
 def _bar(spec: SweepSpec, total: int, initial: int):
@@ -1009,12 +1046,12 @@ def _bar(spec: SweepSpec, total: int, initial: int):
 
 def read_metadata(path) -> dict:
     """The sweep metadata of a table (or part) at ``path``, keys without the
-    ``vimpact.`` prefix; ``numerics``, ``units``, ``columns`` and ``statuses``
-    decoded from JSON, ``schema_version``, ``seed`` and ``rows`` as ints."""
+    ``vimpact.`` prefix; ``numerics``, ``units``, ``columns``, ``statuses``,
+    ``paths`` (kernel path -> rows and reasons) and ``rotation`` decoded from JSON, ``schema_version``, ``seed`` and ``rows`` as ints."""
     raw = pq.read_schema(path).metadata or {}
     meta = {k.decode()[len(META_PREFIX):]: v.decode() for k, v in raw.items()
             if k.decode().startswith(META_PREFIX)}
-    for key in ("numerics", "units", "columns", "statuses"):
+    for key in ("numerics", "units", "columns", "statuses", "paths", "rotation"):
         if key in meta:
             meta[key] = json.loads(meta[key])
     for key in ("schema_version", "seed", "rows", "chunk", "row_start", "row_stop", "n_chunks"):
