@@ -73,3 +73,39 @@ def test_installed_command_exit_code_and_help():
     for option in ("--E", "--G1", "--vz0", "--omega0", "--Q1", "--tangential-memory", "Pa s",
                    "m/s", "rad/s"):
         assert option in helptext
+
+
+def test_explain_normal_only_takes_the_continuum_path(capsys):
+    assert main(["simulate", "--Q1", "0.3", "--nu", "0.5", "--tangential", "none",
+                 "--explain", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["path"].startswith("continuum") and out["status"] == "normal_only"
+    assert any("normal impact only" in r for r in out["explain"])
+    assert out["e_z"] == pytest.approx(kelvin_voigt_continuum(0.3).e_z, abs=1e-8)
+    assert out["e_x"] is None
+
+
+def test_explain_standard_solid_names_its_effects(capsys):
+    assert main(["simulate", "--Q1", "0.3", "--Q2", "1", "--nu", "0.5", "--explain"]) == 0
+    text = capsys.readouterr().out
+    assert "path: elements[verlet,tangential:incremental,arms]" in text
+    assert "Maxwell arms" in text and "no dashpot term" in text
+
+
+def test_scene_file_and_tolerance(capsys):
+    assert main(["simulate", "--scene", "sweeps/scenes/normal_kelvin_voigt.toml",
+                 "--tolerance", "1e-6", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["path"].startswith("continuum") and out["status"] == "normal_only"
+
+
+@pytest.mark.parametrize("args, names", [
+    (["--scene", "sweeps/scenes/rubber_ball.toml", "--Q1", "0.1"], "--Q1"),
+    (["--Q1", "0.1", "--nu", "0.5", "--tolerance", "1e-4", "--numerics", "fast"], "--tolerance"),
+    (["--Q1", "0.1", "--nu", "0.5", "--tolerance", "0.5"], "tolerance = 0.5"),
+    (["--scene", "no/such/file.toml"], "file.toml"),
+])
+def test_scene_and_numerics_errors(args, names, capsys):
+    assert main(["simulate"] + args) == 2
+    err = capsys.readouterr().err
+    assert names in err and len(err.strip().splitlines()) == 1

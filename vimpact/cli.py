@@ -7,6 +7,7 @@ and exit code 2; never a traceback.
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 import math
 import sys
@@ -17,7 +18,8 @@ from ._cli_material import add_material_arguments, material_from_args, missing
 from .material import MODELS
 from .numerics import INTEGRATORS, PRESETS, Numerics
 from .result import STATUSES, UNITS
-from .scene import TANGENTIAL_MEMORY, Scene
+from .paths import choose_path
+from .scene import TANGENTIAL_EFFECTS, TANGENTIAL_MEMORY, Scene
 from .simulate import simulate
 from .sweep_cli import add_sweep_parser
 from .table_cli import add_plot_parser, add_table_parser
@@ -42,8 +44,12 @@ def _build_parser() -> argparse.ArgumentParser:
             "velocities) or a dimensionless one (--Q1 [--Q2] --nu). The model is "
             "inferred from the material options unless --model is given: --eta alone "
             "-> kelvin_voigt, --G1 --G2 --eta -> standard_solid, --prony -> prony, "
-            "neither -> elastic."),
-        epilog="Example: vimpact simulate --Q1 0.1 --nu 0.5 --json")
+            "neither -> elastic. Or read the whole scene from a TOML file (--scene)."),
+        epilog="Examples: vimpact simulate --Q1 0.1 --nu 0.5 --json; "
+               "vimpact simulate --scene sweeps/scenes/rubber_ball.toml --explain")
+    sim.add_argument("--scene", metavar="FILE",
+                     help="read the scene (and optionally [numerics]) from a TOML file, the "
+                          "format of a sweep's fixed part; other scene options are then refused")
     g = sim.add_argument_group("material (physical input)")
     g.add_argument("--model", choices=MODELS, help="rheology (default: inferred)")
     add_material_arguments(g, prony=True)
@@ -65,15 +71,31 @@ def _build_parser() -> argparse.ArgumentParser:
                         "(omit for Kelvin-Voigt)")
     g.add_argument("--theta-ratio", type=float, default=0.4, metavar="RATIO",
                    help="Theta / (m R^2), dimensionless (default 0.4, solid sphere)")
-    g = sim.add_argument_group("options")
-    g.add_argument("--tangential-memory", choices=TANGENTIAL_MEMORY, default="incremental",
+    g = sim.add_argument_group("effects")
+    g.add_argument("--tangential", choices=TANGENTIAL_EFFECTS, default=None,
+                   help="tangential problem: auto (default: full stick when v_c0 != 0), "
+                        "stick, or none (normal impact only; e_x not computed)")
+    g.add_argument("--no-rotation", action="store_true",
+                   help="the sphere does not spin (Theta -> infinity)")
+    g.add_argument("--tangential-memory", choices=TANGENTIAL_MEMORY, default=None,
                    help="tangential element rule: incremental (default, passive) or seed "
                         "(thesis eq. 4.16, total displacement)")
-    g.add_argument("--numerics", choices=tuple(PRESETS), default="default",
-                   help="numerics preset (default: about 1e-4 on e_z, e_x)")
+    g = sim.add_argument_group("numerics")
+    g.add_argument("--numerics", choices=tuple(PRESETS), default=None,
+                   help="numerics preset: fast (about 1e-3), default (about 1e-4), precise, "
+                        "thesis (explicit Euler as in the thesis)")
+    g.add_argument("--tolerance", type=float, metavar="TOL",
+                   help="pick steps and elements for this accuracy on e_z and e_x "
+                        "(instead of a preset; between 1e-7 and 1e-2)")
     g.add_argument("--integrator", choices=tuple(INTEGRATORS), help="override the integrator")
     g.add_argument("--steps", type=int, help="override: time steps per Hertz contact time")
     g.add_argument("--elements", type=int, help="override: elements per Hertz contact radius")
+    g.add_argument("--rtol", type=float, help="override: tolerance of the continuum path")
+    g.add_argument("--no-continuum", action="store_true",
+                   help="always use the element kernel (no Kelvin-Voigt continuum path)")
+    g.add_argument("--explain", action="store_true",
+                   help="say which kernel runs and why, then simulate")
+    g = sim.add_argument_group("output")
     g.add_argument("--allow-large-contact", action="store_true",
                    help="accept a contact half-width above 0.2 R (outside the half-space model)")
     g.add_argument("--trajectory", metavar="FILE",
@@ -88,10 +110,14 @@ def _build_parser() -> argparse.ArgumentParser:
 
 
 _PHYSICAL = ("E", "G", "eta", "G1", "G2", "prony", "R", "m", "Theta", "vz0", "model")
+_EFFECTS = {"tangential": "auto", "tangential_memory": "incremental"}
 
 
 def scene_from_args(a) -> Scene:
     """The scene described by parsed ``simulate`` options."""
+    effects = {k: getattr(a, k) if getattr(a, k) is not None else default
+               for k, default in _EFFECTS.items()}
+    effects["rotation"] = not a.no_rotation
     if a.Q1 is not None:
         given = [f"--{n}" for n in _PHYSICAL if getattr(a, n) is not None]
         given += [f"--{n}" for n in ("vx0", "omega0") if getattr(a, n) != 0.0]
@@ -100,8 +126,7 @@ def scene_from_args(a) -> Scene:
                              "a dimensionless scene (--Q1 [--Q2] --nu) or a physical one")
         if a.nu is None:
             raise missing("nu", "the Poisson ratio in [0, 0.5] is required")
-        return Scene.from_dimensionless(a.Q1, a.nu, a.Q2, theta_ratio=a.theta_ratio,
-                                        tangential_memory=a.tangential_memory)
+        return Scene.from_dimensionless(a.Q1, a.nu, a.Q2, theta_ratio=a.theta_ratio, **effects)
     if a.Q2 is not None:
         raise missing("Q1", "--Q2 is part of the dimensionless input --Q1 --Q2 --nu")
     material = material_from_args(a)
@@ -113,30 +138,69 @@ def scene_from_args(a) -> Scene:
     if theta is None and a.theta_ratio != 0.4:
         theta = a.theta_ratio * a.m * a.R**2
     return Scene(material, R=a.R, m=a.m, v_z0=a.vz0, v_x0=a.vx0, omega0=a.omega0, Theta=theta,
-                 tangential_memory=a.tangential_memory,
-                 allow_large_contact=a.allow_large_contact)
+                 allow_large_contact=a.allow_large_contact, **effects)
 
 
-def _numerics(a) -> Numerics:
-    changes = {k: getattr(a, k) for k in ("integrator", "steps", "elements")
+def _scene_file(a) -> tuple[Scene, Numerics | None]:
+    """Scene and numerics of ``--scene FILE``; scene options beside it are refused."""
+    from .scene_file import load_scene  # imports the sweep machinery: only when asked
+
+    given = [f"--{n.replace('_', '-')}" for n in _PHYSICAL + ("Q1", "Q2", "nu") + tuple(_EFFECTS)
+             if getattr(a, n) is not None]
+    given += [f"--{n.replace('_', '-')}" for n, default in
+              (("vx0", 0.0), ("omega0", 0.0), ("theta_ratio", 0.4), ("no_rotation", False))
+              if getattr(a, n) != default]
+    if given:
+        raise ValueError(f"{', '.join(given)} cannot be combined with --scene: the file "
+                         "describes the whole scene")
+    scene, numerics = load_scene(a.scene)
+    if a.allow_large_contact:
+        scene = dataclasses.replace(scene, allow_large_contact=True)
+    return scene, numerics
+
+
+def _numerics(a, base: Numerics | None = None) -> Numerics:
+    """The numerics of the options: a preset, a tolerance or the file's, then overrides."""
+    if a.tolerance is not None and a.numerics is not None:
+        raise ValueError(f"--tolerance = {a.tolerance:g} cannot be combined with "
+                         f"--numerics = {a.numerics}: give one of them")
+    if a.tolerance is not None:
+        numerics = Numerics.for_tolerance(a.tolerance)
+    elif a.numerics is not None or base is None:
+        numerics = Numerics.preset(a.numerics or "default")
+    else:
+        numerics = base
+    changes = {k: getattr(a, k) for k in ("integrator", "steps", "elements", "rtol")
                if getattr(a, k) is not None}
-    return Numerics.preset(a.numerics).with_(**changes)
+    if a.no_continuum:
+        changes["continuum"] = False
+    return numerics.with_(**changes)
 
 
 def _cmd_simulate(a) -> int:
     if a.trajectory and Path(a.trajectory).suffix.lower() not in (".csv", ".parquet"):
         raise ValueError(f"--trajectory = {a.trajectory!r} is not allowed: "
                          "must end in .csv or .parquet")
-    scene = scene_from_args(a)
-    res = simulate(scene, _numerics(a), trajectory=bool(a.trajectory))
+    if a.scene is not None:
+        scene, file_numerics = _scene_file(a)
+    else:
+        scene, file_numerics = scene_from_args(a), None
+    numerics = _numerics(a, file_numerics)
+    path = choose_path(scene, numerics)
+    if a.explain and not a.json:
+        print(path.explain())
+    res = simulate(scene, numerics, trajectory=bool(a.trajectory))
     if a.trajectory:
-        path = Path(a.trajectory)
-        if path.suffix.lower() == ".csv":
-            res.trajectory.to_csv(path, index=False)
+        out = Path(a.trajectory)
+        if out.suffix.lower() == ".csv":
+            res.trajectory.to_csv(out, index=False)
         else:
-            res.trajectory.to_parquet(path, index=False)
+            res.trajectory.to_parquet(out, index=False)
     if a.json:
-        print(json.dumps(res.to_json_dict()))
+        d = res.to_json_dict()
+        if a.explain:
+            d["explain"] = list(path.reasons)
+        print(json.dumps(d))
     else:
         print(_summary(scene, res))
     return 0
@@ -153,6 +217,7 @@ def _summary(scene: Scene, res) -> str:
         text = "undefined" if math.isnan(value) else f"{value:.6g}"
         lines.append(f"  {key:<13} {text:>12} {unit}")
     lines.append(f"  status        {res.status}: {STATUSES[res.status]}")
+    lines.append(f"  path          {res.path} ({res.n_steps} steps)")
     return "\n".join(lines)
 
 

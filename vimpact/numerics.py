@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, replace
 
 from .core.impact import EULER, SYMPLECTIC_EULER, VERLET
@@ -56,10 +57,40 @@ class Numerics:
                 "between 1e-14 and 1e-2")
 
     @classmethod
+    def for_tolerance(cls, tolerance: float, integrator: str = "verlet") -> "Numerics":
+        """Steps and elements chosen to reach ``tolerance`` on e_z and e_x.
+
+        Uses the error model measured by ``python -m benchmarks.accuracy``
+        (:data:`ERROR_MODEL`: ``error ~ a / steps^p + b / elements^q``, the
+        worst case over Q1 in [1e-3, 10], Q2 and nu), half the tolerance to
+        each knob; the continuum path gets ``rtol = tolerance / 10`` (its
+        error is 0.1 to 6 times rtol). The element path is capped at
+        :data:`MAX_STEPS` and :data:`MAX_ELEMENTS`: below about 1e-6 it
+        cannot follow (its e_x converges only about first order in the steps)
+        and delivers what the cap reaches; the continuum path reaches 1e-12.
+
+        Parameters
+        ----------
+        tolerance : target absolute error on e_z and e_x, in [1e-12, 1e-2]
+        integrator : ``"verlet"`` (the model is measured for it)
+        """
+        tol = positive("tolerance", tolerance)
+        require("tolerance", tolerance, 1e-12 <= tol <= 1e-2, "between 1e-12 and 1e-2")
+        one_of("integrator", integrator, ("verlet",))
+        m = ERROR_MODEL
+        steps = math.ceil((2.0 * m["a"] / tol) ** (1.0 / m["p"]))
+        elements = math.ceil((2.0 * m["b"] / tol) ** (1.0 / m["q"]))
+        return cls(integrator=integrator, steps=int(min(max(steps, 100), MAX_STEPS)),
+                   elements=int(min(max(elements, 20), MAX_ELEMENTS)),
+                   rtol=max(tol / 10.0, 1e-13))
+
+    @classmethod
     def preset(cls, name: str) -> "Numerics":
-        """Named settings: ``default`` (about 1e-4 on e_z, e_x), ``fast``
-        (about 1e-3) and ``thesis`` (explicit Euler, 5000 steps per t_H,
-        1000 elements across the contact diameter, as in the thesis)."""
+        """Named settings (:data:`PRESETS`): ``fast`` (about 1e-3 on e_z, e_x),
+        ``default`` (about 1e-4), ``precise`` (:meth:`for_tolerance` of 1e-7:
+        reached on the continuum path; the element path gives what its cap
+        reaches, about 1e-6) and ``thesis`` (explicit Euler, 5000 steps per
+        t_H, 1000 elements across the contact diameter, as in the thesis)."""
         one_of("numerics preset", name, tuple(PRESETS))
         return PRESETS[name]
 
@@ -72,8 +103,16 @@ class Numerics:
         return INTEGRATORS[self.integrator]
 
 
+#: Error model of the Verlet element path, measured by ``benchmarks/accuracy.py``
+#: (worst case over its scenes): ``max(|e_z err|, |e_x err|) ~ a / steps^p + b / elements^q``.
+ERROR_MODEL = {"a": 0.04, "p": 1.0, "b": 0.5, "q": 2.0}
+#: Caps of :meth:`Numerics.for_tolerance` on the element path (about 0.3 s per impact).
+MAX_STEPS = 16000
+MAX_ELEMENTS = 3200
+
 PRESETS = {
+    "fast": Numerics(steps=400, elements=80, rtol=1e-4),
     "default": Numerics(),
-    "fast": Numerics(steps=400, elements=80),
+    "precise": Numerics.for_tolerance(1e-7),
     "thesis": Numerics(integrator="euler", steps=5000, elements=500),
 }
