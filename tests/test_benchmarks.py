@@ -23,3 +23,19 @@ def test_sweep_speedup_quick(tmp_path):
     data = sweep_speedup.run(spec, repeats=1)
     assert data["rows"] == 3 and data["speedup"] > 0
     json.dumps(data)
+
+
+def test_paths_quick(tmp_path):
+    """Each path runs; the specialized kernels give the general kernel's normal
+    results exactly (same arithmetic, branches folded); the continuum path is
+    the more accurate one at its setting."""
+    from benchmarks import paths
+
+    data = paths.run(quick=True)
+    paths.plot(data, tmp_path / "paths.png")
+    assert (tmp_path / "paths.png").stat().st_size > 0
+    json.dumps(data)
+    for case in data["specialization_equal_numerics"].values():
+        assert case["max_e_z_difference"] == 0.0 and case["speedup"] > 0
+    kv = data["kelvin_voigt_normal_equal_accuracy"]["settings"]
+    assert kv["continuum rtol=1e-7"]["max_e_z_error"] < 1e-6
