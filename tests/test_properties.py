@@ -166,7 +166,7 @@ def test_strategy_reaches_the_corners():
     """The draws cover every rheology, v_c0 = 0 and both ends of nu and theta."""
     seen = []
 
-    @settings(max_examples=200, **SETTINGS)
+    @settings(max_examples=1000, **SETTINGS)
     @given(draws())
     def collect(d):
         seen.append(d)

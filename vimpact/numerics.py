@@ -63,8 +63,9 @@ class Numerics:
         Uses the error model measured by ``python -m benchmarks.accuracy``
         (:data:`ERROR_MODEL`: ``error ~ a / steps^p + b / elements^q``, the
         worst case over Q1 in [1e-3, 10], Q2 and nu), half the tolerance to
-        each knob; the continuum path gets ``rtol = tolerance / 10`` (its
-        error is 0.1 to 6 times rtol). The element path is capped at
+        each knob; the continuum path gets ``rtol = min(tolerance / 10, 1e-8)``
+        (its error is 0.1 to 6 times rtol; it costs microseconds, and below
+        1e-6 its elastic e_z cannot pass 1 by more than the passivity slack). The element path is capped at
         :data:`MAX_STEPS` and :data:`MAX_ELEMENTS`: below about 1e-6 it
         cannot follow (its e_x converges only about first order in the steps)
         and delivers what the cap reaches; the continuum path reaches 1e-12.
@@ -82,7 +83,7 @@ class Numerics:
         elements = math.ceil((2.0 * m["b"] / tol) ** (1.0 / m["q"]))
         return cls(integrator=integrator, steps=int(min(max(steps, 100), MAX_STEPS)),
                    elements=int(min(max(elements, 20), MAX_ELEMENTS)),
-                   rtol=max(tol / 10.0, 1e-13))
+                   rtol=min(max(tol / 10.0, 1e-13), 1e-8))
 
     @classmethod
     def preset(cls, name: str) -> "Numerics":
@@ -111,7 +112,7 @@ MAX_STEPS = 16000
 MAX_ELEMENTS = 3200
 
 PRESETS = {
-    "fast": Numerics(steps=400, elements=80, rtol=1e-4),
+    "fast": Numerics(steps=400, elements=80),
     "default": Numerics(),
     "precise": Numerics.for_tolerance(1e-7),
     "thesis": Numerics(integrator="euler", steps=5000, elements=500),
