@@ -1,0 +1,123 @@
+"""The accuracy-versus-cost benchmark runs end to end on a tiny configuration
+and its derived numbers are consistent (no time is asserted)."""
+
+import json
+import math
+
+import pytest
+
+import vimpact as v
+from benchmarks import accuracy
+
+
+@pytest.fixture(scope="module")
+def data():
+    return accuracy.run(quick=True)
+
+
+def test_structure_and_plot(data, tmp_path):
+    json.dumps(data, allow_nan=False)  # strict JSON
+    accuracy.plot(data, tmp_path / "pareto.png")
+    assert (tmp_path / "pareto.png").stat().st_size > 0
+    assert set(data["integrators"]) == set(accuracy.INTEGRATORS)
+    assert set(data["presets"]) == set(v.PRESETS)
+    for key in ("cheapest", "cheapest_by_time_model", "cheapest_e_z_only",
+                "euler_over_verlet_time", "orders", "error_models", "suggested_presets"):
+        assert key in data["derived"]
+    grids = {r["grid"] for r in data["integrators"]["verlet"]["settings"]}
+    assert grids == {"base", "refined"}
+    assert set(data["derived"]["cheapest"]) == {f"{t:g}" for t in accuracy.TOLERANCES}
+
+
+def test_scenes_oblique_and_reference_converged(data):
+    ref = data["reference"]
+    assert ref["fine"] == [2 * ref["coarse"][0], 2 * ref["coarse"][1]]
+    for s in data["scenes"]:
+        assert math.isfinite(s["e_x_ref"]) and s["e_x_ref"] > 0  # e_x is defined
+        assert 0 < s["e_z_ref"] < 1
+    # even the tiny reference is close to the exact Kelvin-Voigt e_z
+    assert ref["fine_run_kelvin_voigt_e_z_error_max"] < 1e-4
+    assert 0 <= ref["e_x_uncertainty_max"] < 1e-3
+
+
+def test_every_setting_ran_on_the_element_path(data):
+    for name, g in data["integrators"].items():
+        assert g["failed_settings"] == 0
+        assert g["paths"] and all(p.startswith(f"elements[{name},") for p in g["paths"])
+        for r in g["settings"]:
+            assert r["error"] == max(r["e_z_error_max"], r["e_x_error_max"])
+            assert r["e_z_error_median"] <= r["e_z_error_max"]
+            assert r["seconds_per_impact"] > 0
+    for c in data["continuum"]:
+        assert c["failed"] == 0 and all(p.startswith("continuum") for p in c["paths"])
+    # the continuum path is accurate at a tight rtol
+    tight = min(data["continuum"], key=lambda c: c["rtol"])
+    assert tight["e_z_error_max"] < 1e-6
+
+
+def test_front_is_a_pareto_front(data):
+    for g in data["integrators"].values():
+        front = g["front"]
+        assert front
+        times = [r["seconds_per_impact"] for r in front]
+        errors = [r["error"] for r in front]
+        assert times == sorted(times)
+        assert all(a > b for a, b in zip(errors, errors[1:]))
+        # nothing off the front beats a front point in both respects
+        for r in g["settings"]:
+            assert not any(r["seconds_per_impact"] < f["seconds_per_impact"]
+                           and r["error"] < f["error"] for f in front)
+
+
+def test_cheapest_meets_its_tolerance(data):
+    for tol, row in data["derived"]["cheapest"].items():
+        for name in accuracy.INTEGRATORS:
+            c = row[name]
+            if c != "not reached":
+                assert c["error"] <= float(tol)
+
+
+def test_pareto_helper():
+    assert accuracy.pareto([1, 2, 3, 4], [1e-2, 1e-3, 5e-3, math.inf]) == [0, 1]
+    assert accuracy.pareto([2, 1], [1e-3, 1e-3]) == [1]
+
+
+def test_ladder_base_grid_and_refinement():
+    cfg = accuracy.CONFIGS["full"]
+    lad = accuracy._ladder(cfg, "verlet")
+    base = [(s, e) for s, e, g in lad if g == "base"]
+    assert len(base) == 49 and (1000, 200) in base and (8000, 1600) in base
+    assert all(2.5 <= s / e <= 40 for s, e, g in lad if g == "refined")
+    assert len(set((s, e) for s, e, _ in lad)) == len(lad)
+    euler = accuracy._ladder(cfg, "euler")
+    assert max(s for s, _, _ in euler) == 128000
+    assert all(s * e <= 32000 * 1600 for s, e, _ in euler)
+
+
+def test_envelope_bounds_every_point():
+    S = [s for s in (100, 200, 400, 800) for _ in range(3)]
+    E = [e for _ in range(4) for e in (20, 40, 80)]
+    err = [0.05 / s * (1.3 if i % 2 else 0.8) + 0.7 / e**2 for i, (s, e) in enumerate(zip(S, E))]
+    m = accuracy.fit_envelope(S, E, err, 0.0, 1.0, 2.0)
+    assert m["scale"] >= 1.0
+    assert all(m["a"] / s + m["b"] / e**2 >= y * (1 - 1e-12) for s, e, y in zip(S, E, err))
+
+
+def test_error_model_recovers_known_constants():
+    S = [s for s in (100, 200, 400, 800, 1600) for _ in range(4)]
+    E = [e for _ in range(5) for e in (20, 40, 80, 160)]
+    err = [0.3 / s**2 + 0.02 / e**1.5 for s, e in zip(S, E)]
+    m = accuracy.fit_error_model(S, E, err, floor=0.0, p0=2.0)
+    assert m["fitted"]
+    assert m["p"] == pytest.approx(2.0, rel=1e-3) and m["q"] == pytest.approx(1.5, rel=1e-3)
+    assert m["a"] == pytest.approx(0.3, rel=1e-2) and m["b"] == pytest.approx(0.02, rel=1e-2)
+
+
+def test_thesis_table_4_1_explicit_euler(data):
+    t = data["table_4_1"]
+    for n, pct in t["euler"]["percent"].items():
+        # element path (not the continuum one): the thesis's first-order error
+        assert pct == pytest.approx(t["thesis_percent"][n], rel=0.05)
+    assert all(p.startswith("elements[euler") for p in t["euler"]["paths"])
+    # the second-order integrator is far more accurate at the same steps
+    assert t["verlet"]["percent"]["1000"] < 0.01 * t["euler"]["percent"]["1000"]
