@@ -62,14 +62,12 @@ Python API::
 from __future__ import annotations
 
 import dataclasses
-import tomllib
 from pathlib import Path
 
-from .material import MODELS
 from .numerics import Numerics
-from .scene import TANGENTIAL_EFFECTS, TANGENTIAL_MEMORY, Scene
+from .scene import Scene
 from .sweep import (_ARM_KEYS, _MATERIAL_KEYS, _RANDOM_DEFAULTS, _SPHERE_KEYS, _TOP_KEYS, Draw,
-                    SweepSpec, _numerics, _Spec)
+                    SweepSpec, _numerics, _Spec, parse_header, parse_toml, read_toml)
 
 #: Top-level keys of a scene file.
 TOP_KEYS = ("model", "description", "tangential_memory", "tangential", "rotation",
@@ -78,7 +76,6 @@ TOP_KEYS = ("model", "description", "tangential_memory", "tangential", "rotation
 #: Defaults of the ``[scene]`` table (those of a sweep's ``[random]``).
 DEFAULTS = {**_RANDOM_DEFAULTS, "eta_Pa_s": 0.0}  # eta_Pa_s: prony only (optional there)
 
-_TRUE_FALSE = "true or false"
 _ONE_NUMBER = ("one number (a scene is one impact: ranges and choices belong in a "
                "sweep's [random] table)")
 
@@ -119,56 +116,41 @@ def load_scene(path) -> tuple[Scene, Numerics | None]:
     missing keys and bad values.
     """
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise ValueError(f"{path}: scene file not found") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise ValueError(f"{path}: cannot read the scene file: {exc}") from None
-    return scene_from_toml(text, source=path)
+    text, data = read_toml(path, "scene file")
+    return _scene(_Spec(path), text, data)
 
 
 def scene_from_toml(text: str, source="<string>") -> tuple[Scene, Numerics | None]:
     """:func:`load_scene` of the TOML ``text``; ``source`` names it in error messages."""
     spec = _Spec(source)
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise ValueError(f"{source}: not valid TOML: {exc}") from None
-    _top_keys(spec, data)
+    return _scene(spec, text, parse_toml(spec, text))
 
-    model = data.get("model")
-    if model is None:
-        raise spec.error("model", f"missing (one of {', '.join(MODELS)})")
-    if model not in MODELS:
-        raise spec.bad("model", model, "one of " + ", ".join(map(repr, MODELS)))
-    description = data.get("description", "")
-    if not isinstance(description, str):
-        raise spec.bad("description", description, "a string")
-    memory = _choice(spec, data, "tangential_memory", TANGENTIAL_MEMORY, "incremental")
-    tangential = _choice(spec, data, "tangential", TANGENTIAL_EFFECTS, "auto")
-    rotation = _flag(spec, data, "rotation", True)
-    allow_large = _flag(spec, data, "allow_large_contact", False)
+
+def _scene(spec: _Spec, text: str, data: dict) -> tuple[Scene, Numerics | None]:
+    source = spec.path
+    _top_keys(spec, data)
+    header = parse_header(spec, data)
+    allow_large = spec.flag(data, "allow_large_contact", False)
     numerics = _numerics(spec, data["numerics"]) if "numerics" in data else None
 
     if "scene" not in data:
         raise spec.error("scene", "missing: a [scene] table with the physical values ("
-                         + ", ".join(allowed_scene_keys(model)) + ")")
-    draws, arms = _scene_table(spec, model, data["scene"])
+                         + ", ".join(allowed_scene_keys(header.model)) + ")")
+    draws, arms = _scene_table(spec, header.model, data["scene"])
 
     # One row of a sweep with fixed draws: the same key names, defaults and
     # construction as SweepSpec.scene, so the two formats cannot drift apart.
-    sweep = SweepSpec(path=Path(str(source)), text=text, model=model, mode="random", seed=0,
-                      chunk_size=1, output=Path(str(source) + ".parquet"),
-                      numerics=numerics or Numerics(), tangential_memory=memory,
-                      description=description, rows=1, draws=draws, arms=arms)
+    sweep = SweepSpec(path=Path(str(source)), text=text, model=header.model, mode="random",
+                      seed=0, chunk_size=1, output=Path(str(source) + ".parquet"),
+                      numerics=numerics or Numerics(),
+                      tangential_memory=header.tangential_memory,
+                      description=header.description, rows=1, draws=draws, arms=arms,
+                      tangential=header.tangential, rotation=header.rotation)
     try:
         scene = sweep.scene(sweep.parameters(), 0)
-        scene = dataclasses.replace(scene, allow_large_contact=allow_large,
-                                    tangential=tangential, rotation=rotation)
     except ValueError as exc:
         raise ValueError(f"{source}: scene: {exc}") from None
-    return scene, numerics
+    return dataclasses.replace(scene, allow_large_contact=allow_large), numerics
 
 
 def _top_keys(spec: _Spec, data: dict) -> None:
@@ -182,20 +164,6 @@ def _top_keys(spec: _Spec, data: dict) -> None:
             raise spec.error(key, "a sweep key, not a scene key (allowed: "
                              + ", ".join(TOP_KEYS) + ")")
         spec.unknown({key: None}, TOP_KEYS)
-
-
-def _choice(spec: _Spec, data: dict, key: str, choices, default: str) -> str:
-    value = data.get(key, default)
-    if value not in choices:
-        raise spec.bad(key, value, "one of " + ", ".join(map(repr, choices)))
-    return value
-
-
-def _flag(spec: _Spec, data: dict, key: str, default: bool) -> bool:
-    value = data.get(key, default)
-    if not isinstance(value, bool):
-        raise spec.bad(key, value, _TRUE_FALSE)
-    return value
 
 
 def _number(spec: _Spec, key: str, value, name: str) -> float:

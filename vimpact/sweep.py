@@ -112,6 +112,7 @@ import shutil
 import sys
 import tomllib
 from collections.abc import Callable
+from typing import NamedTuple
 from pathlib import Path
 
 import numba
@@ -277,6 +278,62 @@ class _Spec:
         if not isinstance(value, int) or isinstance(value, bool) or value < minimum:
             raise self.bad(key, value, f"an integer >= {minimum}")
         return value
+
+    def choice(self, data: dict, key: str, choices, default: str) -> str:
+        value = data.get(key, default)
+        if value not in choices:
+            raise self.bad(key, value, "one of " + ", ".join(map(repr, choices)))
+        return value
+
+    def flag(self, data: dict, key: str, default: bool) -> bool:
+        value = data.get(key, default)
+        if not isinstance(value, bool):
+            raise self.bad(key, value, "true or false")
+        return value
+
+
+def read_toml(path: Path, what: str) -> tuple[str, dict]:
+    """Text and parsed content of the TOML file ``path`` (``what`` names it in errors)."""
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise ValueError(f"{path}: {what} not found") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ValueError(f"{path}: cannot read the {what}: {exc}") from None
+    return text, parse_toml(_Spec(path), text)
+
+
+def parse_toml(spec: _Spec, text: str) -> dict:
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ValueError(f"{spec.path}: not valid TOML: {exc}") from None
+
+
+class Header(NamedTuple):
+    """The top-level keys a sweep spec and a scene file share."""
+
+    model: str
+    description: str
+    tangential_memory: str
+    tangential: str
+    rotation: bool
+
+
+def parse_header(spec: _Spec, data: dict) -> Header:
+    """``model`` (required), ``description``, ``tangential_memory``, ``tangential``, ``rotation``."""
+    model = data.get("model")
+    if model is None:
+        raise spec.error("model", f"missing (one of {', '.join(MODELS)})")
+    if model not in MODELS:
+        raise spec.bad("model", model, "one of " + ", ".join(map(repr, MODELS)))
+    description = data.get("description", "")
+    if not isinstance(description, str):
+        raise spec.bad("description", description, "a string")
+    return Header(model, description,
+                  spec.choice(data, "tangential_memory", TANGENTIAL_MEMORY, "incremental"),
+                  spec.choice(data, "tangential", TANGENTIAL_EFFECTS, "auto"),
+                  spec.flag(data, "rotation", True))
 
 
 @dataclasses.dataclass(frozen=True)
@@ -564,38 +621,11 @@ def load_spec(path) -> SweepSpec:
     bad TOML, unknown keys and bad values.
     """
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise ValueError(f"{path}: sweep specification not found") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise ValueError(f"{path}: cannot read the sweep specification: {exc}") from None
+    text, data = read_toml(path, "sweep specification")
     spec = _Spec(path)
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise ValueError(f"{path}: not valid TOML: {exc}") from None
     spec.unknown(data, _TOP_KEYS)
-
-    model = data.get("model")
-    if model is None:
-        raise spec.error("model", f"missing (one of {', '.join(MODELS)})")
-    if model not in MODELS:
-        raise spec.bad("model", model, "one of " + ", ".join(map(repr, MODELS)))
-    description = data.get("description", "")
-    if not isinstance(description, str):
-        raise spec.bad("description", description, "a string")
-    memory = data.get("tangential_memory", "incremental")
-    if memory not in TANGENTIAL_MEMORY:
-        raise spec.bad("tangential_memory", memory,
-                       "one of " + ", ".join(map(repr, TANGENTIAL_MEMORY)))
-    tangential = data.get("tangential", "auto")
-    if tangential not in TANGENTIAL_EFFECTS:
-        raise spec.bad("tangential", tangential,
-                       "one of " + ", ".join(map(repr, TANGENTIAL_EFFECTS)))
-    rotation = data.get("rotation", True)
-    if not isinstance(rotation, bool):
-        raise spec.bad("rotation", rotation, "true or false")
+    header = parse_header(spec, data)
+    model = header.model
     chunk_size = spec.integer("chunk_size", data.get("chunk_size", DEFAULT_CHUNK_SIZE), 1)
     output = data.get("output", path.with_suffix(".parquet").name)
     if not isinstance(output, str) or not output.strip():
@@ -622,9 +652,9 @@ def load_spec(path) -> SweepSpec:
         draws, arms = {}, ()
     return SweepSpec(path=path, text=text, model=model, mode=mode, seed=seed,
                      chunk_size=chunk_size, output=output, numerics=numerics,
-                     tangential_memory=memory, description=description, rows=rows,
-                     draws=draws, arms=arms, axes=axes, tangential=tangential,
-                     rotation=rotation)
+                     tangential_memory=header.tangential_memory,
+                     description=header.description, rows=rows, draws=draws, arms=arms,
+                     axes=axes, tangential=header.tangential, rotation=header.rotation)
 
 
 def _numerics(spec: _Spec, table) -> Numerics:
