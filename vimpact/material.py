@@ -94,6 +94,12 @@ class Material:
         return self.G_inf + sum(G for G, _ in self.arms)
 
     @property
+    def kappa(self) -> float:
+        """Tangential over normal element stiffness ``c_t / c_n = 2 (1 - nu) / (2 - nu)``
+        (PHYSICS.md section 3), dimensionless."""
+        return 2.0 * (1.0 - self.nu) / (2.0 - self.nu)
+
+    @property
     def dashpot_time(self) -> float:
         """``eta0 / G_inf``, s."""
         return self.eta0 / self.G_inf

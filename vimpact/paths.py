@@ -144,8 +144,7 @@ def refinement(scene: Scene, numerics: Numerics, spec: KernelSpec) -> tuple[floa
     r = stiffness_ratio(scene)
     time_factor, element_factor = r ** 0.4, r ** 0.2
     mat, T = scene.material, scene.hertz.T
-    kappa = 2.0 * (1.0 - mat.nu) / (2.0 - mat.nu)
-    stiff_t = kappa * scene.contact_mass_factor if spec.tangential else 0.0
+    stiff_t = mat.kappa * scene.contact_mass_factor if spec.tangential else 0.0
     if spec.tangential:
         time_factor *= max(1.0, math.sqrt(stiff_t))
         # a fast tangential oscillation also feels each element entering the

@@ -79,7 +79,7 @@ def pack(scenes: Sequence[Scene], numerics: Numerics, spec: KernelSpec) -> dict[
                 a["g"][i, k] = G_k / mat.G_inf
                 a["tau"][i, k] = tau_k / T
             a["n_arms"][i] = len(mat.arms)
-        a["kappa"][i] = 2.0 * (1.0 - mat.nu) / (2.0 - mat.nu)
+        a["kappa"][i] = mat.kappa
         a["mu_t"][i] = s.contact_mass_factor
         time_factor, element_factor = refinement(s, numerics, spec)
         a["h"][i] = HERTZ_TIME_FACTOR / numerics.steps / time_factor

@@ -142,13 +142,11 @@ def _relax(w0, qrow, g, E, omE, phi, tau0_h, den_free, decay0):
     """Free surface relaxation under zero force over one step; returns the new ``w``.
 
     Solves ``tau0 dw/dt + G_inf w + sum g_i (w - q_i) = 0`` (PHYSICS.md
-    section 5). Without arms the solution is exact (``w decay0``, or 0 for an
-    elastic element). With arms it is implicit in the end value (L-stable),
-    with the arms on the exact linear-path update.
+    section 5) for an element with arms, implicit in the end value (L-stable),
+    the arms on the exact linear-path update. (Without arms the kernel uses
+    the exact ``w decay0`` instead, 0 for an elastic element.)
     """
     n = g.shape[0]
-    if n == 0:
-        return w0 * decay0
     num = tau0_h * w0
     for i in range(n):
         num += g[i] * (E[i] * qrow[i] + (omE[i] - phi[i]) * w0)
@@ -167,8 +165,6 @@ def _free_rate(w, qrow, g, tau, tau0):
         r += g[i] * (w - qrow[i])
     if tau0 > 0.0:
         return -r / tau0
-    if n == 0:
-        return 0.0
     G = 0.0
     rate = 0.0
     for i in range(n):
@@ -221,7 +217,7 @@ def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT,
     out : (N_OUT,) result row
     """
     n_arms = g.shape[0] if ARMS else 0
-    E, omE, phi = arm_coefficients(tau[:n_arms], h)
+    E, omE, phi = arm_coefficients(tau, h)
     G = 0.0
     sum_gphi = 0.0
     for i in range(n_arms):
@@ -388,7 +384,7 @@ def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT,
             caught = False
             if DASHPOT or ARMS:  # an elastic surface is back at rest at once
                 for j in range(active):
-                    if _free_rate(w[j], q[j], g[:n_arms], tau[:n_arms], c0) < v * (1.0 + 1e-9):
+                    if _free_rate(w[j], q[j], g, tau, c0) < v * (1.0 + 1e-9):
                         caught = True
                         break
             if not caught:
