@@ -43,8 +43,6 @@ Nothing here asserts a time.
 
 from __future__ import annotations
 
-import argparse
-import json
 import math
 import os
 import sys
@@ -58,9 +56,8 @@ import vimpact as v
 from vimpact.analytic import kelvin_voigt_continuum
 from vimpact.result import FINISHED
 
-from .machine import machine_info
+from .machine import bench_main, machine_info, save_figure
 
-RESULTS = Path(__file__).parent / "results"
 TOLERANCES = (1e-3, 1e-4, 1e-5, 1e-6, 1e-7)
 INTEGRATORS = ("verlet", "symplectic_euler", "euler")
 THESIS_TABLE_4_1 = {500: 1.1254, 1000: 0.5608, 5000: 0.1119, 10000: 0.0559}  # percent
@@ -873,9 +870,7 @@ def plot(data: dict, path: Path) -> None:
         cx.set_title("Continuum path: Kelvin-Voigt normal-only impacts", fontsize=10)
         cx.grid(True, which="major", alpha=0.3)
         cx.legend(fontsize=7)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    save_figure(fig, path)
 
 
 # ---------------------------------------------------------------- CLI
@@ -949,17 +944,8 @@ def _summary(data: dict) -> str:
     return "\n".join(lines)
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--quick", action="store_true", help="tiny configuration (CI)")
-    parser.add_argument("--out", type=Path, default=RESULTS, help="results folder")
-    args = parser.parse_args()
-    data = run(args.quick)
-    print(json.dumps(data["machine"]))
-    args.out.mkdir(parents=True, exist_ok=True)
-    sfx = "_quick" if args.quick else ""
-    (args.out / f"accuracy{sfx}.json").write_text(json.dumps(data, indent=1, allow_nan=False))
-    plot(data, args.out / f"accuracy_pareto{sfx}.png")
+def main(argv: list[str] | None = None) -> None:
+    data = bench_main(__doc__, run, plot, "accuracy", png_stem="accuracy_pareto", argv=argv)
     print(_summary(data))
 
 

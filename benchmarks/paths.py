@@ -15,9 +15,6 @@ Kernel time only (inputs packed once, median of repeats, all numba threads).
 
 from __future__ import annotations
 
-import argparse
-import json
-from pathlib import Path
 
 import matplotlib
 import numba
@@ -30,10 +27,8 @@ from vimpact.core import impact as kernel
 from vimpact.paths import choose_path
 from vimpact.simulate import pack
 
-from .default_accuracy import _median_time
-from .machine import machine_info
+from .machine import bench_main, machine_info, median_time, save_figure
 
-RESULTS = Path(__file__).parent / "results"
 GENERAL = kernel.KernelSpec(kernel.VERLET, True, 0, True, True)
 
 
@@ -53,7 +48,7 @@ def _kv_normal(quick: bool) -> dict:
         call, result = make(scenes * k, numerics)
         call()  # compile / load
         e_z = np.abs(result()[:len(scenes), kernel.OUT_VZ_END])
-        t = _median_time(call, 1 if quick else 3) / k
+        t = median_time(call, 1 if quick else 3) / k
         out[name] = {"path": choose_path(scenes[0], numerics).name,
                      "max_e_z_error": float(np.max(np.abs(e_z - exact))),
                      "us_per_impact": t / len(scenes) * 1e6}
@@ -100,8 +95,8 @@ def _specialization(quick: bool) -> dict:
         general()
         diff = float(np.max(np.abs(special_out()[:, kernel.OUT_VZ_END]
                                    - general_out()[:, kernel.OUT_VZ_END])))
-        t_spec = _median_time(special, 1 if quick else 3)
-        t_gen = _median_time(general, 1 if quick else 3)
+        t_spec = median_time(special, 1 if quick else 3)
+        t_gen = median_time(general, 1 if quick else 3)
         out[name] = {"path": choose_path(scenes[0], numerics).name,
                      "us_per_impact": t_spec / n * 1e6,
                      "general_us_per_impact": t_gen / n * 1e6, "speedup": t_gen / t_spec,
@@ -138,17 +133,11 @@ def plot(data: dict, path) -> None:
     ax.set_xlabel("time per impact, µs")
     ax.set_title("Cost per impact by path (KV normal rows: equal accuracy 1e-6 on e_z)")
     ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    save_figure(fig, path)
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--quick", action="store_true", help="tiny sizes (seconds)")
-    args = parser.parse_args()
-    data = run(args.quick)
-    print(json.dumps(data["machine"]))
+def main(argv: list[str] | None = None) -> None:
+    data = bench_main(__doc__, run, plot, "paths", argv=argv)
     kv = data["kelvin_voigt_normal_equal_accuracy"]
     for name, d in kv["settings"].items():
         print(f"{name:24s} {d['us_per_impact']:10.1f} us/impact  max e_z error {d['max_e_z_error']:.1e}")
@@ -156,10 +145,6 @@ def main() -> None:
     for name, d in data["specialization_equal_numerics"].items():
         print(f"{name:24s} {d['path']:45s} {d['speedup']:.2f}x vs general "
               f"(e_z difference {d['max_e_z_difference']:.1e})")
-    RESULTS.mkdir(exist_ok=True)
-    suffix = "_quick" if args.quick else ""
-    (RESULTS / f"paths{suffix}.json").write_text(json.dumps(data, indent=2))
-    plot(data, RESULTS / f"paths{suffix}.png")
 
 
 if __name__ == "__main__":

@@ -20,8 +20,6 @@ asserts a time.
 
 from __future__ import annotations
 
-import argparse
-import json
 from dataclasses import asdict
 from pathlib import Path
 
@@ -30,10 +28,9 @@ import numpy as np
 
 import vimpact as v
 
-from .machine import machine_info
+from .machine import bench_main, machine_info, save_figure
 from .throughput import load_average, random_scenes, timed
 
-RESULTS = Path(__file__).parent / "results"
 
 #: sweep values, scenes per point of the numerics sweeps, base numerics, repeats
 CONFIGS = {
@@ -129,22 +126,11 @@ def plot(data: dict, path: Path) -> None:
         ax.legend(fontsize=8)
     axes[0].set_ylabel("wall time of simulate_batch (s)")
     fig.suptitle(f"{data['threads']} numba threads; {data['machine']['cpu']}", fontsize=9)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    save_figure(fig, path)
 
 
 def main(argv: list[str] | None = None) -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--quick", action="store_true", help="tiny configuration (CI)")
-    parser.add_argument("--out", type=Path, default=RESULTS, help="results folder")
-    args = parser.parse_args(argv)
-    data = run(args.quick)
-    print(json.dumps(data["machine"]))
-    args.out.mkdir(parents=True, exist_ok=True)
-    stem = "scaling_quick" if args.quick else "scaling"
-    (args.out / f"{stem}.json").write_text(json.dumps(data, indent=1))
-    plot(data, args.out / f"{stem}.png")
+    data = bench_main(__doc__, run, plot, "scaling", argv=argv)
     for name, sweep in data["sweeps"].items():
         times = ", ".join(f"{x}: {t:.3g} s" for x, t in zip(sweep["x"], sweep["median_seconds"]))
         local = ", ".join(f"{p:.2f}" for p in sweep["local_exponents"])

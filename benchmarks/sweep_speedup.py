@@ -19,9 +19,8 @@ import numpy as np
 
 from vimpact.sweep import load_spec, run_sweep, summary
 
-from .machine import machine_info
+from .machine import RESULTS, machine_info
 
-RESULTS = Path(__file__).parent / "results"
 DEFAULT_SPEC = Path(__file__).parents[1] / "sweeps" / "kelvin_voigt_table.toml"
 
 

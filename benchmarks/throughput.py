@@ -29,8 +29,6 @@ first); the median of the repeats is reported. Nothing here asserts a time.
 
 from __future__ import annotations
 
-import argparse
-import json
 import os
 import sys
 import time
@@ -45,7 +43,7 @@ import pandas as pd
 
 import vimpact as v
 
-from .machine import machine_info
+from .machine import bench_main, machine_info, save_figure
 from .pure_python import pure_python_impact, refined_row
 
 try:
@@ -54,7 +52,6 @@ except ImportError:  # not started from the repository root
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
     from tests.naive import naive_impact
 
-RESULTS = Path(__file__).parent / "results"
 T = TypeVar("T")
 
 #: sizes: kernel batch, NumPy and pure-Python subsets, repeats, numerics
@@ -231,22 +228,11 @@ def plot(data: dict, path: Path) -> None:
     ax.set_ylabel("element-updates per second (1/s)")
     ax.set_title(f"{n['steps']} steps / t_H, {n['elements']} elements / a_H; "
                  f"{data['machine']['cpu']}", fontsize=9)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    save_figure(fig, path)
 
 
 def main(argv: list[str] | None = None) -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--quick", action="store_true", help="tiny configuration (CI)")
-    parser.add_argument("--out", type=Path, default=RESULTS, help="results folder")
-    args = parser.parse_args(argv)
-    data = run(args.quick)
-    print(json.dumps(data["machine"]))
-    args.out.mkdir(parents=True, exist_ok=True)
-    stem = "throughput_quick" if args.quick else "throughput"
-    (args.out / f"{stem}.json").write_text(json.dumps(data, indent=1))
-    plot(data, args.out / f"{stem}.png")
+    data = bench_main(__doc__, run, plot, "throughput", argv=argv)
     print("kernels:", ", ".join(data["kernel_paths"]))
     print(f"{'implementation':<18}{'threads':>8}{'scenes':>8}{'updates':>12}"
           f"{'median s':>10}{'updates/s':>11}")
