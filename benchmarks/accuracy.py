@@ -53,8 +53,8 @@ import numba
 import numpy as np
 
 import vimpact as v
-from vimpact.analytic import kelvin_voigt_continuum
-from vimpact.result import FINISHED
+from vimpact.reference.closed_forms import kelvin_voigt_continuum
+from vimpact.engine.result import FINISHED
 
 from .machine import bench_main, machine_info, save_figure
 
@@ -201,10 +201,10 @@ def raw_restitution(scenes, numerics) -> tuple[np.ndarray, np.ndarray, np.ndarra
     its energy as status ``unstable`` with NaN outputs. Explicit Euler gains
     energy at every practical step on weakly damped scenes, and its
     accuracy is what this benchmark measures, so for those rows the kernel's
-    own numbers are read here (internal ``vimpact.simulate.run_kernels``; the
+    own numbers are read here (internal ``vimpact.engine.simulate.run_kernels``; the
     rows are counted as ``unstable_rows``)."""
-    from vimpact.core import impact as kernel
-    from vimpact.simulate import run_kernels
+    from vimpact.kernels import elements as kernel
+    from vimpact.engine.simulate import run_kernels
 
     out, _, _ = run_kernels(scenes, numerics)
     ok = out[:, kernel.OUT_STATUS] == kernel.STATUS_OK

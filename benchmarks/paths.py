@@ -21,11 +21,11 @@ import numba
 import numpy as np
 
 import vimpact as v
-from vimpact.analytic import kelvin_voigt_continuum
-from vimpact.core import continuum
-from vimpact.core import impact as kernel
-from vimpact.paths import choose_path
-from vimpact.simulate import pack
+from vimpact.reference.closed_forms import kelvin_voigt_continuum
+from vimpact.kernels import continuum_kv as continuum
+from vimpact.kernels import elements as kernel
+from vimpact.engine.routing import choose_path
+from vimpact.engine.simulate import pack
 
 from .machine import bench_main, machine_info, median_time, save_figure
 
@@ -71,7 +71,7 @@ def _element_call(scenes, numerics: v.Numerics, spec=None):
     run = kernel.element_kernel(spec)
 
     def call():
-        run(a["tau0"], a["g"], a["tau"], a["n_arms"], a["kappa"], a["mu_t"], a["h"],
+        run(a["tau0"], a["g"], a["tau"], a["n_arms"], a["kappa"], a["mu_t"], a["mu"], a["h"],
             a["n_elem"], a["dxi"], a["max_steps"], rec, 1, out)
     return call, (lambda: out)
 

@@ -17,7 +17,7 @@ R^2/Theta)``, PHYSICS.md section 7), which is what ``e_x`` needs;
 rounding.
 
 The discretization (time step and element spacing, refined for stiff modes)
-follows the kernel's rule, :func:`vimpact.paths.refinement`, as
+follows the kernel's rule, :func:`vimpact.engine.routing.refinement`, as
 ``naive_impact`` does. Units: SI throughout (m, s, kg, Pa); see
 ``tests/naive.py`` for the sign conventions.
 """
@@ -27,7 +27,7 @@ from __future__ import annotations
 import math
 
 from vimpact import Numerics, Scene
-from vimpact.paths import choose_path, refinement
+from vimpact.engine.routing import choose_path, refinement
 
 
 def _arm_coefficients(tau: float, dt: float) -> tuple[float, float, float]:
@@ -57,7 +57,7 @@ def refined_row(scene: Scene, steps: int, elements: int, row_width: float = 1.05
 
     Returns the factor by which the time step is shorter than ``t_H /
     steps``, the elements per Hertz radius ``a_H`` and the elements in the
-    half row (all dimensionless), from :func:`vimpact.paths.refinement`
+    half row (all dimensionless), from :func:`vimpact.engine.routing.refinement`
     (finer for a stiff tangential mode or a glassy contact).
     """
     numerics = Numerics(steps=steps, elements=elements, row_width=row_width, continuum=False)

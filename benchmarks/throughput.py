@@ -21,7 +21,7 @@ runs too) at the same ``Numerics``:
 
 Each is credited with the time steps it took (the kernel's ``n_steps``
 result column) times the elements in its half row, both refined by
-:func:`vimpact.paths.refinement` for stiff modes exactly as in the kernel.
+:func:`vimpact.engine.routing.refinement` for stiff modes exactly as in the kernel.
 The element count is nominal: the kernel skips elements the sphere has
 never reached, the baselines do not. Compile time is excluded (warm-up call
 first); the median of the repeats is reported. Nothing here asserts a time.
@@ -47,10 +47,10 @@ from .machine import bench_main, machine_info, save_figure
 from .pure_python import pure_python_impact, refined_row
 
 try:
-    from tests.naive import naive_impact
+    from vimpact.reference.numpy_elements import naive_impact
 except ImportError:  # not started from the repository root
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-    from tests.naive import naive_impact
+    from vimpact.reference.numpy_elements import naive_impact
 
 T = TypeVar("T")
 

@@ -1,36 +1,62 @@
-"""vimpact: restitution of a rigid sphere on a viscoelastic half-space (MDR).
+"""vimpact: restitution of a sphere on a viscoelastic half-space (method of dimensionality reduction).
 
-Public API::
+Public API (loaded lazily: ``import vimpact`` imports no numba, pandas or
+pyarrow until a name that needs them is used)::
 
-    from vimpact import Material, Scene, Numerics, simulate, simulate_batch
+    import vimpact as v
 
-    mat = Material.kelvin_voigt(nu=0.5, E=5e10, eta=1e5)       # Pa, Pa s
-    scene = Scene(mat, R=0.2, m=10.0, v_z0=10.0, v_x0=5.0)      # m, kg, m/s
-    res = simulate(scene)                                       # ImpactResult
-    res.e_z, res.e_x
+    mat = v.Material.kelvin_voigt(nu=0.5, E=5e10, eta=1e5)       # Pa, Pa s
+    scene = v.Scene(mat, R=0.2, m=10.0, v_z0=10.0, v_x0=5.0)      # m, kg, m/s
+    res = v.simulate(scene)                                       # ImpactResult
+    res.e_z, res.beta_x
 
-Physics: PHYSICS.md (shipped with the project's docs); units in every docstring.
+Physics, conventions and units: ``docs/physics.md``.
 """
 
-from importlib.metadata import PackageNotFoundError, version
+from __future__ import annotations
 
-from .hertz import HERTZ_TIME_FACTOR, HertzScales, hertz_scales
-from .material import MODELS, Material
-from .numerics import PRESETS, Numerics
-from .result import STATUSES, UNITS, ImpactResult
-from .scene import Scene
-from .paths import Path, choose_path
-from .simulate import HalfSpaceError, explain, simulate, simulate_batch
-from .table import RestitutionTable
+import importlib
+from importlib.metadata import PackageNotFoundError, version
 
 try:
     __version__ = version("vimpact")
 except PackageNotFoundError:  # running from a source tree
     __version__ = "0+unknown"
 
-__all__ = [
-    "HERTZ_TIME_FACTOR", "HalfSpaceError", "HertzScales", "ImpactResult", "MODELS",
-    "Material", "Numerics", "PRESETS", "Path", "RestitutionTable", "STATUSES", "Scene", "UNITS",
-    "choose_path", "explain", "hertz_scales",
-    "simulate", "simulate_batch", "__version__",
-]
+#: public name -> module that defines it
+_EXPORTS = {
+    "HERTZ_TIME_FACTOR": "vimpact.model.hertz",
+    "HertzScales": "vimpact.model.hertz",
+    "hertz_scales": "vimpact.model.hertz",
+    "InputError": "vimpact.model.validation",
+    "MODELS": "vimpact.model.material",
+    "Material": "vimpact.model.material",
+    "PRESETS": "vimpact.model.numerics",
+    "Numerics": "vimpact.model.numerics",
+    "Scene": "vimpact.model.scene",
+    "STATUSES": "vimpact.engine.result",
+    "UNITS": "vimpact.engine.result",
+    "ImpactResult": "vimpact.engine.result",
+    "Path": "vimpact.engine.routing",
+    "choose_path": "vimpact.engine.routing",
+    "HalfSpaceError": "vimpact.engine.simulate",
+    "explain": "vimpact.engine.simulate",
+    "simulate": "vimpact.engine.simulate",
+    "simulate_batch": "vimpact.engine.simulate",
+    "RestitutionTable": "vimpact.lookup.table",
+}
+
+__all__ = sorted(_EXPORTS) + ["__version__"]
+
+
+def __getattr__(name: str):
+    module = _EXPORTS.get(name)
+    if module is None:
+        raise AttributeError(f"module 'vimpact' has no attribute {name!r}")
+    value = getattr(importlib.import_module(module), name)
+    globals()[name] = value  # later look-ups skip this function
+    return value
+
+
+def __dir__() -> list[str]:
+    return __all__

@@ -1,0 +1,111 @@
+"""The command line: JSON output, summaries, trajectories, and exit code 2 on bad input."""
+
+import json
+import subprocess
+import sys
+
+import pandas as pd
+import pytest
+
+from vimpact.reference.closed_forms import kelvin_voigt_continuum
+from vimpact.cli.main import main
+
+KEYS = {"e_z", "e_x", "beta_x", "t_contact", "u_max", "a_max", "t_hertz", "d_hertz", "a_hertz",
+        "energy_ratio", "Q1", "Q2", "nu", "status"}
+
+
+def test_dimensionless_json(capsys):
+    assert main(["simulate", "--Q1", "0.1", "--nu", "0.5", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert KEYS <= set(out)
+    assert out["status"] == "ok" and out["Q2"] is None
+    assert out["e_z"] == pytest.approx(kelvin_voigt_continuum(0.1).e_z, abs=1e-4)
+    assert out["units"]["t_contact"] == "s"
+
+
+def test_physical_summary_and_trajectory(tmp_path, capsys):
+    path = tmp_path / "traj.parquet"
+    args = ["simulate", "--E", "5e10", "--nu", "0.5", "--eta", "1e5", "--R", "0.2", "--m", "10",
+            "--vz0", "10", "--vx0", "5", "--omega0", "-10", "--trajectory", str(path)]
+    assert main(args) == 0
+    text = capsys.readouterr().out
+    assert "kelvin_voigt" in text and "e_z" in text and "status        ok" in text
+    traj = pd.read_parquet(path)
+    assert list(traj.columns) == ["t_s", "u_z_m", "v_z_m_s", "v_x_m_s", "omega_rad_s",
+                                  "F_z_N", "F_x_N", "a_m"]
+    assert traj.t_s.is_monotonic_increasing and (traj.F_z_N >= 0).all()
+    # the sphere is released with the velocities it had when the force vanished
+    assert traj.v_z_m_s.iloc[-1] < 0 < traj.v_z_m_s.iloc[0]
+
+
+@pytest.mark.parametrize("args, name", [
+    (["--m", "-1", "--nu", "0.5", "--E", "1e9", "--R", "0.1", "--vz0", "1"], "m"),
+    (["--Q1", "0.1", "--nu", "0.7"], "nu"),
+    (["--Q1", "-1", "--nu", "0.3"], "Q1"),
+    (["--E", "1e9", "--G", "1e9", "--nu", "0.3", "--R", "1", "--m", "1", "--vz0", "1"], "E"),
+    (["--E", "1e9", "--nu", "0.3", "--R", "1", "--vz0", "1"], "--m"),
+    (["--E", "1e9", "--nu", "0.3", "--R", "1", "--m", "1", "--vz0", "-2"], "v_z0"),
+    (["--G1", "1e6", "--nu", "0.3", "--R", "1", "--m", "1", "--vz0", "1"], "--G2"),
+    (["--Q1", "0.1", "--nu", "0.5", "--R", "1"], "--R"),
+    (["--Q1", "0.1"], "--nu"),
+    (["--E", "1e5", "--nu", "0.5", "--R", "0.01", "--m", "1", "--vz0", "10"], "a_max"),
+    (["--Q1", "0.1", "--nu", "0.5", "--steps", "2"], "steps"),
+    (["--Q1", "0.1", "--nu", "0.5", "--trajectory", "x.txt"], "trajectory"),
+    (["--Q1", "abc", "--nu", "0.5"], "Q1"),
+])
+def test_bad_input_exits_2_with_one_line(args, name, capsys):
+    try:
+        code = main(["simulate", *args])
+    except SystemExit as exc:  # argparse's own checks (types, choices)
+        code = exc.code
+    assert code == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and name in err and "Traceback" not in err
+
+
+def test_installed_command_exit_code_and_help():
+    """The real entry point, as a user runs it."""
+    bad = subprocess.run([sys.executable, "-m", "vimpact.cli", "simulate", "--Q1", "1",
+                          "--nu", "2"], capture_output=True, text=True)
+    assert bad.returncode == 2 and bad.stderr.count("\n") == 1 and "nu" in bad.stderr
+    helptext = subprocess.run([sys.executable, "-m", "vimpact.cli", "simulate", "--help"],
+                              capture_output=True, text=True).stdout
+    for option in ("--E", "--G1", "--vz0", "--omega0", "--Q1", "--tangential-memory", "Pa s",
+                   "m/s", "rad/s"):
+        assert option in helptext
+
+
+def test_explain_normal_only_takes_the_continuum_path(capsys):
+    assert main(["simulate", "--Q1", "0.3", "--nu", "0.5", "--tangential", "none",
+                 "--explain", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["path"].startswith("continuum") and out["status"] == "normal_only"
+    assert any("normal impact only" in r for r in out["explain"])
+    assert out["e_z"] == pytest.approx(kelvin_voigt_continuum(0.3).e_z, abs=1e-8)
+    assert out["e_x"] is None
+
+
+def test_explain_standard_solid_names_its_effects(capsys):
+    assert main(["simulate", "--Q1", "0.3", "--Q2", "1", "--nu", "0.5", "--explain"]) == 0
+    text = capsys.readouterr().out
+    assert "path: elements[verlet,tangential:incremental,arms]" in text
+    assert "Maxwell arms" in text and "no dashpot term" in text
+
+
+def test_scene_file_and_tolerance(capsys):
+    assert main(["simulate", "--scene", "sweeps/scenes/normal_kelvin_voigt.toml",
+                 "--tolerance", "1e-6", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["path"].startswith("continuum") and out["status"] == "normal_only"
+
+
+@pytest.mark.parametrize("args, names", [
+    (["--scene", "sweeps/scenes/rubber_ball.toml", "--Q1", "0.1"], "--Q1"),
+    (["--Q1", "0.1", "--nu", "0.5", "--tolerance", "1e-4", "--numerics", "fast"], "--tolerance"),
+    (["--Q1", "0.1", "--nu", "0.5", "--tolerance", "0.5"], "tolerance = 0.5"),
+    (["--scene", "no/such/file.toml"], "file.toml"),
+])
+def test_scene_and_numerics_errors(args, names, capsys):
+    assert main(["simulate"] + args) == 2
+    err = capsys.readouterr().err
+    assert names in err and len(err.strip().splitlines()) == 1

@@ -1,0 +1,109 @@
+"""Every thesis figure renders (PNG, and SVG/PDF by extension) from small runs and tables."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from tests.lookup.test_table import make_table, results_frame, run, vimpact_main, write_table  # noqa: F401
+from vimpact import Material, Scene
+from vimpact.plots.figures import FIGURE_NAMES, FIGURES, figure_name, plot_figure
+from vimpact.lookup.table import RestitutionTable
+
+
+def random_draws_table(path, n=40, seed=3):
+    """Random physical Kelvin-Voigt impacts, as the fig. 5.1 sweep draws them."""
+    rng = np.random.default_rng(seed)
+    E = 10 ** rng.uniform(7, 10, n)         # Pa
+    nu = rng.uniform(0.0, 0.5, n)
+    eta = 10 ** rng.uniform(1, 5, n)        # Pa s
+    R = 10 ** rng.uniform(-3, -1, n)        # m
+    m = 2500.0 * 4.0 / 3.0 * np.pi * R**3   # kg
+    v = 10 ** rng.uniform(-1, 1, n)         # m/s
+    scenes = [Scene(Material.kelvin_voigt(nu=nu[i], E=E[i], eta=eta[i]), R=R[i], m=m[i],
+                    v_z0=v[i], v_x0=0.5 * v[i], allow_large_contact=True) for i in range(n)]
+    df = results_frame(scenes)
+    df = pd.concat([df, pd.DataFrame({"E_Pa": E, "eta_Pa_s": eta, "R_m": R, "m_kg": m,
+                                      "v_z0_m_s": v})], axis=1)
+    write_table(path, df, "kelvin_voigt", spec="random draws")
+    return path
+
+
+@pytest.fixture(scope="module")
+def tables(tmp_path_factory):
+    d = tmp_path_factory.mktemp("plot_tables")
+    make_table(d / "kv.parquet", Q1=np.logspace(-2, 1, 9), fail=(2,))
+    make_table(d / "ss.parquet", Q1=np.logspace(-2, 1, 7), nu=(0.0, 0.5), Q2=(0.1, 1.0, 10.0))
+    random_draws_table(d / "random.parquet")
+    return {"fig5_1": d / "random.parquet", "fig5_2": d / "kv.parquet", "fig5_3": d / "kv.parquet",
+            "fig5_4": d / "ss.parquet", "fig5_5": d / "ss.parquet"}
+
+
+@pytest.mark.parametrize("name", FIGURE_NAMES)
+def test_every_figure_renders_png(name, tables, tmp_path):
+    out = tmp_path / f"{name}.png"
+    path = plot_figure(name, out, table=tables.get(name))
+    assert path == out and out.stat().st_size > 10_000
+    assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_svg_and_pdf_by_extension(tables, tmp_path):
+    svg = plot_figure("fig5_2", tmp_path / "f.svg", table=RestitutionTable.open(tables["fig5_2"]))
+    assert svg.stat().st_size > 0 and b"<svg" in svg.read_bytes()[:2000]
+    pdf = plot_figure("3.2", tmp_path / "f.pdf")
+    assert pdf.read_bytes()[:5] == b"%PDF-"
+
+
+def test_table_as_dataframe_and_kelvin_voigt_rows_in_a_standard_solid_table(tables, tmp_path):
+    kv = RestitutionTable.open(tables["fig5_2"]).data
+    plot_figure("fig5_3", tmp_path / "a.png", table=kv)  # a DataFrame of rows works too
+    # a fig 5.4/5.5 table that carries its own Kelvin-Voigt rows (Q2 = 0, the sweep's
+    # convention for the limit G2 -> inf) draws those
+    ss = RestitutionTable.open(tables["fig5_4"])
+    mixed = pd.concat([ss.data, kv[np.isclose(kv.nu, 0.5)].assign(Q2=0.0)], ignore_index=True)
+    out = plot_figure("fig5_5", tmp_path / "b.png",
+                      table=RestitutionTable(mixed, {"model": "standard_solid"}))
+    assert out.stat().st_size > 10_000
+    # or a separate Kelvin-Voigt table, in either order
+    out = plot_figure("5.5", tmp_path / "c.svg", table=[tables["fig5_2"], tables["fig5_4"]])
+    assert out.stat().st_size > 10_000
+    with pytest.raises(ValueError, match="one standard_solid table and optionally one"):
+        plot_figure("5.5", tmp_path / "d.png", table=[tables["fig5_4"], tables["fig5_4"]])
+    with pytest.raises(ValueError, match="takes one table, got 2"):
+        plot_figure("5.2", tmp_path / "d.png", table=[tables["fig5_2"], tables["fig5_2"]])
+
+
+def test_figure_errors(tables, tmp_path):
+    with pytest.raises(ValueError, match="sweeps/fig5_2_3_kelvin_voigt_nu.toml"):
+        plot_figure("fig5_2", tmp_path / "x.png")
+    with pytest.raises(ValueError, match="needs a kelvin_voigt table"):
+        plot_figure("fig5_2", tmp_path / "x.png", table=tables["fig5_4"])
+    with pytest.raises(ValueError, match="needs a standard_solid table.*fig5_4_5_standard_solid_q2.toml"):
+        plot_figure("fig5_4", tmp_path / "x.png", table=tables["fig5_2"])
+    with pytest.raises(ValueError, match="must end in .png, .svg, .pdf"):
+        plot_figure("fig3_2", tmp_path / "x.jpg")
+    with pytest.raises(ValueError, match="must be one of fig3_2"):
+        plot_figure("fig9_9", tmp_path / "x.png")
+    with pytest.raises(ValueError, match="takes no table"):
+        plot_figure("fig3_2", tmp_path / "x.png", table=tables["fig5_2"])
+    assert not list(tmp_path.iterdir())
+
+
+def test_figure_names():
+    assert set(FIGURE_NAMES) == {"fig3_2", "fig4_2", "fig4_4", "fig5_1", "fig5_2", "fig5_3",
+                                 "fig5_4", "fig5_5"}
+    assert figure_name("5.2") == figure_name("Fig 5.2") == figure_name("fig5_2") == "fig5_2"
+    assert all(FIGURES[n].spec for n in FIGURE_NAMES if n.startswith("fig5"))
+
+
+def test_cli_plot(vimpact_main, tables, tmp_path, capsys):
+    out = tmp_path / "f.png"
+    code, text, err = run(vimpact_main, ["plot", "fig5_5", "--out", str(out), "--table",
+                                         str(tables["fig5_4"]), "--table", str(tables["fig5_2"])],
+                          capsys)
+    assert code == 0 and out.stat().st_size > 10_000 and str(out) in text, err
+    code, text, err = run(vimpact_main, ["plot", "fig5_1", "--out", str(out)], capsys)
+    assert code == 2 and "sweeps/fig5_1_kelvin_voigt_random.toml" in err and len(err.strip().splitlines()) == 1
+    code, _, err = run(vimpact_main, ["plot", "nope", "--out", str(out)], capsys)
+    assert code == 2 and "fig3_2" in err

@@ -1,0 +1,7 @@
+"""``python -m vimpact.cli``: the same as the ``vimpact`` command."""
+
+import sys
+
+from vimpact.cli.main import main
+
+sys.exit(main())

@@ -1,0 +1,55 @@
+"""The ``vimpact`` command line: the parser and the dispatch to one module per subcommand.
+
+Each subcommand lives in ``vimpact/cli/<name>.py`` with ``add_parser(sub)``,
+which registers it and sets ``func`` (the handler, returning the exit code).
+Bad input (``ValueError``, including :class:`vimpact.InputError`) and
+``OSError`` (a file that cannot be read or written) give one line on stderr and
+exit code 2; anything else is a bug and shows its traceback.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+
+from vimpact import __version__
+
+#: Subcommands in the order ``vimpact --help`` lists them; module ``vimpact.cli.<name>``.
+SUBCOMMANDS = ("simulate", "sweep", "table", "plot")
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message):  # one line, exit code 2
+        self.exit(2, f"{self.prog}: error: {message}\n")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The full ``vimpact`` parser (every subcommand registered)."""
+    parser = _Parser(prog="vimpact", description=(
+        "Coefficients of restitution of a sphere hitting a viscoelastic "
+        "half-space (method of dimensionality reduction)."))
+    parser.add_argument("--version", action="version", version=f"vimpact {__version__}")
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    for name in SUBCOMMANDS:
+        importlib.import_module(f"vimpact.cli.{name}").add_parser(sub)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run the command line with ``argv`` (default ``sys.argv[1:]``); returns the exit code."""
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        return args.func(args)
+    except (ValueError, OSError) as exc:
+        text = " ".join(str(exc).split()) or type(exc).__name__
+        print(f"vimpact {args.command}: error: {text}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("vimpact: interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())

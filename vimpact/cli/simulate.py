@@ -1,0 +1,201 @@
+"""``vimpact simulate``: one impact from physical or dimensionless input, or a scene file."""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import json
+import math
+from pathlib import Path
+
+from vimpact import __version__
+from vimpact.cli.material_args import add_material_arguments, material_from_args, missing
+from vimpact.engine.result import STATUSES, UNITS
+from vimpact.engine.routing import choose_path
+from vimpact.engine.simulate import simulate
+from vimpact.model.material import MODELS
+from vimpact.model.numerics import INTEGRATORS, PRESETS, Numerics
+from vimpact.model.scene import TANGENTIAL_EFFECTS, TANGENTIAL_MEMORY, Scene
+
+
+def add_parser(sub) -> argparse.ArgumentParser:
+    """Register ``vimpact simulate`` on ``sub`` (the object of ``add_subparsers``)."""
+    sim = sub.add_parser(
+        "simulate", help="simulate one impact",
+        description=(
+            "Simulate one impact. Give either a physical scene (material, sphere, "
+            "velocities) or a dimensionless one (--Q1 [--Q2] --nu). The model is "
+            "inferred from the material options unless --model is given: --eta alone "
+            "-> kelvin_voigt, --G1 --G2 --eta -> standard_solid, --prony -> prony, "
+            "neither -> elastic. Or read the whole scene from a TOML file (--scene)."),
+        epilog="Examples: vimpact simulate --Q1 0.1 --nu 0.5 --json; "
+               "vimpact simulate --scene sweeps/scenes/rubber_ball.toml --explain")
+    sim.add_argument("--scene", metavar="FILE",
+                     help="read the scene (and optionally [numerics]) from a TOML file, the "
+                          "format of a sweep's fixed part; other scene options are then refused")
+    g = sim.add_argument_group("material (physical input)")
+    g.add_argument("--model", choices=MODELS, help="rheology (default: inferred)")
+    add_material_arguments(g, prony=True)
+    g = sim.add_argument_group("sphere and impact (physical input)")
+    g.add_argument("--R", type=float, metavar="M", help="sphere radius, m")
+    g.add_argument("--m", type=float, metavar="KG", help="sphere mass, kg")
+    g.add_argument("--Theta", type=float, metavar="KG_M2",
+                   help="moment of inertia, kg m^2 (default 2/5 m R^2)")
+    g.add_argument("--vz0", type=float, metavar="M_S", help="normal impact speed, m/s (> 0)")
+    g.add_argument("--vx0", type=float, default=0.0, metavar="M_S",
+                   help="tangential speed of the centre, m/s (default 0)")
+    g.add_argument("--omega0", type=float, default=0.0, metavar="RAD_S",
+                   help="spin about y, rad/s (default 0); contact point moves with vx0 + R omega0")
+    g = sim.add_argument_group("dimensionless input (instead of the physical one)")
+    g.add_argument("--Q1", type=float, metavar="Q1",
+                   help="damping parameter sqrt(15/32) (eta/G_inf)/T, dimensionless, >= 0")
+    g.add_argument("--Q2", type=float, metavar="Q2",
+                   help="stiffness ratio G1/G2 of the standard solid, dimensionless, > 0 "
+                        "(omit for Kelvin-Voigt)")
+    g.add_argument("--theta-ratio", type=float, default=0.4, metavar="RATIO",
+                   help="Theta / (m R^2), dimensionless (default 0.4, solid sphere)")
+    g = sim.add_argument_group("effects")
+    g.add_argument("--tangential", choices=TANGENTIAL_EFFECTS, default=None,
+                   help="tangential problem: auto (default: full stick when v_c0 != 0), "
+                        "stick, or none (normal impact only; e_x not computed)")
+    g.add_argument("--no-rotation", action="store_true",
+                   help="the sphere does not spin (Theta -> infinity)")
+    g.add_argument("--tangential-memory", choices=TANGENTIAL_MEMORY, default=None,
+                   help="tangential element rule: incremental (default, passive) or seed "
+                        "(thesis eq. 4.16, total displacement)")
+    g = sim.add_argument_group("numerics")
+    g.add_argument("--numerics", choices=tuple(PRESETS), default=None,
+                   help="numerics preset: fast (about 1e-3), default (about 1e-4), precise, "
+                        "thesis (explicit Euler as in the thesis)")
+    g.add_argument("--tolerance", type=float, metavar="TOL",
+                   help="pick steps and elements for this accuracy on e_z and e_x "
+                        "(instead of a preset; between 1e-7 and 1e-2)")
+    g.add_argument("--integrator", choices=tuple(INTEGRATORS), help="override the integrator")
+    g.add_argument("--steps", type=int, help="override: time steps per Hertz contact time")
+    g.add_argument("--elements", type=int, help="override: elements per Hertz contact radius")
+    g.add_argument("--rtol", type=float, help="override: tolerance of the continuum path")
+    g.add_argument("--no-continuum", action="store_true",
+                   help="always use the element kernel (no Kelvin-Voigt continuum path)")
+    g.add_argument("--explain", action="store_true",
+                   help="say which kernel runs and why, then simulate")
+    g = sim.add_argument_group("output")
+    g.add_argument("--allow-large-contact", action="store_true",
+                   help="accept a contact half-width above 0.2 R (outside the half-space model)")
+    g.add_argument("--trajectory", metavar="FILE",
+                   help="write the time series (t, u_z, v_z, v_x, omega, F_z, F_x, a) to "
+                        "FILE, CSV or Parquet by extension (.csv, .parquet)")
+    g.add_argument("--json", action="store_true", help="print one JSON object")
+    sim.set_defaults(func=run)
+    return sim
+
+
+_PHYSICAL = ("E", "G", "eta", "G1", "G2", "prony", "R", "m", "Theta", "vz0", "model")
+_EFFECTS = {"tangential": "auto", "tangential_memory": "incremental"}
+
+
+def scene_from_args(a) -> Scene:
+    """The scene described by parsed ``simulate`` options."""
+    effects = {k: getattr(a, k) if getattr(a, k) is not None else default
+               for k, default in _EFFECTS.items()}
+    effects["rotation"] = not a.no_rotation
+    if a.Q1 is not None:
+        given = [f"--{n}" for n in _PHYSICAL if getattr(a, n) is not None]
+        given += [f"--{n}" for n in ("vx0", "omega0") if getattr(a, n) != 0.0]
+        if given:
+            raise ValueError(f"{', '.join(given)} cannot be combined with --Q1: give either "
+                             "a dimensionless scene (--Q1 [--Q2] --nu) or a physical one")
+        if a.nu is None:
+            raise missing("nu", "the Poisson ratio in [0, 0.5] is required")
+        return Scene.from_dimensionless(a.Q1, a.nu, a.Q2, theta_ratio=a.theta_ratio, **effects)
+    if a.Q2 is not None:
+        raise missing("Q1", "--Q2 is part of the dimensionless input --Q1 --Q2 --nu")
+    material = material_from_args(a)
+    for name, what in (("R", "sphere radius, m"), ("m", "sphere mass, kg"),
+                       ("vz0", "normal impact speed, m/s")):
+        if getattr(a, name) is None:
+            raise missing(name, f"the {what} is required (or use --Q1 --nu)")
+    theta = a.Theta
+    if theta is None and a.theta_ratio != 0.4:
+        theta = a.theta_ratio * a.m * a.R**2
+    return Scene(material, R=a.R, m=a.m, v_z0=a.vz0, v_x0=a.vx0, omega0=a.omega0, Theta=theta,
+                 allow_large_contact=a.allow_large_contact, **effects)
+
+
+def _scene_file(a) -> tuple[Scene, Numerics | None]:
+    """Scene and numerics of ``--scene FILE``; scene options beside it are refused."""
+    from vimpact.model.scene_file import load_scene  # imports the sweep machinery: only when asked
+
+    given = [f"--{n.replace('_', '-')}" for n in _PHYSICAL + ("Q1", "Q2", "nu") + tuple(_EFFECTS)
+             if getattr(a, n) is not None]
+    given += [f"--{n.replace('_', '-')}" for n, default in
+              (("vx0", 0.0), ("omega0", 0.0), ("theta_ratio", 0.4), ("no_rotation", False))
+              if getattr(a, n) != default]
+    if given:
+        raise ValueError(f"{', '.join(given)} cannot be combined with --scene: the file "
+                         "describes the whole scene")
+    scene, numerics = load_scene(a.scene)
+    if a.allow_large_contact:
+        scene = dataclasses.replace(scene, allow_large_contact=True)
+    return scene, numerics
+
+
+def _numerics(a, base: Numerics | None = None) -> Numerics:
+    """The numerics of the options: a preset, a tolerance or the file's, then overrides."""
+    if a.tolerance is not None and a.numerics is not None:
+        raise ValueError(f"--tolerance = {a.tolerance:g} cannot be combined with "
+                         f"--numerics = {a.numerics}: give one of them")
+    if a.tolerance is not None:
+        numerics = Numerics.for_tolerance(a.tolerance)
+    elif a.numerics is not None or base is None:
+        numerics = Numerics.preset(a.numerics or "default")
+    else:
+        numerics = base
+    changes = {k: getattr(a, k) for k in ("integrator", "steps", "elements", "rtol")
+               if getattr(a, k) is not None}
+    if a.no_continuum:
+        changes["continuum"] = False
+    return numerics.with_(**changes)
+
+
+def run(a) -> int:
+    if a.trajectory and Path(a.trajectory).suffix.lower() not in (".csv", ".parquet"):
+        raise ValueError(f"--trajectory = {a.trajectory!r} is not allowed: "
+                         "must end in .csv or .parquet")
+    if a.scene is not None:
+        scene, file_numerics = _scene_file(a)
+    else:
+        scene, file_numerics = scene_from_args(a), None
+    numerics = _numerics(a, file_numerics)
+    path = choose_path(scene, numerics)
+    if a.explain and not a.json:
+        print(path.explain())
+    res = simulate(scene, numerics, trajectory=bool(a.trajectory))
+    if a.trajectory:
+        out = Path(a.trajectory)
+        if out.suffix.lower() == ".csv":
+            res.trajectory.to_csv(out, index=False)
+        else:
+            res.trajectory.to_parquet(out, index=False)
+    if a.json:
+        d = res.to_json_dict()
+        if a.explain:
+            d["explain"] = list(path.reasons)
+        print(json.dumps(d))
+    else:
+        print(_summary(scene, res))
+    return 0
+
+
+def _summary(scene: Scene, res) -> str:
+    mat = scene.material
+    lines = [f"vimpact {__version__}: {mat.model} half-space, nu = {mat.nu:g}, "
+             f"tangential memory {scene.tangential_memory}"]
+    for key in ("e_z", "e_x", "beta_x", "energy_ratio", "Q1", "Q2", "t_contact", "t_hertz",
+                "u_max", "d_hertz", "a_max", "a_hertz", "v_z_end", "v_x_end", "omega_end"):
+        value = getattr(res, key)
+        unit = UNITS[key] if UNITS[key] != "1" else ""
+        text = "undefined" if math.isnan(value) else f"{value:.6g}"
+        lines.append(f"  {key:<13} {text:>12} {unit}")
+    lines.append(f"  status        {res.status}: {STATUSES[res.status]}")
+    lines.append(f"  path          {res.path} ({res.n_steps} steps)")
+    return "\n".join(lines)

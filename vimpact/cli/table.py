@@ -1,0 +1,201 @@
+"""The ``vimpact table`` subcommand: info, lookup and e(v) export of restitution tables.
+
+``add_parser(subparsers)`` registers it on the subparsers object of :func:`vimpact.cli.main.build_parser`; each sets
+``func`` to its handler, which returns the exit code and raises
+``ValueError`` on bad input (``vimpact.cli.main.main`` prints it as one line and
+exits with 2).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import textwrap
+
+import numpy as np
+
+from vimpact.cli.material_args import add_material_arguments, material_from_args
+
+__all__ = ["add_parser"]
+
+
+def _number_list(text: str) -> list[float]:
+    """``"0.1,0.2, 1e-3"`` -> ``[0.1, 0.2, 0.001]`` (argparse type)."""
+    try:
+        values = [float(x) for x in text.split(",") if x.strip()]
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"{text!r} is not a number or a comma-separated list of numbers") from None
+    if not values:
+        raise argparse.ArgumentTypeError("expected a number or a comma-separated list of numbers")
+    return values
+
+
+def _json_value(x):
+    if isinstance(x, (float, np.floating)):
+        return float(x) if math.isfinite(x) else None
+    return x
+
+
+# --------------------------------------------------------------------------
+# vimpact table
+# --------------------------------------------------------------------------
+
+def add_parser(subparsers) -> argparse.ArgumentParser:
+    """Register ``vimpact table {info,lookup,export}`` on ``subparsers``."""
+    table = subparsers.add_parser(
+        "table", help="inspect, interpolate and export restitution tables",
+        description=(
+            "Read a restitution table (Parquet, written by `vimpact sweep`): summarize it, "
+            "interpolate e_z, e_x, beta_x at given Q1 [Q2] nu (linear in log Q1, log Q2 and "
+            "in nu on the table's grid), or export e_z(v), e_x(v) for one material and sphere."))
+    sub = table.add_subparsers(dest="table_command", required=True, metavar="ACTION")
+
+    info = sub.add_parser("info", help="model, rows, statuses, covered ranges, grid, numerics",
+                          description="Summarize a restitution table.",
+                          epilog="Example: vimpact table info kv.parquet --json")
+    info.add_argument("table", metavar="TABLE", help="restitution table (.parquet)")
+    info.add_argument("--json", action="store_true", help="print one JSON object")
+    info.set_defaults(func=_cmd_info)
+
+    look = sub.add_parser(
+        "lookup", help="interpolate e_z, e_x, beta_x at Q1 [Q2] nu",
+        description=(
+            "Interpolate e_z, e_x, beta_x (dimensionless) on a grid table: linear in log Q1 "
+            "(and log Q2), linear in nu. Each of --Q1, --Q2, --nu takes one value or a "
+            "comma-separated list; lists are paired element by element (a single value is "
+            "used for every element). Values outside the table's range are an error unless "
+            "--extrapolate is given."),
+        epilog="Example: vimpact table lookup kv.parquet --Q1 0.01,0.1,1 --nu 0.5 --json")
+    look.add_argument("table", metavar="TABLE", help="restitution table (.parquet)")
+    look.add_argument("--Q1", type=_number_list, required=True, metavar="Q1[,Q1...]",
+                      help="damping parameter sqrt(15/32) (eta/G_inf)/T, dimensionless")
+    look.add_argument("--nu", type=_number_list, required=True, metavar="NU[,NU...]",
+                      help="Poisson ratio, dimensionless")
+    look.add_argument("--Q2", type=_number_list, metavar="Q2[,Q2...]",
+                      help="G1/G2, dimensionless (standard-solid tables only)")
+    look.add_argument("--theta-ratio", type=float, metavar="RATIO",
+                      help="Theta / (m R^2), only for tables that hold several")
+    look.add_argument("--extrapolate", action="store_true",
+                      help="extrapolate linearly outside the covered range (clipped to "
+                           "0 <= e <= 1) instead of failing")
+    look.add_argument("--json", action="store_true", help="print one JSON object")
+    look.set_defaults(func=_cmd_lookup)
+
+    exp = sub.add_parser(
+        "export", help="write e_z(v), e_x(v) for one material and sphere to CSV",
+        description=(
+            "Restitution against impact speed for one material and sphere, from the table: "
+            "each speed gives Q1 (through the Hertz time) and is looked up. The material model "
+            "is inferred from the options (--E/--G with --eta -> kelvin_voigt; --G1 --G2 "
+            "--eta -> standard_solid) and must be the table's. Columns of the CSV: v_z0_m_s "
+            "(m/s), Q1, [Q2,] e_z, e_x, beta_x (dimensionless)."),
+        epilog=("Example: vimpact table export kv.parquet --out curve.csv --E 5e10 --nu 0.5 "
+                "--eta 1e5 --R 0.2 --m 10 --vz0-min 0.1 --vz0-max 10 --n 50"))
+    exp.add_argument("table", metavar="TABLE", help="restitution table (.parquet)")
+    exp.add_argument("--out", required=True, metavar="FILE", help="output CSV file (.csv)")
+    g = exp.add_argument_group("material")
+    add_material_arguments(g, prony=False)
+    g = exp.add_argument_group("sphere and speeds")
+    g.add_argument("--R", type=float, required=True, metavar="M", help="sphere radius, m")
+    g.add_argument("--m", type=float, required=True, metavar="KG", help="sphere mass, kg")
+    g.add_argument("--theta-ratio", type=float, metavar="RATIO",
+                   help="Theta / (m R^2) (default: the table's, 0.4 for a solid sphere)")
+    g.add_argument("--vz0-min", type=float, required=True, metavar="M_S",
+                   help="lowest normal impact speed, m/s (> 0)")
+    g.add_argument("--vz0-max", type=float, required=True, metavar="M_S",
+                   help="highest normal impact speed, m/s")
+    g.add_argument("--n", type=int, default=50, metavar="N", help="number of speeds (default 50)")
+    g.add_argument("--spacing", choices=("log", "linear"), default="log",
+                   help="spacing of the speeds (default log)")
+    g = exp.add_argument_group("options")
+    g.add_argument("--extrapolate", action="store_true",
+                   help="extrapolate outside the table's range instead of failing")
+    g.add_argument("--allow-large-contact", action="store_true",
+                   help="accept speeds whose Hertz contact radius exceeds 0.2 R")
+    g.add_argument("--json", action="store_true", help="print a JSON summary")
+    exp.set_defaults(func=_cmd_export)
+    return table
+
+
+def _open(path):
+    from vimpact.lookup.table import RestitutionTable
+
+    return RestitutionTable.open(path)
+
+
+def _cmd_info(a) -> int:
+    info = _open(a.table).info()
+    if a.json:
+        print(json.dumps(info, default=_json_value))
+    else:
+        from vimpact.lookup.table import format_info
+
+        print(format_info(info))
+    return 0
+
+
+def _cmd_lookup(a) -> int:
+    table = _open(a.table)
+    given = {"--Q1": a.Q1, "--nu": a.nu, **({"--Q2": a.Q2} if a.Q2 else {})}
+    if len({len(v) for v in given.values()} - {1}) > 1:
+        raise ValueError(", ".join(f"{k} has {len(v)} values" for k, v in given.items())
+                         + ": lists must have one length (or be a single value)")
+    res = table.lookup(np.array(a.Q1), np.array(a.nu), None if a.Q2 is None else np.array(a.Q2),
+                       extrapolate=a.extrapolate, theta_ratio=a.theta_ratio)
+    names = list(res)
+    rows = [{k: _json_value(float(res[k][i])) for k in names} for i in range(len(res["Q1"]))]
+    if a.json:
+        print(json.dumps({"table": a.table, "model": table.model, "extrapolate": a.extrapolate,
+                          "rows": rows}))
+    else:
+        print(f"{table.model} table {a.table}" + (" (extrapolated where outside)"
+                                                   if a.extrapolate else ""))
+        print("  ".join(f"{k:>12}" for k in names))
+        for row in rows:
+            print("  ".join(f"{'nan' if row[k] is None else format(row[k], '.6g'):>12}"
+                            for k in names))
+    return 0
+
+
+_MATERIAL_OPTIONS = {
+    "kelvin_voigt": "--E or --G (Pa), --eta (Pa s) and --nu",
+    "standard_solid": "--G1, --G2 (Pa), --eta (Pa s) and --nu",
+}
+
+
+def _cmd_export(a) -> int:
+    require_n = a.n >= 1 and (a.n >= 2 or a.vz0_min == a.vz0_max)
+    if not require_n:
+        raise ValueError(f"--n = {a.n} is not allowed: must be an integer >= 2 "
+                         "(1 only when --vz0-min equals --vz0-max)")
+    if not (math.isfinite(a.vz0_min) and a.vz0_min > 0):
+        raise ValueError(f"--vz0-min = {a.vz0_min!r} is not allowed: must be a finite speed > 0 (m/s)")
+    if not (math.isfinite(a.vz0_max) and a.vz0_max >= a.vz0_min):
+        raise ValueError(f"--vz0-max = {a.vz0_max!r} is not allowed: must be finite and "
+                         f">= --vz0-min = {a.vz0_min!r} (m/s)")
+    table = _open(a.table)
+    material = material_from_args(a)  # model inferred as in `vimpact simulate`
+    if material.model != table.model:
+        need = _MATERIAL_OPTIONS.get(table.model, f"a {table.model} material")
+        raise ValueError(f"the material options give the model {material.model!r}, but the "
+                         f"table is {table.model!r}: give {need}")
+    if a.spacing == "log":
+        speeds = np.geomspace(a.vz0_min, a.vz0_max, a.n)
+    else:
+        speeds = np.linspace(a.vz0_min, a.vz0_max, a.n)
+    df = table.export_curve(a.out, material, a.R, a.m, speeds, theta_ratio=a.theta_ratio,
+                            extrapolate=a.extrapolate,
+                            allow_large_contact=a.allow_large_contact)
+    summary = {"out": a.out, "model": material.model, "rows": len(df),
+               "v_z0_m_s": [float(speeds[0]), float(speeds[-1])],
+               "Q1": [float(df.Q1.min()), float(df.Q1.max())],
+               "e_z": [_json_value(df.e_z.min()), _json_value(df.e_z.max())]}
+    if a.json:
+        print(json.dumps(summary))
+    else:
+        print(f"wrote {len(df)} speeds {speeds[0]:.6g} .. {speeds[-1]:.6g} m/s "
+              f"(Q1 {df.Q1.min():.4g} .. {df.Q1.max():.4g}, e_z {df.e_z.min():.4g} .. "
+              f"{df.e_z.max():.4g}) to {a.out}")
+    return 0

@@ -1,0 +1,109 @@
+"""What one impact produces, with units."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass, field
+
+import pandas as pd
+
+#: Units of every output (``"1"`` = dimensionless).
+UNITS = {
+    "e_z": "1",
+    "e_x": "1",
+    "beta_x": "1",
+    "t_contact": "s",
+    "u_max": "m",
+    "a_max": "m",
+    "t_hertz": "s",
+    "d_hertz": "m",
+    "a_hertz": "m",
+    "energy_ratio": "1",
+    "Q1": "1",
+    "Q2": "1",
+    "nu": "1",
+    "v_z_end": "m/s",
+    "v_x_end": "m/s",
+    "omega_end": "rad/s",
+    "status": "",
+    "n_steps": "1",
+    "path": "",
+}
+
+#: Meaning of each status value.
+STATUSES = {
+    "ok": "finished; all outputs valid",
+    "vc0_zero": "finished; v_c0 = 0, so no tangential force and e_x, beta_x are undefined (NaN)",
+    "normal_only": "finished; the scene asked for the normal impact only (tangential = 'none'): "
+                   "e_x, beta_x not computed (NaN)",
+    "half_space": "finished, but the contact half-width exceeded 0.2 R: outside the half-space model",
+    "time_limit": "the impact had not ended at the time limit (Numerics.max_time); outputs NaN",
+    "row_exceeded": "the contact reached the end of the element row; outputs NaN",
+    "non_finite": "the integration produced a non-finite value; outputs NaN",
+    "unstable": "the numerical solution gained energy (energy_ratio > 1 + 1e-6) although the "
+                "material and the incremental tangential rule are passive: the step was too "
+                "coarse for this scene; outputs NaN (refine: more steps or elements; "
+                "explicit Euler is exempt: it gains energy by construction)",
+}
+
+#: Statuses whose numbers are results (the others carry NaN).
+FINISHED = ("ok", "vc0_zero", "normal_only", "half_space")
+
+
+@dataclass(frozen=True)
+class ImpactResult:
+    """Outcome of one impact. Units in ``UNITS``; NaN only with a status that says why.
+
+    Attributes
+    ----------
+    e_z : normal restitution ``|v_z,end| / v_z0``
+    e_x : tangential restitution ``|v_c,end| / |v_c0|``
+    beta_x : signed tangential restitution ``-v_c,end / v_c0``
+    t_contact : contact time, s
+    u_max : maximum indentation, m
+    a_max : maximum contact half-width, m
+    t_hertz, d_hertz, a_hertz : Hertz contact time (s), indentation (m) and
+        radius (m) of the elastic impact with the relaxed modulus
+    energy_ratio : kinetic energy after / before (translation and rotation)
+    Q1, Q2, nu : dimensionless parameters (Q1 NaN for a general Prony series,
+        Q2 NaN unless a standard solid)
+    v_z_end, v_x_end, omega_end : end velocities, m/s, m/s, rad/s (v_z > 0 into the half-space)
+    status : see ``STATUSES``
+    n_steps : time steps taken (element path) or accepted ODE steps (continuum path)
+    path : the kernel that ran (:mod:`vimpact.engine.routing`), e.g. ``elements[verlet,dashpot]``
+    trajectory : time series of the impact if asked for (``None`` otherwise)
+    """
+
+    e_z: float
+    e_x: float
+    beta_x: float
+    t_contact: float
+    u_max: float
+    a_max: float
+    t_hertz: float
+    d_hertz: float
+    a_hertz: float
+    energy_ratio: float
+    Q1: float
+    Q2: float
+    nu: float
+    v_z_end: float
+    v_x_end: float
+    omega_end: float
+    status: str
+    n_steps: int = 0
+    path: str = ""
+    trajectory: pd.DataFrame | None = field(default=None, repr=False, compare=False)
+
+    def to_dict(self) -> dict:
+        """Outputs as a plain dict (NaN kept as float NaN; no trajectory)."""
+        d = asdict(self)
+        d.pop("trajectory")
+        return d
+
+    def to_json_dict(self) -> dict:
+        """Outputs for JSON: NaN and inf become ``None`` (JSON null); units under ``"units"``."""
+        d = {k: (None if isinstance(v, float) and not math.isfinite(v) else v)
+             for k, v in self.to_dict().items()}
+        d["units"] = dict(UNITS)
+        return d

@@ -1,0 +1,107 @@
+"""Maxwell-arm helpers of the element kernels (PHYSICS.md section 4, exact update).
+
+Every arm is advanced with the exact exponential update for a linear
+displacement path over the step; nothing divides by a viscosity or a
+relaxation time. Kernel units as in :mod:`vimpact.kernels.elements`.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from vimpact.kernels.jit import jit
+
+
+@jit()
+def _arm_coefficient(tau, h):
+    """``(E, 1 - E, phi)`` of the exact arm update over a step ``h``.
+
+    For ``tau dq/dt = w - q`` with ``w`` linear from ``w0`` to ``w1``:
+    ``q1 = E q0 + (1 - E) w0 + phi (w1 - w0)`` with ``E = exp(-h/tau)`` and
+    ``phi = 1 - (tau/h)(1 - E)`` (PHYSICS.md section 4). Valid for ``tau = 0``
+    (the arm follows ``w``) and ``tau = inf`` (the arm is frozen).
+    """
+    x = h / tau if tau > 0.0 else np.inf
+    omE = -math.expm1(-x)
+    if x < 1e-3:  # series: the closed form cancels
+        phi = x * (0.5 - x * (1.0 / 6.0 - x * (1.0 / 24.0 - x / 120.0)))
+    else:
+        phi = 1.0 - omE / x
+    return 1.0 - omE, omE, phi
+
+
+@jit()
+def arm_coefficients(tau, h):
+    """Arrays ``(E, 1 - E, phi)`` of :func:`_arm_coefficient` for every arm."""
+    n = tau.shape[0]
+    E = np.empty(n)
+    omE = np.empty(n)
+    phi = np.empty(n)
+    for i in range(n):
+        E[i], omE[i], phi[i] = _arm_coefficient(tau[i], h)
+    return E, omE, phi
+
+
+@jit(inline="always")
+def _follow_over(w0, w1, qrow, g, tau, dt):
+    """Like :func:`_follow` over a part ``dt`` of a step (an element entering
+    contact within the step); coefficients computed here, entries are rare."""
+    acc = 0.0
+    for i in range(g.shape[0]):
+        E, omE, phi = _arm_coefficient(tau[i], dt)
+        qi = E * qrow[i] + omE * w0 + phi * (w1 - w0)
+        qrow[i] = qi
+        acc += g[i] * (w1 - qi)
+    return acc
+
+
+@jit(inline="always")
+def _follow(w0, w1, qrow, g, E, omE, phi):
+    """Advance the arms of one element along ``w0 -> w1``; return ``sum g_i (w1 - q_i)``."""
+    acc = 0.0
+    for i in range(g.shape[0]):
+        qi = E[i] * qrow[i] + omE[i] * w0 + phi[i] * (w1 - w0)
+        qrow[i] = qi
+        acc += g[i] * (w1 - qi)
+    return acc
+
+
+@jit(inline="always")
+def _relax(w0, qrow, g, E, omE, phi, tau0_h, den_free, decay0):
+    """Free surface relaxation under zero force over one step; returns the new ``w``.
+
+    Solves ``tau0 dw/dt + G_inf w + sum g_i (w - q_i) = 0`` (PHYSICS.md
+    section 5) for an element with arms, implicit in the end value (L-stable),
+    the arms on the exact linear-path update. (Without arms the kernel uses
+    the exact ``w decay0`` instead, 0 for an elastic element.)
+    """
+    n = g.shape[0]
+    num = tau0_h * w0
+    for i in range(n):
+        num += g[i] * (E[i] * qrow[i] + (omE[i] - phi[i]) * w0)
+    w1 = num / den_free
+    for i in range(n):
+        qrow[i] = E[i] * qrow[i] + omE[i] * w0 + phi[i] * (w1 - w0)
+    return w1
+
+
+@jit()
+def _free_rate(w, qrow, g, tau, tau0):
+    """Current ``dw/dt`` of a free surface element (kernel units)."""
+    n = g.shape[0]
+    r = w
+    for i in range(n):
+        r += g[i] * (w - qrow[i])
+    if tau0 > 0.0:
+        return -r / tau0
+    G = 0.0
+    rate = 0.0
+    for i in range(n):
+        G += g[i]
+        if tau[i] > 0.0:
+            rate += g[i] * (w - qrow[i]) / tau[i]
+    return rate / (1.0 + G)
+
+

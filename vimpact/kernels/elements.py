@@ -1,0 +1,326 @@
+"""Element kernel of the MDR impact, in kernel units.
+
+Unit-free numba kernels; nothing here imports the user-facing layer.
+
+Kernel units (PHYSICS.md sections 2, 3, 7): indentation ``u`` and normal
+surface displacements ``w`` in units of the Hertz indentation ``d``; element
+positions ``xi`` in units of the Hertz radius ``a_H`` (so the MDR profile is
+``g = xi^2``); time in units of ``T = d / v_z0``; normal velocity in units of
+``v_z0``. The tangential problem is linear in ``v_c0`` (PHYSICS.md section 7),
+so tangential displacements and velocities are in units of ``v_c0 T`` and
+``v_c0``: the contact point starts with ``v_c = 1``. Forces are in units of
+``m v_z0 / T`` (normal) and ``m v_c0 / T`` (tangential); the element
+stiffness per unit length is then ``15/16`` (normal) and ``kappa * 15/16``
+(tangential) with ``kappa = c_t / c_n = 2 (1 - nu) / (2 - nu)``.
+
+Material (PHYSICS.md section 4), relative to the relaxed modulus ``G_inf``:
+``tau0 = eta0 / (G_inf T)`` (parallel dashpot), arms ``g_i = G_i / G_inf``
+with times ``tau_i / T``. Every arm is advanced with the exact exponential
+update for a linear displacement path over the step; nothing divides by a
+viscosity or a relaxation time.
+
+Integrators (the value of ``integrator``):
+
+``EULER``
+    the thesis's explicit Euler: ``u += h v``, ``v -= h F`` with the force of
+    the old state. First order; not symplectic (an elastic impact gains
+    energy) and only conditionally stable with a dashpot.
+``SYMPLECTIC_EULER``
+    semi-implicit Euler (kick-drift): ``v+ = (v - h F_el) / (1 + h C)``,
+    ``u += h v+``, elements follow the drift. First order, symplectic for
+    the elastic part, dashpot implicit (unconditionally stable).
+``VERLET``
+    generalized Stormer-Verlet (kick-drift-kick) with the dashpot force
+    implicit in the half-step velocity: ``v+ = (v - h/2 F_el) / (1 + h/2 C)``,
+    drift ``u += h v+``, elements follow the linear path of the drift (for
+    which the arm update is exact), then ``v = v+ - h/2 (F_el' + C' v+)``.
+    Second order for smooth forces, unconditionally stable for the dashpot.
+
+Compile-time specialization (issue 5): the impact body :func:`_impact` takes
+the scene's effects as its first arguments (``tangential``, ``memory``,
+``integrator``, ``arms``, ``dashpot``) and is inlined into a batch kernel
+built by :func:`element_kernel` for one :class:`KernelSpec`, where these are
+closure constants: LLVM folds the branches away, so a normal-only
+Kelvin-Voigt kernel carries no tangential and no arm code at all.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+from typing import NamedTuple
+
+import numpy as np
+from numba import prange
+
+from vimpact.kernels.arms import _follow, _follow_over, _free_rate, _relax, arm_coefficients
+from vimpact.kernels.jit import jit
+from vimpact.kernels.layout import (  # noqa: F401 - re-exported: the kernels' common layout
+    ELEMENT_STIFFNESS, EULER, N_OUT, N_REC, OUT_B_MAX, OUT_N_REC, OUT_STATUS, OUT_STEPS,
+    OUT_T_CONTACT, OUT_U_MAX, OUT_VC_END, OUT_VZ_END, REC_B, REC_FX, REC_FZ, REC_T, REC_U, REC_V,
+    REC_VC, STATUS_NON_FINITE, STATUS_OK, STATUS_ROW_EXCEEDED, STATUS_TIME_LIMIT, SYMPLECTIC_EULER,
+    VERLET, _record)
+
+
+
+@jit(inline="always")
+def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT,
+            tau0, g, tau, kappa, mu_t, h, n_elem, dxi, max_steps, rec, rec_every, out):
+    """Advance one impact to its end and write the results into ``out``.
+
+    The first five arguments are the compile-time effects (constants in the
+    kernels built by :func:`element_kernel`); the others are kernel-unit
+    inputs (module docstring).
+
+    Parameters
+    ----------
+    TANGENTIAL : advance the tangential problem (False: normal only, or ``v_c0 = 0``)
+    MEMORY : 0 incremental (Maw-Barber-Fawcett), 1 seed (thesis eq. 4.16)
+    INTEGRATOR : ``EULER``, ``SYMPLECTIC_EULER`` or ``VERLET``
+    ARMS : the material has Maxwell arms (``g``, ``tau`` non-empty)
+    DASHPOT : the material has a parallel dashpot (``tau0 > 0``)
+    tau0 : parallel dashpot time ``eta0 / (G_inf T)``
+    g, tau : arm moduli ``G_i / G_inf`` and times ``tau_i / T`` (1-D, equal length)
+    kappa : ``c_t / c_n``
+    mu_t : inverse effective tangential mass times m: ``1 + m R^2 / Theta``
+    h : time step / T
+    n_elem, dxi : elements in the half row and their spacing / a_H
+    max_steps : time limit in steps
+    rec : (n_rec, N_REC) trajectory buffer (may have zero rows)
+    rec_every : record every this many steps (ignored without rows)
+    out : (N_OUT,) result row
+    """
+    n_arms = g.shape[0] if ARMS else 0
+    E, omE, phi = arm_coefficients(tau, h)
+    G = 0.0
+    sum_gphi = 0.0
+    for i in range(n_arms):
+        G += g[i]
+        sum_gphi += g[i] * phi[i]
+    c0 = tau0 if DASHPOT else 0.0
+    tau0_h = c0 / h
+    den_free = tau0_h + 1.0 + G - sum_gphi
+    decay0 = math.exp(-h / c0) if DASHPOT else 0.0
+
+    k_el = 2.0 * ELEMENT_STIFFNESS * dxi  # both halves of the symmetric row
+    xi2 = np.empty(n_elem)
+    for j in range(n_elem):
+        xi = (j + 0.5) * dxi
+        xi2[j] = xi * xi
+    n_t = n_elem if TANGENTIAL else 0  # no tangential state at all without it
+    w = np.zeros(n_elem)
+    q = np.zeros((n_elem, n_arms))
+    s = np.zeros(n_t)
+    p = np.zeros((n_t, n_arms))
+    contact = np.zeros(n_elem, dtype=np.bool_)
+    f = np.zeros(n_elem)  # last normal force of each element in contact / (k_el)
+
+    u = 0.0
+    v = 1.0
+    uc = 0.0
+    vc = 1.0 if TANGENTIAL else 0.0
+    F_el = 0.0  # position/history part of the normal force
+    C = 0.0  # dashpot coefficient of the normal force
+    Ft_el = 0.0
+    Ct = 0.0
+    active = 0  # elements [0, active) have ever been touched
+    t_exit = 0.0  # time the last element left (impact starts touching at t = 0)
+    u_max = 0.0
+    j_outer_max = -1
+    n_rec = rec.shape[0]
+    i_rec = 0
+    status = STATUS_TIME_LIMIT
+    step = 0
+    b_now = 0.0
+    while step < max_steps:
+        # ---- sphere: first half (or the whole kick) ----
+        if INTEGRATOR == EULER:
+            v_test = v - h * (F_el + C * v)
+            u1 = u + h * v
+        elif INTEGRATOR == SYMPLECTIC_EULER:
+            v_test = (v - h * F_el) / (1.0 + h * C)
+            u1 = u + h * v_test
+        else:
+            v_test = (v - 0.5 * h * F_el) / (1.0 + 0.5 * h * C)
+            u1 = u + h * v_test
+        vc_test = 0.0
+        duc = 0.0
+        if TANGENTIAL:
+            if INTEGRATOR == EULER:
+                vc_test = vc - h * mu_t * (Ft_el + Ct * vc)
+                duc = h * vc
+            elif INTEGRATOR == SYMPLECTIC_EULER:
+                vc_test = (vc - h * mu_t * Ft_el) / (1.0 + h * mu_t * Ct)
+                duc = h * vc_test
+            else:
+                vc_test = (vc - 0.5 * h * mu_t * Ft_el) / (1.0 + 0.5 * h * mu_t * Ct)
+                duc = h * vc_test
+        uc1 = uc + duc
+        # ---- elements ----
+        while active < n_elem and xi2[active] <= u1:
+            active += 1
+        sum_r = 0.0
+        sum_rt = 0.0
+        t_leave = 0.0
+        n_c = 0
+        j_outer = -1
+        for j in range(active):
+            w0 = w[j]
+            w1 = u1 - xi2[j]
+            was_in = contact[j]
+            theta = 1.0
+            if was_in:
+                r = w1
+                if ARMS:
+                    r += _follow(w0, w1, q[j], g, E, omE, phi)
+            else:
+                if ARMS:
+                    wf = _relax(w0, q[j], g, E, omE, phi, tau0_h, den_free, decay0)
+                else:
+                    wf = w0 * decay0
+                if TANGENTIAL:
+                    if ARMS:
+                        s[j] = _relax(s[j], p[j], g, E, omE, phi, tau0_h, den_free, decay0)
+                    else:
+                        s[j] = s[j] * decay0
+                if w1 < wf:
+                    w[j] = wf
+                    continue
+                # (re-)entry: the sphere reached the relaxed surface at the
+                # fraction 1 - theta of the step; the element follows it from
+                # there (the arms see a ramp wf -> w1 over theta h, not a jump)
+                theta = (w1 - wf) / (w1 - wf + w0 + xi2[j] - u)
+                r = w1
+                if ARMS:
+                    r += _follow_over(wf, w1, q[j], g, tau, theta * h)
+            w[j] = w1
+            fj = r + c0 * v_test
+            if fj <= 0.0:  # force would pull: element leaves
+                if was_in:  # interpolate its force to zero within the step
+                    t_leave = max(t_leave, (step + f[j] / (f[j] - fj)) * h)
+                contact[j] = False
+                continue
+            contact[j] = True
+            f[j] = fj
+            n_c += 1
+            j_outer = j
+            sum_r += r
+            if TANGENTIAL:
+                s0 = s[j]
+                if MEMORY == 1:  # seed: total displacement of the contact point
+                    s1 = uc1
+                elif was_in:  # incremental: only displacement since entry loads it
+                    s1 = s0 + duc
+                else:  # incremental, entering: relaxed state plus the part of
+                    # the step after the surface was reached
+                    s1 = s0 + duc * theta
+                sum_rt += s1
+                if ARMS:
+                    if was_in:
+                        sum_rt += _follow(s0, s1, p[j], g, E, omE, phi)
+                    else:
+                        sum_rt += _follow_over(s0, s1, p[j], g, tau, theta * h)
+                s[j] = s1
+        if n_c == 0 and t_leave > 0.0:
+            t_exit = t_leave  # the last elements left within this step
+        F_el1 = k_el * sum_r
+        C1 = k_el * c0 * n_c
+        Ft_el1 = k_el * kappa * sum_rt
+        Ct1 = k_el * kappa * c0 * n_c
+        # ---- sphere: second half ----
+        if INTEGRATOR == VERLET:
+            v = v_test - 0.5 * h * (F_el1 + C1 * v_test)
+            if TANGENTIAL:
+                vc = vc_test - 0.5 * h * mu_t * (Ft_el1 + Ct1 * vc_test)
+        else:
+            v = v_test
+            vc = vc_test
+        u = u1
+        uc = uc1
+        F_el, C, Ft_el, Ct = F_el1, C1, Ft_el1, Ct1
+        step += 1
+        t = step * h
+        if not (math.isfinite(u) and math.isfinite(v) and math.isfinite(vc)):
+            status = STATUS_NON_FINITE
+            break
+        if u > u_max:
+            u_max = u
+        b_now = (j_outer + 1) * dxi if n_c > 0 else 0.0
+        if j_outer > j_outer_max:
+            j_outer_max = j_outer
+        if n_rec > 0 and step % rec_every == 0:
+            i_rec = _record(rec, i_rec, t, u, v, vc, F_el + C * v, Ft_el + Ct * vc, b_now)
+        if j_outer_max >= n_elem - 1:
+            status = STATUS_ROW_EXCEEDED
+            break
+        # ---- end of impact: no contact, moving away, no free surface can catch up ----
+        if n_c == 0 and v < 0.0:
+            caught = False
+            if DASHPOT or ARMS:  # an elastic surface is back at rest at once
+                for j in range(active):
+                    if _free_rate(w[j], q[j], g, tau, c0) < v * (1.0 + 1e-9):
+                        caught = True
+                        break
+            if not caught:
+                status = STATUS_OK
+                break
+    # a final record marks the end state (overwriting the last row if full)
+    if n_rec > 0:
+        i_rec = _record(rec, min(i_rec, n_rec - 1), step * h, u, v, vc, F_el + C * v, Ft_el + Ct * vc, b_now)
+    out[OUT_VZ_END] = v
+    out[OUT_VC_END] = vc  # stays 0 without tangential motion
+    out[OUT_T_CONTACT] = t_exit
+    out[OUT_U_MAX] = u_max
+    out[OUT_B_MAX] = (j_outer_max + 1) * dxi
+    out[OUT_STATUS] = status
+    out[OUT_STEPS] = step
+    out[OUT_N_REC] = i_rec
+
+
+class KernelSpec(NamedTuple):
+    """The compile-time effects of an element kernel (one compiled kernel each).
+
+    Attributes
+    ----------
+    integrator : ``EULER``, ``SYMPLECTIC_EULER`` or ``VERLET``
+    tangential : the tangential problem is advanced
+    memory : 0 incremental, 1 seed (meaningful only with ``tangential``)
+    arms : the material has Maxwell arms
+    dashpot : the material has a parallel dashpot
+    friction : Coulomb friction (finite ``mu``); ``False`` is full stick
+    """
+
+    integrator: int
+    tangential: bool
+    memory: int
+    arms: bool
+    dashpot: bool
+    friction: bool = False
+
+
+@functools.lru_cache(maxsize=None)
+def element_kernel(spec: KernelSpec):
+    """The batch kernel specialized for ``spec`` (compiled on first use, cached on disk).
+
+    Signature: ``run(tau0, g, tau, n_arms, kappa, mu_t, mu, h, n_elem, dxi,
+    max_steps, rec, rec_every, out)`` with per-set arrays of length ``n``
+    (``g``, ``tau`` padded to ``(n, max_arms)``; ``h``, ``n_elem``, ``dxi``
+    per set; ``mu`` the friction coefficient in tangential kernel units,
+    ``mu v_z0 / |v_c0|``, read only by kernels with ``spec.friction``), shared ``rec_every``, a trajectory buffer ``rec`` of shape
+    ``(n, n_rec, N_REC)`` (``n_rec`` may be 0) and ``out`` of shape
+    ``(n, N_OUT)``. ``prange`` runs over the parameter sets; each writes its
+    own row.
+    """
+    # plain Python constants in the closure: numba freezes them, LLVM folds the branches
+    integrator, tangential, memory = int(spec.integrator), bool(spec.tangential), int(spec.memory)
+    arms, dashpot = bool(spec.arms), bool(spec.dashpot)
+
+    @jit(parallel=True)
+    def run(tau0, g, tau, n_arms, kappa, mu_t, mu, h, n_elem, dxi, max_steps, rec, rec_every, out):
+        for i in prange(tau0.shape[0]):
+            k = n_arms[i]
+            _impact(tangential, memory, integrator, arms, dashpot, tau0[i], g[i, :k],
+                    tau[i, :k], kappa[i], mu_t[i], h[i], n_elem[i], dxi[i], max_steps[i],
+                    rec[i], rec_every, out[i])
+
+    return run

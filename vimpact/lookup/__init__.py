@@ -1,0 +1,1 @@
+"""Restitution tables: reading, describing, interpolating, e(v) curves."""

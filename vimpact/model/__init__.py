@@ -1,0 +1,1 @@
+"""Validated inputs: materials, scenes, numerics and the Hertz scales they are measured in."""

@@ -1,0 +1,125 @@
+"""Viscoelastic half-space materials (PHYSICS.md section 4).
+
+Every material is a generalized Maxwell solid with an optional parallel
+dashpot, ``G(t) = G_inf + sum_i G_i exp(-t/tau_i) (+ eta0 delta(t))``, and a
+constant Poisson ratio ``nu``. The named rheologies are constructors that
+fill in this one form.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from vimpact.model.validation import non_negative, poisson_ratio, positive, require
+
+MODELS = ("elastic", "kelvin_voigt", "standard_solid", "prony")
+
+
+def shear_modulus(E: float, nu: float) -> float:
+    """Shear modulus ``G = E / (2 (1 + nu))`` in Pa from Young's modulus ``E`` in Pa."""
+    return E / (2.0 * (1.0 + nu))
+
+
+def _modulus(G, E, nu, name="G"):
+    require(f"{name} and E", (G, E), (G is None) != (E is None), "exactly one of them given")
+    return positive(name, G) if G is not None else shear_modulus(positive("E", E), nu)
+
+
+@dataclass(frozen=True)
+class Material:
+    """A viscoelastic half-space.
+
+    Attributes
+    ----------
+    model : one of ``MODELS``
+    nu : Poisson ratio, dimensionless, in [0, 0.5]
+    G_inf : relaxed (long-time) shear modulus, Pa
+    arms : Maxwell arms ``((G_i [Pa], tau_i [s]), ...)``
+    eta0 : parallel dashpot viscosity, Pa s
+    """
+
+    model: str
+    nu: float
+    G_inf: float
+    arms: tuple[tuple[float, float], ...] = ()
+    eta0: float = 0.0
+
+    def __post_init__(self):
+        require("model", self.model, self.model in MODELS, "one of " + ", ".join(MODELS))
+        poisson_ratio("nu", self.nu)
+        positive("G_inf", self.G_inf)
+        non_negative("eta0", self.eta0)
+        for i, arm in enumerate(self.arms):
+            require(f"arm {i + 1}", arm, len(arm) == 2, "a pair (G_i [Pa], tau_i [s])")
+            positive(f"G_{i + 1} (arm {i + 1} modulus, Pa)", arm[0])
+            positive(f"tau_{i + 1} (arm {i + 1} relaxation time, s)", arm[1])
+
+    # ---- constructors -------------------------------------------------
+    @classmethod
+    def elastic(cls, nu: float, G: float | None = None, E: float | None = None) -> "Material":
+        """Elastic half-space with shear modulus ``G`` or Young's modulus ``E`` (Pa)."""
+        nu = poisson_ratio("nu", nu)
+        return cls("elastic", nu, _modulus(G, E, nu))
+
+    @classmethod
+    def kelvin_voigt(cls, nu: float, eta: float, G: float | None = None,
+                     E: float | None = None) -> "Material":
+        """Kelvin-Voigt body: spring ``G`` (or ``E``, Pa) parallel to a dashpot ``eta`` (Pa s)."""
+        nu = poisson_ratio("nu", nu)
+        return cls("kelvin_voigt", nu, _modulus(G, E, nu), (), non_negative("eta", eta))
+
+    @classmethod
+    def standard_solid(cls, nu: float, G1: float, G2: float, eta: float) -> "Material":
+        """Standard linear solid: spring ``G1`` parallel to a Maxwell arm (spring ``G2``,
+        dashpot ``eta``). Moduli in Pa, ``eta`` in Pa s; arm time ``tau = eta / G2``."""
+        nu = poisson_ratio("nu", nu)
+        G1, G2 = positive("G1", G1), positive("G2", G2)
+        eta = non_negative("eta", eta)
+        if eta == 0.0:  # an arm with no dashpot carries no force
+            return cls("standard_solid", nu, G1)
+        return cls("standard_solid", nu, G1, ((G2, eta / G2),))
+
+    @classmethod
+    def prony(cls, nu: float, G_inf: float, arms, eta0: float = 0.0) -> "Material":
+        """Prony series: relaxed modulus ``G_inf`` (Pa), arms ``[(G_i [Pa], tau_i [s]), ...]``,
+        optional parallel dashpot ``eta0`` (Pa s)."""
+        nu = poisson_ratio("nu", nu)
+        arms = tuple((float(a[0]), float(a[1])) for a in arms)
+        return cls("prony", nu, positive("G_inf", G_inf), arms, non_negative("eta0", eta0))
+
+    # ---- derived ------------------------------------------------------
+    @property
+    def glassy_modulus(self) -> float:
+        """Instantaneous shear modulus ``G_inf + sum G_i``, Pa."""
+        return self.G_inf + sum(G for G, _ in self.arms)
+
+    @property
+    def kappa(self) -> float:
+        """Tangential over normal element stiffness ``c_t / c_n = 2 (1 - nu) / (2 - nu)``
+        (PHYSICS.md section 3), dimensionless."""
+        return 2.0 * (1.0 - self.nu) / (2.0 - self.nu)
+
+    @property
+    def dashpot_time(self) -> float:
+        """``eta0 / G_inf``, s."""
+        return self.eta0 / self.G_inf
+
+    @property
+    def q2(self) -> float:
+        """``Q2 = G1 / G2`` for a standard solid, NaN otherwise (inf without arm)."""
+        if self.model != "standard_solid":
+            return float("nan")
+        return self.G_inf / self.arms[0][0] if self.arms else float("inf")
+
+    def viscous_time(self) -> float:
+        """The time ``eta / G_inf`` that defines ``Q1`` (s): the dashpot of a
+        Kelvin-Voigt body, the arm dashpot of a standard solid over ``G1``;
+        0 for an elastic body, NaN for a general Prony series."""
+        if self.model in ("elastic", "kelvin_voigt"):
+            return self.dashpot_time
+        if self.model == "standard_solid":
+            if not self.arms:
+                return 0.0
+            G2, tau = self.arms[0]
+            return G2 * tau / self.G_inf
+        return float("nan")

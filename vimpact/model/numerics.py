@@ -1,0 +1,122 @@
+"""Numerics of the element kernel as a value object with named presets."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+
+from vimpact.kernels.elements import EULER, SYMPLECTIC_EULER, VERLET
+from vimpact.model.validation import one_of, positive, require
+
+#: Integrators by name (see :mod:`vimpact.kernels.elements`) and their nominal order.
+INTEGRATORS = {"euler": EULER, "symplectic_euler": SYMPLECTIC_EULER, "verlet": VERLET}
+ORDER = {"euler": 1, "symplectic_euler": 1, "verlet": 2}
+
+
+@dataclass(frozen=True)
+class Numerics:
+    """How an impact is discretized.
+
+    Attributes
+    ----------
+    integrator : ``"verlet"`` (default: second order, dashpot implicit),
+        ``"symplectic_euler"`` (first order, dashpot implicit) or ``"euler"``
+        (the thesis's explicit Euler, first order)
+    steps : time steps per Hertz contact time ``t_H`` (of the relaxed
+        modulus); the step is shortened further for a stiffer tangential
+        mode and for explicit Euler's stability (``vimpact.engine.routing.refinement``)
+    elements : elements per Hertz contact radius ``a_H`` on the half row
+    row_width : length of the half row, in units of ``a_H`` (>= 1; the
+        contact of a passive material never exceeds ``a_H``, and reaching
+        the end of the row stops the run with status ``row_exceeded``)
+    max_time : time limit in units of ``t_H (1 + 10 t_v / T)`` with the
+        viscous time ``t_v = (eta0 + sum G_i tau_i) / G_inf`` (capped at 1e4);
+        an impact still running then ends with status ``time_limit``
+    continuum : take the continuum 1-DOF path for Kelvin-Voigt and elastic
+        normal-only scenes (default ``True``; ``False`` forces elements)
+    rtol : relative tolerance of the adaptive continuum path
+    """
+
+    integrator: str = "verlet"
+    steps: int = 1400
+    elements: int = 200
+    row_width: float = 1.05
+    max_time: float = 100.0
+    continuum: bool = True
+    rtol: float = 1e-8
+
+    def __post_init__(self):
+        one_of("integrator", self.integrator, tuple(INTEGRATORS))
+        for name in ("steps", "elements"):
+            value = getattr(self, name)
+            require(name, value, isinstance(value, int) and value >= 4, "an integer >= 4")
+        require("row_width", self.row_width, positive("row_width", self.row_width) >= 1.0, ">= 1")
+        positive("max_time", self.max_time)
+        require("continuum", self.continuum, isinstance(self.continuum, bool), "True or False")
+        require("rtol", self.rtol, 1e-14 <= positive("rtol", self.rtol) <= 1e-2,
+                "between 1e-14 and 1e-2")
+
+    @classmethod
+    def for_tolerance(cls, tolerance: float, integrator: str = "verlet") -> "Numerics":
+        """Steps and elements chosen to reach ``tolerance`` on e_z and e_x.
+
+        Uses the error model measured by ``python -m benchmarks.accuracy``
+        (:data:`ERROR_MODEL`: ``error ~ a / steps^p + b / elements^q``, the
+        worst case over Q1 in [1e-3, 10], Q2 and nu), half the tolerance to
+        each knob; the continuum path gets ``rtol = min(tolerance / 10, 1e-8)``
+        (its error is 0.1 to 6 times rtol; it costs microseconds, and below
+        1e-6 its elastic e_z cannot pass 1 by more than the passivity slack). The element path is capped at
+        :data:`MAX_STEPS` and :data:`MAX_ELEMENTS`: below about 1e-6 it
+        cannot follow (its e_x converges only about first order in the steps)
+        and delivers what the cap reaches; the continuum path reaches 1e-12.
+
+        Parameters
+        ----------
+        tolerance : target absolute error on e_z and e_x, in [1e-12, 1e-2]
+        integrator : ``"verlet"`` (the model is measured for it)
+        """
+        tol = positive("tolerance", tolerance)
+        require("tolerance", tolerance, 1e-12 <= tol <= 1e-2, "between 1e-12 and 1e-2")
+        one_of("integrator", integrator, ("verlet",))
+        m = ERROR_MODEL
+        steps = math.ceil((2.0 * m["a"] / tol) ** (1.0 / m["p"]))
+        elements = math.ceil((2.0 * m["b"] / tol) ** (1.0 / m["q"]))
+        return cls(integrator=integrator, steps=int(min(max(steps, 100), MAX_STEPS)),
+                   elements=int(min(max(elements, 20), MAX_ELEMENTS)),
+                   rtol=min(max(tol / 10.0, 1e-13), 1e-8))
+
+    @classmethod
+    def preset(cls, name: str) -> "Numerics":
+        """Named settings (:data:`PRESETS`): ``fast`` (about 1e-3 on e_z, e_x),
+        ``default`` (about 1e-4), ``precise`` (1e-7 and better on the continuum
+        path; about 2e-6 on the element path, the best it verifiably reaches) and ``thesis`` (explicit Euler, 5000 steps per
+        t_H, 1000 elements across the contact diameter, as in the thesis)."""
+        one_of("numerics preset", name, tuple(PRESETS))
+        return PRESETS[name]
+
+    def with_(self, **changes) -> "Numerics":
+        """A copy with some fields changed (validated)."""
+        return replace(self, **changes)
+
+    @property
+    def integrator_code(self) -> int:
+        return INTEGRATORS[self.integrator]
+
+
+#: Error model of the Verlet element path, measured by ``benchmarks/accuracy.py``
+#: (an envelope bounding every measured setting over its 20 scenes, not a median
+#: fit): ``max(|e_z err|, |e_x err|) <= a / steps^p + b / elements^q``.
+ERROR_MODEL = {"a": 0.176, "p": 1.0, "b": 3.11, "q": 2.0}
+#: Caps of :meth:`Numerics.for_tolerance` on the element path (about 0.3 s per impact).
+MAX_STEPS = 16000
+MAX_ELEMENTS = 3200
+
+PRESETS = {
+    # chosen from the accuracy-versus-time front (benchmarks/results/accuracy.json)
+    "fast": Numerics(steps=500, elements=70),  # measured 3.1e-4 at 0.11 ms/impact
+    "default": Numerics(),  # 1400/200: measured 6.4e-5 at 0.56 ms/impact
+    # the best the element path verifiably reaches (e_x ~2e-6, e_z ~1.4e-7);
+    # 1e-7 and better on the continuum path
+    "precise": Numerics(steps=16000, elements=3200, rtol=1e-10),
+    "thesis": Numerics(integrator="euler", steps=5000, elements=500),
+}

@@ -1,0 +1,156 @@
+"""One impact: sphere, material, initial velocities and options (PHYSICS.md section 1)."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+from vimpact.model.hertz import HertzScales, Q1_PER_TAU, effective_modulus, hertz_scales
+from vimpact.model.material import Material
+from vimpact.model.validation import finite, one_of, positive, require
+
+TANGENTIAL_MEMORY = ("incremental", "seed")
+
+#: What a scene asks of the tangential problem: ``auto`` (stick whenever
+#: ``v_c0 != 0``), ``stick`` (full stick, PHYSICS.md section 6) or ``none``
+#: (normal impact only: no tangential state at all, e_x and beta_x NaN).
+#: Slip is not modelled yet.
+TANGENTIAL_EFFECTS = ("auto", "stick", "none")
+
+#: The thesis's half-space limit: contact half-width at most this times R.
+HALF_SPACE_LIMIT = 0.2
+
+
+@dataclass(frozen=True)
+class Scene:
+    """A rigid sphere hitting a viscoelastic half-space.
+
+    Attributes
+    ----------
+    material : the half-space
+    R : sphere radius, m
+    m : sphere mass, kg
+    v_z0 : normal impact speed, m/s (> 0, into the half-space)
+    v_x0 : tangential speed of the centre, m/s
+    omega0 : spin about the y axis, rad/s (contact point moves with ``v_x + R omega``)
+    Theta : moment of inertia, kg m^2 (default ``2/5 m R^2``, a solid sphere)
+    tangential_memory : ``"incremental"`` (default, passive: elements enter
+        unstrained) or ``"seed"`` (thesis eq. 4.16: total displacement; not passive)
+    allow_large_contact : accept a contact half-width above ``0.2 R`` (the
+        half-space model is then outside its range; the thesis stops there)
+    tangential : ``"auto"`` (default: full stick whenever ``v_c0 != 0``),
+        ``"stick"`` or ``"none"`` (normal impact only; ``TANGENTIAL_EFFECTS``)
+    rotation : the sphere may spin (default). ``False`` is the limit
+        ``Theta -> inf``: the tangential force changes ``v_x`` only and
+        ``omega`` keeps ``omega0`` (``Theta`` is then not used)
+    """
+
+    material: Material
+    R: float
+    m: float
+    v_z0: float
+    v_x0: float = 0.0
+    omega0: float = 0.0
+    Theta: float | None = None
+    tangential_memory: str = "incremental"
+    allow_large_contact: bool = False
+    tangential: str = "auto"
+    rotation: bool = True
+    hertz: HertzScales = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self):
+        require("material", self.material, isinstance(self.material, Material), "a vimpact.Material")
+        positive("R", self.R)
+        positive("m", self.m)
+        positive("v_z0", self.v_z0)
+        finite("v_x0", self.v_x0)
+        finite("omega0", self.omega0)
+        if self.Theta is None:
+            object.__setattr__(self, "Theta", 0.4 * self.m * self.R**2)
+        positive("Theta", self.Theta)
+        one_of("tangential_memory", self.tangential_memory, TANGENTIAL_MEMORY)
+        one_of("tangential", self.tangential, TANGENTIAL_EFFECTS)
+        require("rotation", self.rotation, isinstance(self.rotation, bool), "True or False")
+        mat = self.material
+        object.__setattr__(self, "hertz", hertz_scales(mat.G_inf, mat.nu, self.R, self.m, self.v_z0))
+
+    @classmethod
+    def from_dimensionless(cls, Q1: float, nu: float, Q2: float | None = None, *,
+                           theta_ratio: float = 0.4, tangential_memory: str = "incremental",
+                           tangential: str = "auto", rotation: bool = True) -> "Scene":
+        """A physical scene with the given dimensionless parameters.
+
+        Kelvin-Voigt for ``Q2 = None``, standard solid otherwise. Restitution
+        depends only on ``Q1`` (``Q2``), ``nu`` and ``theta_ratio = Theta /
+        (m R^2)`` (PHYSICS.md section 8), so any scene with these values gives
+        the same ``e_z``, ``e_x``; this one has ``R = 1 m``, ``m = 1 kg``,
+        ``v_z0 = v_x0 = 1 m/s``, ``omega0 = 0`` and a modulus chosen so that
+        ``a_H = 0.01 R``.
+        """
+        Q1 = finite("Q1", Q1)
+        require("Q1", Q1, Q1 >= 0.0, ">= 0")
+        nu = float(nu)
+        R, m, v_z0 = 1.0, 1.0, 1.0
+        d = 1e-4  # a_H = sqrt(R d) = 0.01 R
+        E_star = 15.0 * m * v_z0**2 / (16.0 * math.sqrt(R) * d**2.5)
+        G = E_star * (1.0 - nu) / 2.0
+        tau = Q1 / Q1_PER_TAU * d / v_z0  # eta / G_inf, s
+        if Q2 is None:
+            material = Material.kelvin_voigt(nu=nu, G=G, eta=tau * G)
+        else:
+            Q2 = positive("Q2", Q2)
+            material = Material.standard_solid(nu=nu, G1=G, G2=G / Q2, eta=tau * G)
+        return cls(material, R=R, m=m, v_z0=v_z0, v_x0=1.0, omega0=0.0,
+                   Theta=positive("theta_ratio", theta_ratio) * m * R**2,
+                   tangential_memory=tangential_memory, tangential=tangential, rotation=rotation)
+
+    # ---- derived quantities ------------------------------------------
+    @property
+    def v_c0(self) -> float:
+        """Initial contact-point velocity ``v_x0 + R omega0``, m/s."""
+        return self.v_x0 + self.R * self.omega0
+
+    @property
+    def theta_ratio(self) -> float:
+        """``Theta / (m R^2)``, dimensionless."""
+        return self.Theta / (self.m * self.R**2)
+
+    @property
+    def computes_tangential(self) -> bool:
+        """The tangential problem is solved: asked for (``tangential`` is not
+        ``"none"``) and not trivially zero (``v_c0 != 0``, PHYSICS.md section 7)."""
+        return self.tangential != "none" and self.v_c0 != 0.0
+
+    @property
+    def contact_mass_factor(self) -> float:
+        """``1 + m R^2 / Theta`` (``1`` without rotation): the contact point
+        accelerates this much faster than the centre under a tangential force
+        (PHYSICS.md section 7), dimensionless."""
+        return 1.0 + 1.0 / self.theta_ratio if self.rotation else 1.0
+
+    def tangential_end_state(self, vc_ratio):
+        """Centre velocity (m/s) and spin (rad/s) when the contact-point velocity
+        has become ``vc_ratio * v_c0`` (works on arrays)."""
+        impulse = (1.0 - vc_ratio) / self.contact_mass_factor * self.v_c0  # J / m, m/s
+        spin = impulse * self.m * self.R / self.Theta if self.rotation else 0.0 * impulse
+        return self.v_x0 - impulse, self.omega0 - spin
+
+    @property
+    def E_star(self) -> float:
+        """Effective (relaxed) modulus ``2 G_inf / (1 - nu)``, Pa."""
+        return float(effective_modulus(self.material.G_inf, self.material.nu))
+
+    @property
+    def Q1(self) -> float:
+        """``Q1 = sqrt(15/32) (eta / G_inf) / T``, dimensionless (NaN for a general Prony series)."""
+        return Q1_PER_TAU * self.material.viscous_time() / self.hertz.T
+
+    @property
+    def Q2(self) -> float:
+        """``Q2 = G1 / G2`` (standard solid; NaN otherwise)."""
+        return self.material.q2
+
+    @property
+    def kinetic_energy(self) -> float:
+        """Kinetic energy before the impact, J."""
+        return 0.5 * (self.m * (self.v_z0**2 + self.v_x0**2) + self.Theta * self.omega0**2)

@@ -1,0 +1,1 @@
+"""Closed forms and independent references the kernels are checked against."""

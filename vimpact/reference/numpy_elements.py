@@ -1,0 +1,318 @@
+"""Slow, independent reference of the MDR impact in physical (SI) units.
+
+This is the documentation-grade restatement of the element model of
+PHYSICS.md sections 3-7, written directly in metres, seconds, kilograms and
+pascals. It shares no code with :mod:`vimpact.kernels.elements` and does not
+nondimensionalize anything: it only takes the discretization (``t_H`` and
+``a_H`` for the step and the element spacing) from
+:func:`vimpact.model.hertz.hertz_scales` and the refinement rule from
+:func:`vimpact.engine.routing.refinement`. In particular it
+
+- uses the element stiffnesses ``c_n G`` and ``c_t G`` per unit length with
+  ``c_n = 2 / (1 - nu)``, ``c_t = 4 / (2 - nu)`` and the material moduli in Pa,
+- tracks the centre velocity ``v_x`` and the spin ``omega`` separately
+  (``m dv_x/dt = -F_x``, ``Theta domega/dt = -R F_x``); the contact-point
+  velocity ``v_c = v_x + R omega`` is only ever formed from them,
+- runs the tangential problem at its true size (no scaling by ``v_c0``).
+
+The time stepping is the same algorithm as the kernel's ``VERLET``
+integrator, so for the same discretization both agree to rounding (about
+1e-9 relative or better). It is vectorized over elements with NumPy and loops
+over time steps in Python: slow on purpose, keep the sizes small.
+
+Sign convention: ``v_z > 0`` into the half-space, indentation ``u > 0``
+into the half-space, the normal surface displacement ``w`` of an element is
+positive into the half-space, forces push the sphere back.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from vimpact import Numerics
+from vimpact.model.hertz import hertz_scales
+from vimpact.engine.routing import choose_path, refinement
+
+#: PHYSICS.md section 1: the half-space model holds up to a = 0.2 R.
+HALF_SPACE_LIMIT = 0.2
+
+
+# --------------------------------------------------------------- rheology
+
+def arm_update_coefficients(tau, dt):
+    """Coefficients of the exact arm update over a time ``dt`` (PHYSICS.md section 4).
+
+    For ``tau dq/dt = w - q`` with ``w`` linear in time from ``w0`` to ``w1``::
+
+        q(dt) = E q0 + (1 - E) w0 + phi (w1 - w0),
+        E = exp(-dt/tau),  phi = 1 - (tau/dt)(1 - E)
+
+    ``tau`` (s) and ``dt`` (s) broadcast against each other. Returns
+    ``(E, 1 - E, phi)``. ``1 - E`` comes from ``expm1``; ``phi`` from its
+    Taylor series where ``dt/tau`` is small (the closed form cancels there).
+    """
+    x = np.asarray(dt, dtype=float) / np.asarray(tau, dtype=float)
+    one_minus_E = -np.expm1(-x)
+    E = 1.0 - one_minus_E
+    series = x * (1.0 / 2.0 - x * (1.0 / 6.0 - x * (1.0 / 24.0 - x / 120.0)))
+    safe_x = np.where(x > 0.0, x, 1.0)
+    closed = 1.0 - one_minus_E / safe_x
+    phi = np.where(x < 1e-3, series, closed)
+    return E, one_minus_E, phi
+
+
+def advance_arms(q, w0, w1, coefficients):
+    """Arm variables ``q`` (elements x arms, m) after ``w`` went linearly ``w0 -> w1``."""
+    E, one_minus_E, phi = coefficients
+    return E * q + one_minus_E * w0[:, None] + phi * (w1 - w0)[:, None]
+
+
+class Rheology:
+    """The general element of PHYSICS.md section 4, per unit length and per
+    unit of the geometric factor ``c`` (``c_n`` or ``c_t``)::
+
+        stress(w, q, dw/dt) = G_inf w + eta0 dw/dt + sum_i G_i (w - q_i)
+
+    Moduli in Pa, ``eta0`` in Pa s, ``tau_i`` in s.
+    """
+
+    def __init__(self, material):
+        self.G_inf = float(material.G_inf)
+        self.eta0 = float(material.eta0)
+        self.G = np.array([G for G, _ in material.arms], dtype=float)
+        self.tau = np.array([tau for _, tau in material.arms], dtype=float)
+        self.n_arms = len(self.G)
+
+    def spring_stress(self, w, q):
+        """``G_inf w + sum_i G_i (w - q_i)`` (Pa), the part without the dashpot."""
+        return self.G_inf * w + (self.G * (w[:, None] - q)).sum(axis=1)
+
+    def relax(self, w0, q0, h, coefficients):
+        """Free surface under zero force over one step ``h`` (PHYSICS.md section 5).
+
+        Solves ``eta0 dw/dt + G_inf w + sum G_i (w - q_i) = 0``:
+        without arms exactly (``w0 exp(-h G_inf/eta0)``, or 0 for an elastic
+        element); with arms implicitly in the end value ``w1``, the arms on
+        the exact linear-path update ``w0 -> w1``:
+        ``eta0 (w1 - w0)/h + G_inf w1 + sum G_i (w1 - q_i(w1)) = 0``.
+        Returns ``(w1, q1)``.
+        """
+        if self.n_arms == 0:
+            if self.eta0 > 0.0:
+                return w0 * math.exp(-h * self.G_inf / self.eta0), q0
+            return np.zeros_like(w0), q0
+        E, one_minus_E, phi = coefficients
+        # q_i(w1) = E q0 + (1-E) w0 + phi (w1 - w0): collect the terms in w1
+        lhs = self.eta0 / h + self.G_inf + (self.G * (1.0 - phi)).sum()
+        rhs = self.eta0 / h * w0 + (self.G * (E * q0 + (one_minus_E - phi) * w0[:, None])).sum(axis=1)
+        w1 = rhs / lhs
+        return w1, advance_arms(q0, w0, w1, coefficients)
+
+    def free_rate(self, w, q):
+        """``dw/dt`` (m/s) of free surface elements under zero force."""
+        spring = self.spring_stress(w, q)
+        if self.eta0 > 0.0:
+            return -spring / self.eta0
+        if self.n_arms == 0:
+            return np.zeros_like(w)  # elastic: already at rest at w = 0
+        # d/dt [G_inf w + sum G_i (w - q_i)] = 0 with tau_i dq_i/dt = w - q_i
+        arm_rates = (self.G * (w[:, None] - q) / self.tau).sum(axis=1)
+        return arm_rates / (self.G_inf + self.G.sum())
+
+
+# ------------------------------------------------------------------ impact
+
+def naive_impact(scene, steps, elements, row_width=1.05, max_time=100.0):
+    """Simulate ``scene`` (a :class:`vimpact.Scene`) in SI units with the
+    Stormer-Verlet scheme of the kernel.
+
+    Parameters
+    ----------
+    scene : the impact
+    steps : time steps per Hertz contact time ``t_H`` (of ``G_inf``)
+    elements : elements per Hertz radius ``a_H`` on the half row
+    row_width : half-row length in units of ``a_H``
+    max_time : time limit in units of ``t_H + 10 eta0 / G_inf``
+
+    Returns
+    -------
+    dict with ``e_z, e_x, beta_x`` (1; ``e_x, beta_x`` NaN if ``v_c0 = 0``),
+    ``v_z_end, v_x_end`` (m/s), ``omega_end`` (rad/s), ``t_contact`` (s),
+    ``u_max``, ``a_max`` (m), ``energy_ratio`` (1), ``status``
+    (``ok``, ``vc0_zero``, ``half_space``, ``time_limit``, ``row_exceeded``,
+    ``non_finite``) and ``steps`` (time steps taken).
+    """
+    mat = scene.material
+    rheo = Rheology(mat)
+    nu = float(mat.nu)
+    c_n = 2.0 / (1.0 - nu)  # normal stiffness per length / G
+    c_t = 4.0 / (2.0 - nu)  # tangential stiffness per length / G
+    R, m, Theta = float(scene.R), float(scene.m), float(scene.Theta)
+
+    hz = hertz_scales(mat.G_inf, nu, R, m, scene.v_z0)
+    # the discretization rule of the kernel (finer steps and elements for a
+    # stiffer tangential mode or a glassy contact): taken, not re-derived
+    numerics = Numerics(steps=steps, elements=elements, row_width=row_width, continuum=False)
+    time_factor, element_factor = refinement(scene, numerics, choose_path(scene, numerics).spec)
+    h = hz.t_H / steps / time_factor  # s
+    elements = int(math.ceil(elements * element_factor))
+    dx = hz.a_H / elements  # m
+    n = int(math.ceil(row_width * elements))
+    x = (np.arange(n) + 0.5) * dx  # element positions, m
+    gap = x * x / R  # MDR profile g(x) = x^2 / R, m
+    weight = 2.0 * dx  # symmetric row: each element stands for itself and its mirror image
+    max_steps = int(math.ceil(max_time * (hz.t_H + 10.0 * rheo.eta0 / rheo.G_inf) / h))
+
+    arms_h = arm_update_coefficients(rheo.tau, h)  # full-step coefficients, per arm
+
+    # element state
+    w = np.zeros(n)  # normal surface displacement, m
+    q = np.zeros((n, rheo.n_arms))  # normal arm variables, m
+    s = np.zeros(n)  # tangential surface displacement, m
+    p = np.zeros((n, rheo.n_arms))  # tangential arm variables, m
+    contact = np.zeros(n, dtype=bool)
+    f_last = np.zeros(n)  # last normal force of each element in contact, N
+
+    # sphere state
+    u, v_z = 0.0, float(scene.v_z0)  # indentation (m), normal velocity (m/s)
+    v_x, omega = float(scene.v_x0), float(scene.omega0)
+    u_c = 0.0  # tangential displacement of the contact point, m
+    # forces of the current state: spring part and dashpot coefficient (N, N s/m)
+    Fz_spring, Cz = 0.0, 0.0
+    Fx_spring, Cx = 0.0, 0.0
+
+    memory = scene.tangential_memory
+    t_contact = 0.0
+    u_max = 0.0
+    j_outer_max = -1
+    status = "time_limit"
+    step = 0
+    while step < max_steps:
+        # ---- first half kick, dashpot implicit in the half-step velocities ----
+        # m v+ = m v - h/2 (Fz_spring + Cz v+)
+        v_z_half = (m * v_z - 0.5 * h * Fz_spring) / (m + 0.5 * h * Cz)
+        # m v_x+ = m v_x - h/2 F_x,  Theta omega+ = Theta omega - h/2 R F_x,
+        # F_x = Fx_spring + Cx (v_x+ + R omega+): a 2x2 linear system
+        k = 0.5 * h * Cx
+        A = np.array([[m + k, k * R], [k * R, Theta + k * R * R]])
+        b = np.array([m * v_x - 0.5 * h * Fx_spring, Theta * omega - 0.5 * h * R * Fx_spring])
+        v_x_half, omega_half = np.linalg.solve(A, b)
+        v_c_half = v_x_half + R * omega_half
+
+        # ---- drift ----
+        u_new = u + h * v_z_half
+        u_c_new = u_c + h * v_c_half
+        du_c = u_c_new - u_c
+        w_sphere_old = u - gap  # where the sphere surface was above each element
+        w_sphere = u_new - gap  # ... and is now
+
+        # ---- elements ----
+        was_in = contact.copy()
+        free = ~was_in
+        w0 = w.copy()
+        s0 = s.copy()
+
+        # in contact: follow the sphere, arms on the exact linear path
+        q[was_in] = advance_arms(q[was_in], w0[was_in], w_sphere[was_in], arms_h)
+        # free: relax under zero force over the whole step (normal and tangential)
+        w_free, q[free] = rheo.relax(w0[free], q[free], h, arms_h)
+        s_free, p[free] = rheo.relax(s0[free], p[free], h, arms_h)
+        w_relaxed = w0.copy()
+        w_relaxed[free] = w_free
+        s[free] = s_free
+        # a free element enters when the sphere reaches its relaxed surface
+        entering = free & (w_sphere >= w_relaxed)
+        staying_free = free & ~entering
+        w[staying_free] = w_relaxed[staying_free]
+        # theta: fraction of the step after the sphere reached the surface
+        # (linear interpolation of the gap sphere - surface over the step)
+        theta = np.ones(n)
+        gain = w_sphere - w_relaxed
+        theta[entering] = gain[entering] / (gain[entering] + (w0 - w_sphere_old)[entering])
+        # entering elements ramp from the relaxed surface to the sphere over theta h
+        arms_theta = arm_update_coefficients(rheo.tau[None, :], (theta[entering] * h)[:, None])
+        q[entering] = advance_arms(q[entering], w_relaxed[entering], w_sphere[entering], arms_theta)
+
+        touching = was_in | entering
+        w[touching] = w_sphere[touching]
+        spring = np.zeros(n)
+        spring[touching] = rheo.spring_stress(w[touching], q[touching])
+        force = c_n * weight * (spring + rheo.eta0 * v_z_half)  # N, element and mirror image
+        # no adhesion: an element whose force would pull leaves contact
+        leaving = touching & (force <= 0.0)
+        now_in = touching & ~leaving
+        left = leaving & was_in
+        if left.any():
+            # the time the last of them left: interpolate its force to zero
+            fraction = f_last[left] / (f_last[left] - force[left])
+            t_leave = ((step + fraction) * h).max()
+        contact = now_in
+        f_last[now_in] = force[now_in]
+
+        # tangential state of the elements in contact (PHYSICS.md section 6)
+        if memory == "seed":  # thesis eq. 4.16: total contact-point displacement
+            s_new = np.full(n, u_c_new)
+        else:  # incremental: only the displacement since entering loads an element
+            s_new = s + du_c * theta  # theta = 1 for elements that were in contact
+        stay = now_in & was_in
+        new = now_in & entering
+        p[stay] = advance_arms(p[stay], s0[stay], s_new[stay], arms_h)
+        p[new] = advance_arms(p[new], s[new], s_new[new], arm_update_coefficients(
+            rheo.tau[None, :], (theta[new] * h)[:, None]))
+        s[now_in] = s_new[now_in]
+
+        # forces of the new state
+        n_c = int(now_in.sum())
+        Fz_spring = c_n * weight * spring[now_in].sum()
+        Cz = c_n * weight * rheo.eta0 * n_c
+        Fx_spring = c_t * weight * rheo.spring_stress(s[now_in], p[now_in]).sum()
+        Cx = c_t * weight * rheo.eta0 * n_c
+        if n_c == 0 and left.any():
+            t_contact = t_leave
+
+        # ---- second half kick (dashpot with the half-step velocities) ----
+        F_z = Fz_spring + Cz * v_z_half
+        F_x = Fx_spring + Cx * v_c_half
+        v_z = v_z_half - 0.5 * h * F_z / m
+        v_x = v_x_half - 0.5 * h * F_x / m
+        omega = omega_half - 0.5 * h * R * F_x / Theta
+        u, u_c = u_new, u_c_new
+        step += 1
+
+        if not all(map(math.isfinite, (u, v_z, v_x, omega))):
+            status = "non_finite"
+            break
+        u_max = max(u_max, u)
+        if n_c > 0:
+            j_outer_max = max(j_outer_max, int(np.flatnonzero(now_in)[-1]))
+        if j_outer_max >= n - 1:
+            status = "row_exceeded"
+            break
+        # ---- end: no contact, moving away, and no free surface catches up ----
+        if n_c == 0 and v_z < 0.0:
+            rate = rheo.free_rate(w, q)
+            if not (rate < v_z * (1.0 + 1e-9)).any():
+                status = "ok"
+                break
+
+    v_c0 = scene.v_x0 + R * scene.omega0
+    v_c_end = v_x + R * omega
+    energy0 = 0.5 * (m * (scene.v_z0**2 + scene.v_x0**2) + Theta * scene.omega0**2)
+    energy1 = 0.5 * (m * (v_z**2 + v_x**2) + Theta * omega**2)
+    a_max = (j_outer_max + 1) * dx
+    if status == "ok":
+        if a_max > HALF_SPACE_LIMIT * R:
+            status = "half_space"
+        elif v_c0 == 0.0:
+            status = "vc0_zero"
+    nan = float("nan")
+    return dict(
+        e_z=abs(v_z) / scene.v_z0,
+        e_x=abs(v_c_end) / abs(v_c0) if v_c0 != 0.0 else nan,
+        beta_x=-v_c_end / v_c0 if v_c0 != 0.0 else nan,
+        v_z_end=v_z, v_x_end=v_x, omega_end=omega,
+        t_contact=t_contact, u_max=u_max, a_max=a_max,
+        energy_ratio=energy1 / energy0, status=status, steps=step,
+    )
