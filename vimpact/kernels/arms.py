@@ -105,3 +105,24 @@ def _free_rate(w, qrow, g, tau, tau0):
     return rate / (1.0 + G)
 
 
+
+@jit(inline="always")
+def _to_stress(target, s0, p0, prow, g, E, omE, phi, tau0_dt):
+    """The end value ``s1`` of a path ``s0 -> s1`` (linear over a time ``dt``)
+    whose element stress is ``target``: Coulomb slip (PHYSICS.md section 12).
+
+    Solves ``s1 + sum g_i (s1 - p_i(s1)) + tau0 (s1 - s0) / dt = target`` with
+    the arms on the exact linear-path update from ``p0`` (``E``, ``omE``,
+    ``phi`` the coefficients for ``dt``, ``tau0_dt = tau0 / dt``); writes the
+    arms to ``prow`` and returns ``s1``. Like :func:`_relax`, with a target
+    stress instead of zero.
+    """
+    num = target + tau0_dt * s0
+    den = tau0_dt + 1.0
+    for i in range(g.shape[0]):
+        num += g[i] * (E[i] * p0[i] + (omE[i] - phi[i]) * s0)
+        den += g[i] * (1.0 - phi[i])
+    s1 = num / den
+    for i in range(g.shape[0]):
+        prow[i] = E[i] * p0[i] + omE[i] * s0 + phi[i] * (s1 - s0)
+    return s1

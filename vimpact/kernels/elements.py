@@ -53,19 +53,20 @@ from typing import NamedTuple
 import numpy as np
 from numba import prange
 
-from vimpact.kernels.arms import _follow, _follow_over, _free_rate, _relax, arm_coefficients
+from vimpact.kernels.arms import (_arm_coefficient, _follow, _follow_over, _free_rate, _relax,
+                                  _to_stress, arm_coefficients)
 from vimpact.kernels.jit import jit
 from vimpact.kernels.layout import (  # noqa: F401 - re-exported: the kernels' common layout
     ELEMENT_STIFFNESS, EULER, N_OUT, N_REC, OUT_B_MAX, OUT_N_REC, OUT_STATUS, OUT_STEPS,
-    OUT_T_CONTACT, OUT_U_MAX, OUT_VC_END, OUT_VZ_END, REC_B, REC_FX, REC_FZ, REC_T, REC_U, REC_V,
-    REC_VC, STATUS_NON_FINITE, STATUS_OK, STATUS_ROW_EXCEEDED, STATUS_TIME_LIMIT, SYMPLECTIC_EULER,
+    OUT_T_CONTACT, OUT_T_GROSS_SLIP, OUT_U_MAX, OUT_VC_END, OUT_VZ_END, OUT_W_FRICTION, REC_B,
+    REC_FX, REC_FZ, REC_SLIP, REC_T, REC_U, REC_V, REC_VC, STATUS_NON_FINITE, STATUS_OK, STATUS_ROW_EXCEEDED, STATUS_TIME_LIMIT, SYMPLECTIC_EULER,
     VERLET, _record)
 
 
 
 @jit(inline="always")
-def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT,
-            tau0, g, tau, kappa, mu_t, h, n_elem, dxi, max_steps, rec, rec_every, out):
+def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT, FRICTION,
+            tau0, g, tau, kappa, mu_t, mu_k, h, n_elem, dxi, max_steps, rec, rec_every, out):
     """Advance one impact to its end and write the results into ``out``.
 
     The first five arguments are the compile-time effects (constants in the
@@ -79,10 +80,15 @@ def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT,
     INTEGRATOR : ``EULER``, ``SYMPLECTIC_EULER`` or ``VERLET``
     ARMS : the material has Maxwell arms (``g``, ``tau`` non-empty)
     DASHPOT : the material has a parallel dashpot (``tau0 > 0``)
+    FRICTION : Coulomb friction: every element in contact keeps
+        ``|f_t| <= mu f_n`` (PHYSICS.md section 12); needs ``TANGENTIAL`` and
+        incremental memory
     tau0 : parallel dashpot time ``eta0 / (G_inf T)``
     g, tau : arm moduli ``G_i / G_inf`` and times ``tau_i / T`` (1-D, equal length)
     kappa : ``c_t / c_n``
     mu_t : inverse effective tangential mass times m: ``1 + m R^2 / Theta``
+    mu_k : friction coefficient in kernel units, ``mu v_z0 / |v_c0|`` (read
+        only with ``FRICTION``; ``inf`` sticks)
     h : time step / T
     n_elem, dxi : elements in the half row and their spacing / a_H
     max_steps : time limit in steps
@@ -114,6 +120,16 @@ def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT,
     p = np.zeros((n_t, n_arms))
     contact = np.zeros(n_elem, dtype=np.bool_)
     f = np.zeros(n_elem)  # last normal force of each element in contact / (k_el)
+    FRIC = FRICTION and TANGENTIAL
+    n_af = n_arms if FRIC else 0
+    p_save = np.empty(n_af)  # arms of a slip candidate before the stick trial
+    E_e = np.empty(n_af)  # arm coefficients over the in-contact part of an entering step
+    omE_e = np.empty(n_af)
+    phi_e = np.empty(n_af)
+    Cs = 0.0  # slipping elements: tangential force per unit normal velocity (mu f_n's dashpot)
+    t_gross = 0.0
+    w_fric = 0.0
+    slip_now = 0.0
 
     u = 0.0
     v = 1.0
@@ -146,14 +162,18 @@ def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT,
         vc_test = 0.0
         duc = 0.0
         if TANGENTIAL:
+            Ft_pos = Ft_el
+            if FRIC and DASHPOT:  # slipping elements: mu times their normal force, whose
+                # dashpot part takes this step's normal velocity (as the normal kick)
+                Ft_pos = Ft_el + Cs * (v if INTEGRATOR == EULER else v_test)
             if INTEGRATOR == EULER:
-                vc_test = vc - h * mu_t * (Ft_el + Ct * vc)
+                vc_test = vc - h * mu_t * (Ft_pos + Ct * vc)
                 duc = h * vc
             elif INTEGRATOR == SYMPLECTIC_EULER:
-                vc_test = (vc - h * mu_t * Ft_el) / (1.0 + h * mu_t * Ct)
+                vc_test = (vc - h * mu_t * Ft_pos) / (1.0 + h * mu_t * Ct)
                 duc = h * vc_test
             else:
-                vc_test = (vc - 0.5 * h * mu_t * Ft_el) / (1.0 + 0.5 * h * mu_t * Ct)
+                vc_test = (vc - 0.5 * h * mu_t * Ft_pos) / (1.0 + 0.5 * h * mu_t * Ct)
                 duc = h * vc_test
         uc1 = uc + duc
         # ---- elements ----
@@ -163,6 +183,10 @@ def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT,
         sum_rt = 0.0
         t_leave = 0.0
         n_c = 0
+        n_stick = 0
+        n_slip = 0
+        sum_slip_r = 0.0  # sum of sign * (normal spring part) over slipping elements
+        sum_slip_sign = 0.0
         j_outer = -1
         for j in range(active):
             w0 = w[j]
@@ -205,7 +229,7 @@ def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT,
             n_c += 1
             j_outer = j
             sum_r += r
-            if TANGENTIAL:
+            if TANGENTIAL and not FRIC:
                 s0 = s[j]
                 if MEMORY == 1:  # seed: total displacement of the contact point
                     s1 = uc1
@@ -221,23 +245,73 @@ def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT,
                     else:
                         sum_rt += _follow_over(s0, s1, p[j], g, tau, theta * h)
                 s[j] = s1
+            if FRIC:  # stick trial, then return to the cone |f_t| <= mu f_n
+                s0 = s[j]
+                s1 = s0 + duc if was_in else s0 + duc * theta
+                for i in range(n_af):
+                    p_save[i] = p[j, i]
+                fol = 0.0
+                if ARMS:
+                    if was_in:
+                        fol = _follow(s0, s1, p[j], g, E, omE, phi)
+                    else:
+                        fol = _follow_over(s0, s1, p[j], g, tau, theta * h)
+                trial = s1 + fol
+                if DASHPOT:
+                    trial += c0 * vc_test
+                cone = mu_k * fj / kappa  # element stress at the cone, tangential units
+                if abs(trial) <= cone:  # stick (always for mu = inf)
+                    sum_rt += s1
+                    sum_rt += fol
+                    n_stick += 1
+                    s[j] = s1
+                else:  # slip: the element's own path s0 -> s_slip puts it on the cone
+                    target = math.copysign(cone, trial)
+                    dt = h if was_in else max(theta, 1e-12) * h
+                    if ARMS:
+                        if was_in:
+                            s_slip = _to_stress(target, s0, p_save, p[j], g, E, omE, phi, c0 / dt)
+                        else:
+                            for i in range(n_af):
+                                E_e[i], omE_e[i], phi_e[i] = _arm_coefficient(tau[i], dt)
+                            s_slip = _to_stress(target, s0, p_save, p[j], g, E_e, omE_e, phi_e,
+                                                c0 / dt)
+                    else:
+                        s_slip = (target + c0 / dt * s0) / (1.0 + c0 / dt)
+                    w_fric += k_el * kappa * target * (s1 - s_slip)
+                    s[j] = s_slip
+                    sgn = math.copysign(1.0, trial)
+                    sum_slip_r += sgn * r
+                    sum_slip_sign += sgn
+                    n_slip += 1
         if n_c == 0 and t_leave > 0.0:
             t_exit = t_leave  # the last elements left within this step
         F_el1 = k_el * sum_r
         C1 = k_el * c0 * n_c
         Ft_el1 = k_el * kappa * sum_rt
         Ct1 = k_el * kappa * c0 * n_c
+        Cs1 = 0.0
+        if FRIC:
+            Ct1 = k_el * kappa * c0 * n_stick
+            if n_slip > 0:  # (mu_k may be inf: only slipping elements carry it)
+                Ft_el1 += mu_k * k_el * sum_slip_r
+                Cs1 = mu_k * k_el * c0 * sum_slip_sign
+            if n_slip == n_c and n_c > 0:
+                t_gross += h
+            slip_now = n_slip * dxi
         # ---- sphere: second half ----
         if INTEGRATOR == VERLET:
             v = v_test - 0.5 * h * (F_el1 + C1 * v_test)
-            if TANGENTIAL:
+            if FRIC and DASHPOT:
+                vc = vc_test - 0.5 * h * mu_t * (Ft_el1 + Ct1 * vc_test + Cs1 * v_test)
+            elif TANGENTIAL:
                 vc = vc_test - 0.5 * h * mu_t * (Ft_el1 + Ct1 * vc_test)
         else:
             v = v_test
             vc = vc_test
         u = u1
         uc = uc1
-        F_el, C, Ft_el, Ct = F_el1, C1, Ft_el1, Ct1
+        F_el, C, Ft_el, Ct, Cs = F_el1, C1, Ft_el1, Ct1, Cs1
         step += 1
         t = step * h
         if not (math.isfinite(u) and math.isfinite(v) and math.isfinite(vc)):
@@ -249,7 +323,10 @@ def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT,
         if j_outer > j_outer_max:
             j_outer_max = j_outer
         if n_rec > 0 and step % rec_every == 0:
-            i_rec = _record(rec, i_rec, t, u, v, vc, F_el + C * v, Ft_el + Ct * vc, b_now)
+            i_before = i_rec
+            i_rec = _record(rec, i_rec, t, u, v, vc, F_el + C * v, Ft_el + Ct * vc + Cs * v, b_now)
+            if i_rec > i_before:
+                rec[i_before, REC_SLIP] = slip_now
         if j_outer_max >= n_elem - 1:
             status = STATUS_ROW_EXCEEDED
             break
@@ -266,7 +343,9 @@ def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT,
                 break
     # a final record marks the end state (overwriting the last row if full)
     if n_rec > 0:
-        i_rec = _record(rec, min(i_rec, n_rec - 1), step * h, u, v, vc, F_el + C * v, Ft_el + Ct * vc, b_now)
+        i_last = min(i_rec, n_rec - 1)
+        i_rec = _record(rec, i_last, step * h, u, v, vc, F_el + C * v, Ft_el + Ct * vc + Cs * v, b_now)
+        rec[i_last, REC_SLIP] = slip_now
     out[OUT_VZ_END] = v
     out[OUT_VC_END] = vc  # stays 0 without tangential motion
     out[OUT_T_CONTACT] = t_exit
@@ -275,6 +354,8 @@ def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT,
     out[OUT_STATUS] = status
     out[OUT_STEPS] = step
     out[OUT_N_REC] = i_rec
+    out[OUT_T_GROSS_SLIP] = t_gross
+    out[OUT_W_FRICTION] = w_fric
 
 
 class KernelSpec(NamedTuple):
@@ -313,14 +394,19 @@ def element_kernel(spec: KernelSpec):
     """
     # plain Python constants in the closure: numba freezes them, LLVM folds the branches
     integrator, tangential, memory = int(spec.integrator), bool(spec.tangential), int(spec.memory)
-    arms, dashpot = bool(spec.arms), bool(spec.dashpot)
+    arms, dashpot, friction = bool(spec.arms), bool(spec.dashpot), bool(spec.friction)
+    if friction and tangential and memory != 0:
+        raise ValueError(f"KernelSpec(memory={memory}, friction=True) is not supported: Coulomb "
+                         "friction needs incremental memory (0); the seed memory sets every "
+                         "element to the total contact-point displacement, which slip cannot "
+                         "change")
 
     @jit(parallel=True)
     def run(tau0, g, tau, n_arms, kappa, mu_t, mu, h, n_elem, dxi, max_steps, rec, rec_every, out):
         for i in prange(tau0.shape[0]):
             k = n_arms[i]
-            _impact(tangential, memory, integrator, arms, dashpot, tau0[i], g[i, :k],
-                    tau[i, :k], kappa[i], mu_t[i], h[i], n_elem[i], dxi[i], max_steps[i],
+            _impact(tangential, memory, integrator, arms, dashpot, friction, tau0[i], g[i, :k],
+                    tau[i, :k], kappa[i], mu_t[i], mu[i], h[i], n_elem[i], dxi[i], max_steps[i],
                     rec[i], rec_every, out[i])
 
     return run

@@ -30,11 +30,21 @@ OUT_B_MAX = 4  # maximum contact half-width / a_H
 OUT_STATUS = 5
 OUT_STEPS = 6  # time steps taken
 OUT_N_REC = 7  # trajectory rows written
-N_OUT = 8
+# Coulomb friction (element kernels with KernelSpec.friction; 0 in every other kernel):
+OUT_T_GROSS_SLIP = 8  # time with gross slip (contact non-empty, every element in it slipping) / T
+# energy dissipated by slip, sum over slipping elements of f_t * (slip increment),
+# in units of m v_c0^2 (m the sphere's mass, v_c0 the initial contact-point speed);
+# the tangential kinetic energy at the start is 1/2 m v_c0^2 / mu_t (mu_t = 1 + m R^2/Theta)
+OUT_W_FRICTION = 9
+N_OUT = 10
 
 # columns of a trajectory record
 REC_T, REC_U, REC_V, REC_VC, REC_FZ, REC_FX, REC_B = range(7)
-N_REC = 7
+# slip-zone width / a_H: slipping elements of the half row times their spacing
+# (the annulus b - c of a stick core c); written by the element kernels after
+# _record (0 without friction), left untouched by the continuum kernels
+REC_SLIP = 7
+N_REC = 8
 
 #: Element stiffness per unit length in kernel units (both halves of the row counted by the caller).
 ELEMENT_STIFFNESS = 15.0 / 16.0
