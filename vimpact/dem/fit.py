@@ -1,0 +1,181 @@
+"""vimpact's restitution curves of each contact, and DEM constants fitted to them.
+
+The targets are ``e_z(v)`` (normal impacts, every size level of the contact)
+and, for codes with a tangential restitution, ``beta_x(v)`` (full stick,
+``v_c0 = v_z0``; under stick ``beta_x`` does not depend on ``v_c0``). A fit
+runs the code's own law (:mod:`vimpact.dem.laws`) with the candidate
+constants at the same points and minimizes the RMS difference; its residual
+is reported as it is, never tuned away.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.optimize import minimize_scalar
+
+from vimpact.dem import laws
+from vimpact.dem.problem import Contact, DemProblem
+from vimpact.model.pair import pair_restitution
+
+
+@dataclass
+class Targets:
+    """vimpact's curves of one contact, flattened over (size level, speed).
+
+    Attributes
+    ----------
+    contact : the contact
+    v : approach speeds, m/s; ``level`` : size level index of each point
+    R, m : effective radius (m) and mass (kg) at each point
+    e_z : normal restitution; ``beta_x`` : tangential (full stick), or ``None``
+    t_contact : contact time, s; ``status`` : engine status of each point
+    """
+
+    contact: Contact
+    v: np.ndarray
+    level: np.ndarray
+    R: np.ndarray
+    m: np.ndarray
+    e_z: np.ndarray
+    beta_x: np.ndarray | None
+    t_contact: np.ndarray
+    status: np.ndarray
+
+    @property
+    def nominal(self) -> np.ndarray:
+        """Mask of the points at the nominal size level."""
+        return self.level == (int(self.level.max()) + 1) // 2 if self.level.size else self.level
+
+
+def compute_targets(problem: DemProblem, contact: Contact, *, tangential: bool = False,
+                    numerics=None) -> Targets:
+    """Run vimpact for ``contact`` at every size level and speed of ``problem``."""
+    from vimpact.model.numerics import Numerics
+
+    numerics = numerics or Numerics.preset("fast")
+    parts = []
+    for k, (b1, b2) in enumerate(contact.levels()):
+        R, m = contact.effective((b1, b2))
+        df = pair_restitution(b1, b2, problem.speeds, numerics=numerics)
+        beta = (pair_restitution(b1, b2, problem.speeds, tangential=True, numerics=numerics)
+                ["beta_x"].to_numpy(dtype=float) if tangential else None)
+        parts.append((k, R, m, df, beta))
+    n = problem.speeds.size
+    cat = np.concatenate
+    e_z = cat([p[3]["e_z"].to_numpy(dtype=float) for p in parts])
+    if not np.all(np.isfinite(e_z)):
+        bad = cat([p[3]["status"].to_numpy(dtype=str) for p in parts])[~np.isfinite(e_z)]
+        raise ValueError(f"contact {contact.key}: vimpact gave no e_z at some speeds "
+                         f"(status {sorted(set(bad))}); narrow the speed range")
+    return Targets(
+        contact=contact,
+        v=np.tile(problem.speeds, len(parts)),
+        level=np.repeat(np.arange(len(parts)), n),
+        R=np.repeat([p[1] for p in parts], n),
+        m=np.repeat([p[2] for p in parts], n),
+        e_z=e_z,
+        beta_x=cat([p[4] for p in parts]) if tangential else None,
+        t_contact=cat([p[3]["t_contact"].to_numpy(dtype=float) for p in parts]),
+        status=cat([p[3]["status"].to_numpy(dtype=str) for p in parts]),
+    )
+
+
+@dataclass
+class Residual:
+    """Difference ``code - vimpact`` over the fitted points (dimensionless)."""
+
+    max_abs: float
+    rms: float
+
+    @classmethod
+    def of(cls, predicted, target) -> "Residual":
+        d = np.asarray(predicted, dtype=float) - np.asarray(target, dtype=float)
+        return cls(float(np.max(np.abs(d))), float(np.sqrt(np.mean(d * d))))
+
+    def __str__(self) -> str:
+        return f"max {self.max_abs:.2e}, RMS {self.rms:.2e}"
+
+
+@dataclass
+class ContactFit:
+    """A code's constants for one contact and what the code will produce with them.
+
+    Attributes
+    ----------
+    contact : the contact; ``params`` : the exported constants (name -> value, SI)
+    e_z : restitution the code's law gives at the target points with ``params``
+    beta_x : likewise for the tangential restitution, or ``None`` if not represented
+    res_e_z, res_beta_x : residuals against vimpact (``None`` if not represented)
+    notes : what the code cannot represent, conventions applied
+    """
+
+    contact: Contact
+    params: dict
+    e_z: np.ndarray
+    beta_x: np.ndarray | None = None
+    res_e_z: Residual | None = None
+    res_beta_x: Residual | None = None
+    notes: list[str] = field(default_factory=list)
+
+
+def fit_constant(target: np.ndarray, lo: float = 0.0, hi: float = 1.0) -> tuple[float, Residual]:
+    """The constant closest to ``target`` in RMS (its mean), clipped to ``[lo, hi]``."""
+    c = float(np.clip(np.mean(target), lo, hi))
+    return c, Residual.of(np.full_like(target, c), target)
+
+
+def fit_viscoelastic_hertz(t: Targets, E_star: float, mass_factor: np.ndarray | None = None,
+                           clipped: bool = True) -> tuple[float, np.ndarray]:
+    """Dissipation time ``A`` (s) of the viscoelastic Hertz law closest to ``t.e_z`` in RMS.
+
+    Parameters
+    ----------
+    t : the targets; ``E_star`` : the law's effective modulus, Pa
+    mass_factor : per point, the factor by which the code's effective ``A``
+        differs from the fitted one (LAMMPS scales its damping with ``m_eff``,
+        so a polydisperse contact has ``A m_eff / m_eff,nominal``); default 1
+
+    Returns
+    -------
+    (A, e) : the constant and the law's restitution at the target points
+    """
+    f = np.ones_like(t.v) if mass_factor is None else np.asarray(mass_factor, dtype=float)
+    d = laws.hertz_overlap(E_star, t.R, t.m, t.v)
+    unit = f * t.v / d  # alpha per unit A, 1/s
+
+    def predict(A: float) -> np.ndarray:
+        return laws.viscoelastic_hertz_curve(np.minimum(A * unit, 1e3), clipped)
+
+    # first-order guess from the small-damping slope, then a bounded search in log A
+    guess = float(np.median(np.maximum(1.0 - t.e_z, 1e-9) / laws.SMALL_DAMPING_SLOPE / unit))
+    lo, hi = math.log10(guess) - 3.0, min(math.log10(guess) + 3.0, math.log10(1e3 / unit.max()))
+
+    def cost(logA: float) -> float:
+        r = predict(10.0**logA) - t.e_z
+        return float(np.mean(r * r))
+
+    best = minimize_scalar(cost, bounds=(lo, hi), method="bounded",
+                           options={"xatol": 1e-9, "maxiter": 500})
+    A = 10.0**best.x
+    return A, predict(A)
+
+
+def linear_tangential_beta(en: float, et_like: tuple[float, float]) -> float:
+    """``beta`` of a linear spring-dashpot contact that ends at zero overlap with
+    normal restitution ``en`` and tangential oscillator ``(w_t/omega0, zeta_t)``."""
+    return laws.linear_spring_dashpot(laws.zeta_of_restitution(en), "overlap", et_like)[1]
+
+
+def fit_scalar(predict, target: np.ndarray, lo: float, hi: float) -> tuple[float, np.ndarray]:
+    """One constant ``p`` in ``[lo, hi]`` minimizing ``RMS(predict(p) - target)``."""
+
+    def cost(p: float) -> float:
+        r = np.asarray(predict(p)) - target
+        return float(np.mean(r * r))
+
+    best = minimize_scalar(cost, bounds=(lo, hi), method="bounded",
+                           options={"xatol": 1e-10, "maxiter": 500})
+    return float(best.x), np.asarray(predict(best.x), dtype=float)
