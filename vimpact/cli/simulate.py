@@ -6,6 +6,7 @@ import argparse
 import dataclasses
 import json
 import math
+import os
 from pathlib import Path
 
 from vimpact import __version__
@@ -15,7 +16,8 @@ from vimpact.engine.routing import choose_path
 from vimpact.engine.simulate import simulate
 from vimpact.model.material import MODELS
 from vimpact.model.numerics import INTEGRATORS, PRESETS, Numerics
-from vimpact.model.scene import TANGENTIAL_EFFECTS, TANGENTIAL_MEMORY, Scene
+from vimpact.model.scene import DEFAULT_THETA_RATIO, TANGENTIAL_EFFECTS, TANGENTIAL_MEMORY, Scene
+from vimpact.model.validation import InputError
 
 
 def add_parser(sub) -> argparse.ArgumentParser:
@@ -52,14 +54,18 @@ def add_parser(sub) -> argparse.ArgumentParser:
     g.add_argument("--Q2", type=float, metavar="Q2",
                    help="stiffness ratio G1/G2 of the standard solid, dimensionless, > 0 "
                         "(omit for Kelvin-Voigt)")
-    g.add_argument("--theta-ratio", type=float, default=0.4, metavar="RATIO",
-                   help="Theta / (m R^2), dimensionless (default 0.4, solid sphere)")
+    g.add_argument("--theta-ratio", type=float, default=None, metavar="RATIO",
+                   help="Theta / (m R^2), dimensionless (default 0.4, solid sphere; "
+                        "instead of --Theta)")
     g = sim.add_argument_group("effects")
     g.add_argument("--tangential", choices=TANGENTIAL_EFFECTS, default=None,
                    help="tangential problem: auto (default: full stick when v_c0 != 0), "
                         "stick, or none (normal impact only; e_x not computed)")
     g.add_argument("--no-rotation", action="store_true",
                    help="the sphere does not spin (Theta -> infinity)")
+    g.add_argument("--mu", type=float, default=None, metavar="MU",
+                   help="Coulomb friction coefficient, dimensionless, >= 0 (default: inf, "
+                        "full stick)")
     g.add_argument("--tangential-memory", choices=TANGENTIAL_MEMORY, default=None,
                    help="tangential element rule: incremental (default, passive) or seed "
                         "(thesis eq. 4.16, total displacement)")
@@ -91,13 +97,40 @@ def add_parser(sub) -> argparse.ArgumentParser:
 
 _PHYSICAL = ("E", "G", "eta", "G1", "G2", "prony", "R", "m", "Theta", "vz0", "model")
 _EFFECTS = {"tangential": "auto", "tangential_memory": "incremental"}
+#: Scene and Material parameter names -> the flag a user typed
+_FLAGS = {"v_z0": "--vz0", "v_x0": "--vx0", "omega0": "--omega0", "theta_ratio": "--theta-ratio",
+          "tangential_memory": "--tangential-memory", "G_inf": "--G", "eta0": "--eta",
+          "R": "--R", "m": "--m", "Theta": "--Theta", "mu": "--mu", "nu": "--nu", "Q1": "--Q1",
+          "Q2": "--Q2", "E": "--E", "G": "--G", "eta": "--eta", "G1": "--G1", "G2": "--G2"}
+
+
+def _as_flags(exc: ValueError) -> InputError:
+    """The error of a Scene/Material parameter, named by its command-line flag."""
+    text = str(exc)
+    name = text.split(" = ", 1)[0]
+    if name in _FLAGS:
+        text = _FLAGS[name] + text[len(name):]
+    return InputError(text)
 
 
 def scene_from_args(a) -> Scene:
-    """The scene described by parsed ``simulate`` options."""
+    """The scene described by parsed ``simulate`` options (errors name the flags)."""
+    try:
+        return _scene_from_args(a)
+    except InputError as exc:
+        raise _as_flags(exc) from None
+
+
+def _scene_from_args(a) -> Scene:
     effects = {k: getattr(a, k) if getattr(a, k) is not None else default
                for k, default in _EFFECTS.items()}
     effects["rotation"] = not a.no_rotation
+    if a.mu is not None:
+        effects["mu"] = a.mu
+    if a.Theta is not None and a.theta_ratio is not None:
+        raise InputError(f"--Theta = {a.Theta:g} cannot be combined with --theta-ratio = "
+                         f"{a.theta_ratio:g}: give one of them")
+    ratio = a.theta_ratio if a.theta_ratio is not None else DEFAULT_THETA_RATIO
     if a.Q1 is not None:
         given = [f"--{n}" for n in _PHYSICAL if getattr(a, n) is not None]
         given += [f"--{n}" for n in ("vx0", "omega0") if getattr(a, n) != 0.0]
@@ -106,7 +139,10 @@ def scene_from_args(a) -> Scene:
                              "a dimensionless scene (--Q1 [--Q2] --nu) or a physical one")
         if a.nu is None:
             raise missing("nu", "the Poisson ratio in [0, 0.5] is required")
-        return Scene.from_dimensionless(a.Q1, a.nu, a.Q2, theta_ratio=a.theta_ratio, **effects)
+        if a.Theta is not None:
+            raise InputError("--Theta cannot be combined with --Q1: the dimensionless scene "
+                             "takes --theta-ratio")
+        return Scene.from_dimensionless(a.Q1, a.nu, a.Q2, theta_ratio=ratio, **effects)
     if a.Q2 is not None:
         raise missing("Q1", "--Q2 is part of the dimensionless input --Q1 --Q2 --nu")
     material = material_from_args(a)
@@ -115,7 +151,7 @@ def scene_from_args(a) -> Scene:
         if getattr(a, name) is None:
             raise missing(name, f"the {what} is required (or use --Q1 --nu)")
     theta = a.Theta
-    if theta is None and a.theta_ratio != 0.4:
+    if theta is None and a.theta_ratio is not None:
         theta = a.theta_ratio * a.m * a.R**2
     return Scene(material, R=a.R, m=a.m, v_z0=a.vz0, v_x0=a.vx0, omega0=a.omega0, Theta=theta,
                  allow_large_contact=a.allow_large_contact, **effects)
@@ -128,7 +164,8 @@ def _scene_file(a) -> tuple[Scene, Numerics | None]:
     given = [f"--{n.replace('_', '-')}" for n in _PHYSICAL + ("Q1", "Q2", "nu") + tuple(_EFFECTS)
              if getattr(a, n) is not None]
     given += [f"--{n.replace('_', '-')}" for n, default in
-              (("vx0", 0.0), ("omega0", 0.0), ("theta_ratio", 0.4), ("no_rotation", False))
+              (("vx0", 0.0), ("omega0", 0.0), ("theta_ratio", None), ("mu", None),
+               ("no_rotation", False))
               if getattr(a, n) != default]
     if given:
         raise ValueError(f"{', '.join(given)} cannot be combined with --scene: the file "
@@ -157,10 +194,27 @@ def _numerics(a, base: Numerics | None = None) -> Numerics:
     return numerics.with_(**changes)
 
 
+def _check_output(flag: str, path: str, suffixes: tuple[str, ...]) -> Path:
+    """Refuse an output path before any work: wrong extension, a directory, a
+    missing or unwritable folder."""
+    out = Path(path)
+    if out.suffix.lower() not in suffixes:
+        raise InputError(f"{flag} = {path!r} is not allowed: must end in {' or '.join(suffixes)}")
+    if out.is_dir():
+        raise InputError(f"{flag} = {path!r} is not allowed: it is a directory")
+    folder = out.parent if str(out.parent) else Path(".")
+    if not folder.is_dir():
+        raise InputError(f"{flag} = {path!r} is not allowed: the folder {str(folder)!r} "
+                         "does not exist")
+    if not os.access(folder, os.W_OK) or (out.exists() and not os.access(out, os.W_OK)):
+        raise InputError(f"{flag} = {path!r} is not allowed: not writable")
+    return out
+
+
 def run(a) -> int:
-    if a.trajectory and Path(a.trajectory).suffix.lower() not in (".csv", ".parquet"):
-        raise ValueError(f"--trajectory = {a.trajectory!r} is not allowed: "
-                         "must end in .csv or .parquet")
+    """Handler of ``vimpact simulate``; returns the exit code."""
+    if a.trajectory:
+        _check_output("--trajectory", a.trajectory, (".csv", ".parquet"))
     if a.scene is not None:
         scene, file_numerics = _scene_file(a)
     else:
@@ -190,12 +244,18 @@ def _summary(scene: Scene, res) -> str:
     mat = scene.material
     lines = [f"vimpact {__version__}: {mat.model} half-space, nu = {mat.nu:g}, "
              f"tangential memory {scene.tangential_memory}"]
-    for key in ("e_z", "e_x", "beta_x", "energy_ratio", "Q1", "Q2", "t_contact", "t_hertz",
-                "u_max", "d_hertz", "a_max", "a_hertz", "v_z_end", "v_x_end", "omega_end"):
+    for key in ("e_z", "beta_x", "e_x", "mu_eff", "energy_ratio", "Q1", "Q2", "t_contact",
+                "t_hertz", "u_max", "d_hertz", "a_max", "a_hertz", "v_z_end", "v_x_end",
+                "omega_end", "rebound_angle"):
         value = getattr(res, key)
         unit = UNITS[key] if UNITS[key] != "1" else ""
         text = "undefined" if math.isnan(value) else f"{value:.6g}"
         lines.append(f"  {key:<13} {text:>12} {unit}")
     lines.append(f"  status        {res.status}: {STATUSES[res.status]}")
     lines.append(f"  path          {res.path} ({res.n_steps} steps)")
+    if res.error:
+        lines.append(f"  reason        {res.error}")
+    if scene.computes_tangential and mat.nu != 0.5:
+        lines.append("  note          the tangential MDR mapping is exact only at nu = 0.5 for a "
+                     "rigid sphere; at this nu beta_x is the thesis's approximation")
     return "\n".join(lines)

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass, field, fields
 
 import pandas as pd
 
@@ -25,9 +25,12 @@ UNITS = {
     "v_z_end": "m/s",
     "v_x_end": "m/s",
     "omega_end": "rad/s",
+    "mu_eff": "1",
+    "rebound_angle": "deg",
     "status": "",
     "n_steps": "1",
     "path": "",
+    "error": "",
 }
 
 #: Meaning of each status value.
@@ -40,14 +43,24 @@ STATUSES = {
     "time_limit": "the impact had not ended at the time limit (Numerics.max_time); outputs NaN",
     "row_exceeded": "the contact reached the end of the element row; outputs NaN",
     "non_finite": "the integration produced a non-finite value; outputs NaN",
-    "unstable": "the numerical solution gained energy (energy_ratio > 1 + 1e-6) although the "
-                "material and the incremental tangential rule are passive: the step was too "
-                "coarse for this scene; outputs NaN (refine: more steps or elements; "
-                "explicit Euler is exempt: it gains energy by construction)",
+    "unstable": "the numerical solution gained energy (the contact energy, normal plus the "
+                "contact point's effective tangential energy, rose above 1 + 1e-6 of its start) "
+                "although the material and the incremental tangential rule are passive: the "
+                "step was too coarse for this scene; outputs NaN (refine: more steps or "
+                "elements)",
+    "energy_gain": "finished, but explicit Euler gained energy (more than 1e-6 of the contact "
+                   "energy), as it does by construction: numbers kept as the thesis's integrator "
+                   "gives them, not converged (use verlet)",
+    "unresolved": "the contact lasted fewer time steps than the element path needs to resolve "
+                  "it (numerics.MIN_CONTACT_STEPS); outputs NaN (more steps, or the continuum path)",
+    "too_costly": "the element path would need more steps or elements than its cost bounds "
+                  "(numerics.MAX_STEPS_PER_T_H, MAX_ELEMENTS_IN_ROW) for this scene; outputs NaN "
+                  "(reason in the error column)",
+    "invalid": "the row's inputs are not a valid scene (reason in the error column); outputs NaN",
 }
 
 #: Statuses whose numbers are results (the others carry NaN).
-FINISHED = ("ok", "vc0_zero", "normal_only", "half_space")
+FINISHED = ("ok", "vc0_zero", "normal_only", "half_space", "energy_gain")
 
 
 @dataclass(frozen=True)
@@ -69,6 +82,9 @@ class ImpactResult:
         Q2 NaN unless a standard solid)
     v_z_end, v_x_end, omega_end : end velocities, m/s, m/s, rad/s (v_z > 0 into the half-space)
     status : see ``STATUSES``
+    mu_eff : impulse ratio ``|int F_x dt| / int F_z dt`` (NaN without tangential problem)
+    rebound_angle : angle of the centre's rebound velocity to the normal,
+        ``atan2(v_x_end, -v_z_end)``, degrees
     n_steps : time steps taken (element path) or accepted ODE steps (continuum path)
     path : the kernel that ran (:mod:`vimpact.engine.routing`), e.g. ``elements[verlet,dashpot]``
     trajectory : time series of the impact if asked for (``None`` otherwise)
@@ -93,13 +109,14 @@ class ImpactResult:
     status: str
     n_steps: int = 0
     path: str = ""
+    mu_eff: float = math.nan
+    rebound_angle: float = math.nan
+    error: str | None = None
     trajectory: pd.DataFrame | None = field(default=None, repr=False, compare=False)
 
     def to_dict(self) -> dict:
         """Outputs as a plain dict (NaN kept as float NaN; no trajectory)."""
-        d = asdict(self)
-        d.pop("trajectory")
-        return d
+        return {name: getattr(self, name) for name in RESULT_FIELDS}
 
     def to_json_dict(self) -> dict:
         """Outputs for JSON: NaN and inf become ``None`` (JSON null); units under ``"units"``."""
@@ -107,3 +124,8 @@ class ImpactResult:
              for k, v in self.to_dict().items()}
         d["units"] = dict(UNITS)
         return d
+
+
+#: Columns of :func:`vimpact.simulate_batch` (the fields of :class:`ImpactResult`
+#: without the trajectory), in order.
+RESULT_FIELDS = tuple(f.name for f in fields(ImpactResult) if f.name != "trajectory")

@@ -16,11 +16,13 @@ A scene names its effects (tangential problem or not, rotation, rheology);
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
-from vimpact.kernels.elements import EULER, KernelSpec
-from vimpact.model.hertz import HERTZ_TIME_FACTOR
+import numpy as np
+
+from vimpact.engine import discretization
+from vimpact.engine.columns import SceneColumns
+from vimpact.kernels.elements import KernelSpec
 from vimpact.model.numerics import INTEGRATORS, Numerics
 from vimpact.model.scene import TANGENTIAL_MEMORY, Scene
 
@@ -56,6 +58,8 @@ class Path:
             parts.append("arms")
         if sp.dashpot:
             parts.append("dashpot")
+        if sp.friction:
+            parts.append("friction")
         return f"elements[{','.join(parts)}]"
 
     def explain(self) -> str:
@@ -66,101 +70,111 @@ class Path:
 _INTEGRATOR_NAMES = {code: name for name, code in INTEGRATORS.items()}
 
 
+_INTEGRATOR_NAMES = {code: name for name, code in INTEGRATORS.items()}
+
+#: path of the Kelvin-Voigt/elastic normal-only continuum kernel
+CONTINUUM_KV = Path(CONTINUUM, None, ())
+
+
+@dataclass(frozen=True)
+class Routes:
+    """Which kernel runs each row of a batch.
+
+    Attributes
+    ----------
+    group : per row, the index of its path in ``paths`` (-1: invalid row, no kernel)
+    paths : the distinct paths of the batch (``reasons`` left empty: see :func:`choose_path`)
+    """
+
+    group: np.ndarray
+    paths: tuple[Path, ...]
+
+
+def route(cols: SceneColumns, numerics: Numerics) -> Routes:
+    """The cheapest kernel for every row of ``cols`` (vectorized; the one routing rule)."""
+    valid = cols.valid
+    tangential = cols.computes_tangential & valid
+    arms = cols.has_arms
+    dashpot = cols.eta0 > 0.0
+    friction = tangential & np.isfinite(cols.mu)
+    memory = np.where(tangential, cols.memory, 0)
+    continuum = ~arms & ~tangential & numerics.continuum
+    key = (continuum.astype(np.int64) << 5 | tangential << 4 | memory << 3 | arms << 2
+           | dashpot << 1 | friction)
+    key = np.where(valid, key, -1)
+    paths: list[Path] = []
+    group = np.full(len(cols), -1, dtype=np.int64)
+    for k in np.unique(key[key >= 0]):
+        rows = key == k
+        if k >> 5:
+            path = CONTINUUM_KV
+        else:
+            path = Path(ELEMENTS, KernelSpec(numerics.integrator_code, bool(k >> 4 & 1),
+                                             int(k >> 3 & 1), bool(k >> 2 & 1), bool(k >> 1 & 1),
+                                             bool(k & 1)), ())
+        group[rows] = len(paths)
+        paths.append(path)
+    return Routes(group, tuple(paths))
+
+
 def choose_path(scene: Scene, numerics: Numerics) -> Path:
-    """The cheapest kernel that computes everything ``scene`` asks for."""
+    """The kernel :func:`route` picks for ``scene``, with the reasons in words."""
+    cols = SceneColumns.from_scenes([scene])
+    routes = route(cols, numerics)
+    path = routes.paths[routes.group[0]]
     mat = scene.material
-    arms = any(G > 0.0 for G, _ in mat.arms)
-    dashpot = mat.eta0 > 0.0
+    arms, dashpot = bool(cols.has_arms[0]), mat.eta0 > 0.0
     tangential = scene.computes_tangential
     reasons = []
     if scene.tangential == "none":
         reasons.append("normal impact only (tangential = 'none'): no tangential state")
     elif scene.v_c0 == 0.0:
-        reasons.append("v_c0 = v_x0 + R omega0 = 0: no tangential force (PHYSICS.md 7), "
-                       "tangential work skipped")
+        reasons.append("v_c0 = v_x0 + R omega0 = 0: no tangential force, tangential work skipped")
     else:
         rot = (f"with rotation (Theta/(m R^2) = {scene.theta_ratio:.4g}, contact-point mass "
                f"factor {scene.contact_mass_factor:.4g})" if scene.rotation
                else "without rotation (Theta -> inf)")
-        reasons.append(f"tangential full stick, {scene.tangential_memory} memory, {rot}")
+        contact = ("full stick" if path.spec is None or not path.spec.friction
+                   else f"Coulomb friction mu = {scene.mu:g}")
+        reasons.append(f"tangential {contact}, {scene.tangential_memory} memory, {rot}")
     what = [("Maxwell arms" if arms else "no arm variables"),
             ("a parallel dashpot" if dashpot else "no dashpot term")]
     reasons.append(f"material {mat.model}: {what[0]}, {what[1]}")
-    if not arms and not tangential and numerics.continuum:
-        reasons.append("Kelvin-Voigt/elastic normal impact: closed-form continuum force "
-                       "(PHYSICS.md 5), 1-DOF ODE, adaptive Dormand-Prince 5(4) with event "
-                       f"location, rtol = {numerics.rtol:g}")
+    if path.spec is None:
+        reasons.append("Kelvin-Voigt/elastic normal impact: closed-form continuum force, 1-DOF "
+                       "ODE, adaptive Dormand-Prince 5(4) with event location, "
+                       f"rtol = {numerics.rtol:g}")
         return Path(CONTINUUM, None, tuple(reasons))
     if not arms and not tangential:
         reasons.append("continuum path switched off (Numerics.continuum = False)")
     else:
         need = [n for n, on in (("the tangential problem", tangential), ("Maxwell arms", arms)) if on]
         reasons.append(f"elements needed for {' and '.join(need)}")
-    spec = KernelSpec(numerics.integrator_code, tangential,
-                      TANGENTIAL_MEMORY.index(scene.tangential_memory) if tangential else 0,
-                      arms, dashpot)
-    ft, fe = refinement(scene, numerics, spec)
-    finer = f" (refined {ft:.3g}x for the stiffest mode)" if ft > 1.0 else ""
-    finer_e = f" (refined {fe:.3g}x: glassy contact is narrower)" if fe > 1.0 else ""
+    glassy = float(discretization.stiffness_ratio(cols)[0])
+    ft, fe = (float(x[0]) for x in discretization.refinement(
+        cols, numerics, np.array([tangential]), path.spec.integrator))
+    why_t = [f"glassy contact {glassy ** 0.4:.3g}x shorter"] if glassy > 1.0 else []
+    why_e = [f"glassy contact {glassy ** 0.2:.3g}x narrower"] if glassy > 1.0 else []
+    if fe > glassy ** 0.2 * (1.0 + 1e-12):
+        why_e.append("stiff tangential mode: finer for elements entering the contact")
+    if ft > glassy ** 0.4 * (1.0 + 1e-12):
+        why_t.append("stiffest mode and stability of the explicit terms")
+    finer = f" (refined {ft:.3g}x: {'; '.join(why_t)})" if ft > 1.0 else ""
+    finer_e = f" (refined {fe:.3g}x: {'; '.join(why_e)})" if fe > 1.0 else ""
     reasons.append(f"element kernel: {numerics.integrator}, {numerics.steps} steps per "
                    f"t_H{finer}, {numerics.elements} elements per a_H{finer_e}")
-    return Path(ELEMENTS, spec, tuple(reasons))
-
-
-#: ``kappa mu_t`` of a solid sphere (Theta = 2/5 m R^2) at nu = 0.5: the
-#: tangential stiffness the default numerics are calibrated on.
-SOLID_SPHERE_STIFFNESS = 2.0 / 3.0 * 3.5
-
-
-def stiffness_ratio(scene: Scene) -> float:
-    """How much stiffer than the relaxed modulus the half-space acts during the
-    contact, ``1 + sum g_i tau_i / (tau_i + t_H)`` (``g_i = G_i / G_inf``):
-    an arm whose time is long against the Hertz time is a spring, one whose
-    time is short relaxes away. Dimensionless, >= 1."""
-    mat, t_H = scene.material, scene.hertz.t_H
-    return 1.0 + sum(G / mat.G_inf * tau / (tau + t_H) for G, tau in mat.arms if G > 0.0)
+    return Path(ELEMENTS, path.spec, tuple(reasons))
 
 
 def refinement(scene: Scene, numerics: Numerics, spec: KernelSpec) -> tuple[float, float]:
-    """Factors (>= 1) by which the time step and the element spacing are made
-    finer than ``t_H / steps`` and ``a_H / elements``: the numerics resolve
-    the stiffest mode as well as they resolve a relaxed elastic impact.
+    """:func:`vimpact.engine.discretization.refinement` of one scene on the kernel ``spec``
+    (time-step and element-spacing factors, >= 1)."""
+    cols = SceneColumns.from_scenes([scene])
+    ft, fe = discretization.refinement(cols, numerics, np.array([bool(spec.tangential)]),
+                                       spec.integrator)
+    return float(ft[0]), float(fe[0])
 
-    - A glassy half-space (arms stiffer than the relaxed spring, with times
-      long against the contact) makes a Hertz contact of ``r =``
-      :func:`stiffness_ratio` times the modulus: ``r^(-2/5)`` times shorter
-      and ``r^(-1/5)`` times narrower. Steps and elements scale with it.
-    - Tangential problem: its oscillation is ``sqrt(kappa mu_t)`` times faster
-      than the normal one (``kappa = c_t / c_n``, ``mu_t`` the contact-point
-      mass factor), so the step resolves it as well (``Theta / (m R^2) =
-      1e-3`` gives about 26).
-    - Viscous terms that are explicit in part of the step (the dashpot under
-      explicit Euler; arms whose time is below the step, which act as
-      dashpots ``G_i tau_i``, under every integrator) keep ``h C <= 1`` with
-      the largest damping coefficient ``C`` the row can have.
-    - Stability of the explicit kicks: ``h omega <= 1/2`` for the stiffest
-      spring on the scale of one step (all arms slower than the step).
-    """
-    r = stiffness_ratio(scene)
-    time_factor, element_factor = r ** 0.4, r ** 0.2
-    mat, T = scene.material, scene.hertz.T
-    stiff_t = mat.kappa * scene.contact_mass_factor if spec.tangential else 0.0
-    if spec.tangential:
-        time_factor *= max(1.0, math.sqrt(stiff_t))
-        # a fast tangential oscillation also feels each element entering the
-        # contact: finer elements, measured to bring Theta/(m R^2) = 1e-3 within
-        # 5e-4 of a twice finer run (a heuristic exponent, not a derived one)
-        element_factor *= max(1.0, (stiff_t / SOLID_SPHERE_STIFFNESS) ** 0.25)
-    h = HERTZ_TIME_FACTOR / numerics.steps / time_factor  # / T
-    viscous = sum(G / mat.G_inf * tau / T for G, tau in mat.arms if tau / T < h)
-    if spec.integrator == EULER:
-        viscous += mat.dashpot_time / T
-    rate = 15.0 / 8.0 * viscous * numerics.row_width * max(1.0, stiff_t)  # / T
-    time_factor *= max(1.0, h * rate)
-    # stability margin of the explicit kicks: h omega <= 1/2 for the stiffest
-    # spring on the scale of one step (arms slower than the step are springs)
-    h = HERTZ_TIME_FACTOR / numerics.steps / time_factor
-    springs = 1.0 + sum(G / mat.G_inf for G, tau in mat.arms if tau / T >= h)
-    omega = math.sqrt(15.0 / 8.0 * numerics.row_width * springs * max(1.0, stiff_t))  # / T
-    time_factor *= max(1.0, 2.0 * h * omega)
-    return time_factor, element_factor
+
+def stiffness_ratio(scene: Scene) -> float:
+    """:func:`vimpact.engine.discretization.stiffness_ratio` of one scene, >= 1."""
+    return float(discretization.stiffness_ratio(SceneColumns.from_scenes([scene]))[0])

@@ -329,7 +329,7 @@ def kv_normal_impact(tau0, rtol, max_steps, rec, rec_every, out):
     """
     n_rec = rec.shape[0]
     i_rec = 0
-    out[OUT_VC_END] = 0.0
+    out[:] = 0.0  # every column of the row is written (those it does not compute stay 0)
     if not (tau0 >= 0.0 and math.isfinite(tau0)):
         out[OUT_VZ_END] = np.nan
         out[OUT_T_CONTACT] = np.nan

@@ -109,6 +109,15 @@ class Numerics:
 ERROR_MODEL = {"a": 0.176, "p": 1.0, "b": 3.11, "q": 2.0}
 #: Caps of :meth:`Numerics.for_tolerance` on the element path (about 0.3 s per impact).
 MAX_STEPS = 16000
+#: Fewest time steps an impact's contact may span on the element path; a
+#: shorter contact (heavy damping: the sphere bounces off a stiff dashpot
+#: within a few steps) is reported as status ``unresolved``, not as a number.
+MIN_CONTACT_STEPS = 20
+#: Cost bounds of one impact on the element path (after the automatic refinement
+#: for stiff modes): more is refused with status ``too_costly`` instead of running
+#: for hours. 1e7 steps per Hertz time is about a minute per impact.
+MAX_STEPS_PER_T_H = 1e7
+MAX_ELEMENTS_IN_ROW = 1e6
 MAX_ELEMENTS = 3200
 
 PRESETS = {

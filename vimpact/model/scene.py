@@ -3,11 +3,13 @@
 from __future__ import annotations
 
 import math
+
+import numpy as np
 from dataclasses import dataclass, field
 
 from vimpact.model.hertz import HertzScales, Q1_PER_TAU, effective_modulus, hertz_scales
 from vimpact.model.material import Material
-from vimpact.model.validation import finite, one_of, positive, require
+from vimpact.model.validation import InputError, finite, flag, friction_coefficient, one_of, positive, require
 
 TANGENTIAL_MEMORY = ("incremental", "seed")
 
@@ -16,6 +18,9 @@ TANGENTIAL_MEMORY = ("incremental", "seed")
 #: (normal impact only: no tangential state at all, e_x and beta_x NaN).
 #: Slip is not modelled yet.
 TANGENTIAL_EFFECTS = ("auto", "stick", "none")
+
+#: ``Theta / (m R^2)`` of a solid sphere, the default moment of inertia.
+DEFAULT_THETA_RATIO = 0.4
 
 #: The thesis's half-space limit: contact half-width at most this times R.
 HALF_SPACE_LIMIT = 0.2
@@ -43,6 +48,9 @@ class Scene:
     rotation : the sphere may spin (default). ``False`` is the limit
         ``Theta -> inf``: the tangential force changes ``v_x`` only and
         ``omega`` keeps ``omega0`` (``Theta`` is then not used)
+    mu : Coulomb friction coefficient, dimensionless, >= 0 (default ``inf``:
+        full stick, PHYSICS section 6; finite: every element obeys
+        ``|f_t| <= mu f_n``, section 12)
     """
 
     material: Material
@@ -56,28 +64,43 @@ class Scene:
     allow_large_contact: bool = False
     tangential: str = "auto"
     rotation: bool = True
+    mu: float = math.inf
     hertz: HertzScales = field(init=False, repr=False, compare=False)
 
     def __post_init__(self):
         require("material", self.material, isinstance(self.material, Material), "a vimpact.Material")
-        positive("R", self.R)
-        positive("m", self.m)
-        positive("v_z0", self.v_z0)
-        finite("v_x0", self.v_x0)
-        finite("omega0", self.omega0)
+        object.__setattr__(self, "R", positive("R", self.R))
+        object.__setattr__(self, "m", positive("m", self.m))
+        object.__setattr__(self, "v_z0", positive("v_z0", self.v_z0))
+        object.__setattr__(self, "v_x0", finite("v_x0", self.v_x0))
+        object.__setattr__(self, "omega0", finite("omega0", self.omega0))
         if self.Theta is None:
-            object.__setattr__(self, "Theta", 0.4 * self.m * self.R**2)
-        positive("Theta", self.Theta)
+            object.__setattr__(self, "Theta", DEFAULT_THETA_RATIO * self.m * self.R**2)
+        object.__setattr__(self, "Theta", positive("Theta", self.Theta))
         one_of("tangential_memory", self.tangential_memory, TANGENTIAL_MEMORY)
         one_of("tangential", self.tangential, TANGENTIAL_EFFECTS)
-        require("rotation", self.rotation, isinstance(self.rotation, bool), "True or False")
+        flag("rotation", self.rotation)
+        flag("allow_large_contact", self.allow_large_contact)
+        object.__setattr__(self, "mu", friction_coefficient("mu", self.mu))
         mat = self.material
-        object.__setattr__(self, "hertz", hertz_scales(mat.G_inf, mat.nu, self.R, self.m, self.v_z0))
+        with np.errstate(all="ignore"):
+            hz = hertz_scales(mat.G_inf, mat.nu, self.R, self.m, self.v_z0)
+            ratio = self.Theta / (self.m * self.R**2) if math.isfinite(self.R**2 * self.m) else 0.0
+        if not (all(math.isfinite(x) and x > 0.0 for x in hz) and ratio > 0.0
+                and math.isfinite(1.0 / ratio) and math.isfinite(mat.dashpot_time / hz.T)
+                and all(math.isfinite(tau / hz.T) and math.isfinite(G / mat.G_inf)
+                        for G, tau in mat.arms)):
+            raise InputError(
+                f"the scene (G_inf = {mat.G_inf:.3g} Pa, R = {self.R:.3g} m, m = {self.m:.3g} kg, "
+                f"v_z0 = {self.v_z0:.3g} m/s, Theta = {self.Theta:.3g} kg m^2) is not allowed: "
+                "its Hertz scales or dimensionless inputs leave the floating-point range")
+        object.__setattr__(self, "hertz", hz)
 
     @classmethod
     def from_dimensionless(cls, Q1: float, nu: float, Q2: float | None = None, *,
-                           theta_ratio: float = 0.4, tangential_memory: str = "incremental",
-                           tangential: str = "auto", rotation: bool = True) -> "Scene":
+                           theta_ratio: float = DEFAULT_THETA_RATIO,
+                           tangential_memory: str = "incremental", tangential: str = "auto",
+                           rotation: bool = True, mu: float = math.inf) -> "Scene":
         """A physical scene with the given dimensionless parameters.
 
         Kelvin-Voigt for ``Q2 = None``, standard solid otherwise. Restitution
@@ -102,7 +125,8 @@ class Scene:
             material = Material.standard_solid(nu=nu, G1=G, G2=G / Q2, eta=tau * G)
         return cls(material, R=R, m=m, v_z0=v_z0, v_x0=1.0, omega0=0.0,
                    Theta=positive("theta_ratio", theta_ratio) * m * R**2,
-                   tangential_memory=tangential_memory, tangential=tangential, rotation=rotation)
+                   tangential_memory=tangential_memory, tangential=tangential, rotation=rotation,
+                   mu=mu)
 
     # ---- derived quantities ------------------------------------------
     @property

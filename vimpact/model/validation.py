@@ -1,8 +1,17 @@
-"""Input checks with messages that name the parameter, its value and what is allowed."""
+"""Input checks with messages that name the parameter, its value and what is allowed.
+
+One set of rules (:data:`RULES`) serves both ways in: the scalar checks of the
+one-impact API (:func:`positive`, :func:`finite`, ...; they raise
+:class:`InputError`) and the vectorized checks of the batch path
+(:func:`check_column`; a bad row gets a reason, the others go on).
+"""
 
 from __future__ import annotations
 
 import math
+import numbers
+
+import numpy as np
 
 
 class InputError(ValueError):
@@ -13,48 +22,119 @@ class InputError(ValueError):
     """
 
 
+#: rule name -> (vectorized test on a float array, what is allowed)
+RULES = {
+    "finite": (lambda x: np.isfinite(x), "a finite number"),
+    "positive": (lambda x: np.isfinite(x) & (x > 0.0), "a finite number > 0"),
+    "non_negative": (lambda x: np.isfinite(x) & (x >= 0.0), "a finite number >= 0"),
+    "poisson_ratio": (lambda x: (x >= 0.0) & (x <= 0.5), "in [0, 0.5]"),
+    # a friction coefficient: >= 0, inf meaning full stick
+    "friction": (lambda x: (x >= 0.0) & ~np.isnan(x), "a number >= 0 (inf: full stick)"),
+}
+
+
+def message(name: str, value, allowed: str) -> str:
+    """The one wording of every input error."""
+    return f"{name} = {value!r} is not allowed: must be {allowed}"
+
+
 def require(name: str, value, ok: bool, allowed: str) -> None:
-    """Raise ``ValueError("name = value: must be allowed")`` unless ``ok``."""
+    """Raise :class:`InputError` naming ``name``, ``value`` and ``allowed`` unless ``ok``."""
     if not ok:
-        raise InputError(f"{name} = {value!r} is not allowed: must be {allowed}")
+        raise InputError(message(name, value, allowed))
+
+
+def _check(rule: str, name: str, value) -> float:
+    x = _number(name, value)
+    test, allowed = RULES[rule]
+    require(name, value, bool(test(np.float64(x))), allowed)
+    return x
 
 
 def positive(name: str, value) -> float:
     """``value`` as a float, finite and > 0."""
-    x = _number(name, value)
-    require(name, value, math.isfinite(x) and x > 0.0, "a finite number > 0")
-    return x
+    return _check("positive", name, value)
 
 
 def non_negative(name: str, value) -> float:
     """``value`` as a float, finite and >= 0."""
-    x = _number(name, value)
-    require(name, value, math.isfinite(x) and x >= 0.0, "a finite number >= 0")
-    return x
+    return _check("non_negative", name, value)
 
 
 def finite(name: str, value) -> float:
     """``value`` as a finite float."""
-    x = _number(name, value)
-    require(name, value, math.isfinite(x), "a finite number")
-    return x
+    return _check("finite", name, value)
 
 
 def poisson_ratio(name: str, value) -> float:
     """Poisson ratio in [0, 0.5]."""
-    x = _number(name, value)
-    require(name, value, 0.0 <= x <= 0.5, "in [0, 0.5]")
-    return x
+    return _check("poisson_ratio", name, value)
+
+
+def friction_coefficient(name: str, value) -> float:
+    """Coulomb friction coefficient, >= 0 (``inf``: full stick)."""
+    return _check("friction", name, value)
 
 
 def one_of(name: str, value, choices) -> str:
     """``value`` must be one of ``choices``."""
-    require(name, value, value in choices, "one of " + ", ".join(map(repr, choices)))
+    require(name, value, isinstance(value, str) and value in choices,
+            "one of " + ", ".join(map(repr, choices)))
     return value
 
 
+def flag(name: str, value) -> bool:
+    """``value`` must be ``True`` or ``False``."""
+    require(name, value, isinstance(value, (bool, np.bool_)), "True or False")
+    return bool(value)
+
+
 def _number(name: str, value) -> float:
+    """A real number (not a string, not a bool) as a float."""
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
+        raise InputError(message(name, value, "a number"))
     try:
         return float(value)
-    except (TypeError, ValueError):
-        raise InputError(f"{name} = {value!r} is not allowed: must be a number") from None
+    except OverflowError:  # an int beyond the float range
+        raise InputError(message(name, value, "a finite number")) from None
+
+
+def check_column(name: str, values, rule: str, reasons: np.ndarray) -> np.ndarray:
+    """Vectorized check of one input column.
+
+    Parameters
+    ----------
+    name : column name, used in the reasons
+    values : array-like of the column (numbers; anything else is a bad row)
+    rule : a key of :data:`RULES`
+    reasons : object array of the batch, ``None`` for a good row so far; the
+        first reason of a bad row is written here (later checks keep it)
+
+    Returns
+    -------
+    The column as float64, with NaN where the row is bad.
+    """
+    raw = np.asarray(values)
+    if raw.dtype.kind in "fiu":
+        x = raw.astype(np.float64)
+    else:  # object, strings, bools: element by element (rare)
+        x = np.array([_float_or_nan(v) for v in raw.ravel()], dtype=np.float64)
+    test, allowed = RULES[rule]
+    with np.errstate(invalid="ignore"):
+        bad = ~test(x)
+    if raw.dtype.kind == "b":
+        bad[:] = True
+    for i in np.flatnonzero(bad & np.equal(reasons, None)):
+        reasons[i] = message(name, raw.ravel()[i].item() if hasattr(raw.ravel()[i], "item")
+                             else raw.ravel()[i], allowed if raw.dtype.kind != "b" else "a number")
+    x[bad] = np.nan
+    return x
+
+
+def _float_or_nan(v) -> float:
+    if isinstance(v, (bool, np.bool_)) or not isinstance(v, numbers.Real):
+        return math.nan
+    try:
+        return float(v)
+    except OverflowError:
+        return math.nan

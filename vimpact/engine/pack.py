@@ -1,0 +1,82 @@
+"""Scene columns to kernel arrays (kernel units), and the kernel calls.
+
+Units (:mod:`vimpact.kernels.elements`): times in units of ``T = d / v_z0``,
+moduli relative to ``G_inf``, lengths in ``d`` (normal) and ``a_H``
+(positions); tangential quantities in units of ``v_c0``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from vimpact.engine import discretization
+from vimpact.engine.columns import SceneColumns
+from vimpact.engine.routing import Path
+from vimpact.kernels import continuum_kv
+from vimpact.kernels import layout
+from vimpact.kernels.elements import KernelSpec, element_kernel
+from vimpact.model.numerics import Numerics
+
+#: Accepted steps of the adaptive continuum path at most (it needs tens to hundreds).
+CONTINUUM_MAX_STEPS = 1_000_000
+
+
+def element_arrays(cols: SceneColumns, numerics: Numerics, spec: KernelSpec) -> dict[str, np.ndarray]:
+    """Kernel inputs of ``cols`` (all rows on the element kernel ``spec``) as arrays.
+
+    ``tau0`` dashpot time, ``g``/``tau`` the arms (``(n, max_arms)``, the real
+    arms of a row first, ``n_arms`` of them), ``kappa``, ``mu_t`` contact-point
+    mass factor, ``mu`` friction in tangential units (``mu v_z0 / |v_c0|``),
+    ``h`` step, ``n_elem``/``dxi`` the half row, ``max_steps`` the time limit.
+    """
+    n = len(cols)
+    tangential = np.full(n, bool(spec.tangential))
+    real = cols.G_arm > 0.0
+    n_arms = real.sum(axis=1).astype(np.int64)
+    width = int(n_arms.max(initial=0)) if spec.arms else 0
+    g = np.zeros((n, width))
+    tau = np.zeros((n, width))
+    if width:
+        order = np.argsort(~real, axis=1, kind="stable")[:, :width]  # real arms first
+        g = np.take_along_axis(cols.G_arm, order, axis=1) / cols.G_inf[:, None]
+        tau = np.take_along_axis(cols.tau_arm, order, axis=1) / cols.T[:, None]
+        tau = np.where(np.take_along_axis(real, order, axis=1), tau, 1.0)
+    with np.errstate(divide="ignore"):
+        mu = np.where(np.isfinite(cols.mu), cols.mu * cols.v_z0 / np.abs(cols.v_c0), np.inf)
+    a = {
+        "tau0": cols.dashpot_time / cols.T,
+        "g": np.ascontiguousarray(g),
+        "tau": np.ascontiguousarray(tau),
+        "n_arms": n_arms if spec.arms else np.zeros(n, dtype=np.int64),
+        "kappa": cols.kappa,
+        "mu_t": cols.contact_mass_factor,
+        "mu": mu,
+    }
+    a.update(discretization.element_row(cols, numerics, tangential, spec.integrator))
+    return a
+
+
+def run_path(path: Path, cols: SceneColumns, numerics: Numerics, rec: np.ndarray,
+             rec_every: int, out: np.ndarray, arrays: dict | None = None) -> None:
+    """Run the rows ``cols`` on ``path``, results into ``out`` (``(n, N_OUT)``) and
+    the trajectory buffer ``rec`` (``(n, n_rec, N_REC)``; ``n_rec`` may be 0).
+    ``arrays``: the element-kernel inputs if already made (:func:`element_arrays`)."""
+    if path.spec is None:
+        tau0 = cols.dashpot_time / cols.T
+        if rec.shape[1] == 0:
+            continuum_kv.kv_normal_batch(tau0, numerics.rtol, CONTINUUM_MAX_STEPS, out)
+            return
+        for i in range(len(cols)):
+            out[i, layout.OUT_N_REC] = continuum_kv.kv_normal_impact(
+                tau0[i], numerics.rtol, CONTINUUM_MAX_STEPS, rec[i], rec_every, out[i])
+        return
+    a = arrays if arrays is not None else element_arrays(cols, numerics, path.spec)
+    element_kernel(path.spec)(a["tau0"], a["g"], a["tau"], a["n_arms"], a["kappa"], a["mu_t"],
+                              a["mu"], a["h"], a["n_elem"], a["dxi"], a["max_steps"], rec,
+                              rec_every, out)
+
+
+def interleave(n: int, threads: int) -> np.ndarray:
+    """An order that hands every thread of a static ``prange`` split a mix of the
+    rows (neighbouring rows of a grid cost alike)."""
+    return np.concatenate([np.arange(k, n, threads) for k in range(threads)])

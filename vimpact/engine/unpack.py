@@ -1,0 +1,138 @@
+"""Kernel result rows to SI result columns, statuses and NaN guards, vectorized."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from vimpact.engine.columns import SceneColumns
+from vimpact.engine.result import FINISHED, RESULT_FIELDS
+from vimpact.kernels import layout
+from vimpact.model.numerics import MIN_CONTACT_STEPS
+from vimpact.model.scene import HALF_SPACE_LIMIT, TANGENTIAL_EFFECTS, TANGENTIAL_MEMORY
+
+#: kernel status code -> status name
+KERNEL_STATUSES = {
+    layout.STATUS_OK: "ok",
+    layout.STATUS_TIME_LIMIT: "time_limit",
+    layout.STATUS_ROW_EXCEEDED: "row_exceeded",
+    layout.STATUS_NON_FINITE: "non_finite",
+    layout.STATUS_ASSUMPTION: "non_finite",  # only reached if a hand-over failed
+}
+
+#: Energy a passive impact may gain from rounding and integration error
+#: (relative to the contact energy); more is status ``unstable`` (or
+#: ``energy_gain`` for explicit Euler, which gains energy by construction).
+PASSIVITY_SLACK = 1e-6
+
+#: Outputs that are numbers only with a status in ``FINISHED``.
+OUTPUTS = ("e_z", "e_x", "beta_x", "t_contact", "u_max", "a_max", "energy_ratio", "v_z_end",
+           "v_x_end", "omega_end", "mu_eff", "rebound_angle")
+#: Outputs that are NaN (by definition) without a tangential problem.
+TANGENTIAL_OUTPUTS = ("e_x", "beta_x", "mu_eff")
+
+
+def unpack(cols: SceneColumns, out: np.ndarray, path_names: np.ndarray, explicit_euler: np.ndarray,
+           steps_per_T: np.ndarray, refused: np.ndarray) -> dict[str, np.ndarray]:
+    """SI result columns (:data:`vimpact.engine.result.RESULT_FIELDS`) of kernel rows.
+
+    Parameters
+    ----------
+    cols : the scenes
+    out : ``(n, N_OUT)`` kernel rows (anything in invalid rows)
+    path_names : object array, the path of each row (``None`` for invalid rows)
+    explicit_euler : rows integrated by explicit Euler (energy gain expected)
+    steps_per_T : time steps per time unit ``T`` of each element-path row (0 on
+        continuum rows): with the contact time, how well the contact was resolved
+    refused : object array, why a valid row was not run (cost bounds), else ``None``
+    """
+    n = len(cols)
+    valid = cols.valid
+    kstatus = out[:, layout.OUT_STATUS].astype(np.int64)
+    status = np.full(n, "invalid", dtype=object)
+    ran = valid & np.equal(refused, None)
+    for code, name in KERNEL_STATUSES.items():
+        status[ran & (kstatus == code)] = name
+    status[valid & ~ran] = "too_costly"
+    ok = status == "ok"
+    tangential = cols.computes_tangential
+    v_z0, v_c0, mu_t = cols.v_z0, cols.v_c0, cols.contact_mass_factor
+    vz_end = out[:, layout.OUT_VZ_END]
+    vc_end = np.where(tangential, out[:, layout.OUT_VC_END], 1.0)  # / v_c0
+    with np.errstate(all="ignore"):
+        v_z_end = vz_end * v_z0
+        impulse = (1.0 - vc_end) / mu_t * v_c0  # tangential impulse / m, m/s
+        spin = np.where(cols.rotation, impulse * cols.m * cols.R / cols.Theta, 0.0)
+        v_x_end = cols.v_x0 - impulse
+        omega_end = cols.omega0 - spin
+        energy0 = 0.5 * (cols.m * (v_z0**2 + cols.v_x0**2) + cols.Theta * cols.omega0**2)
+        energy1 = 0.5 * (cols.m * (v_z_end**2 + v_x_end**2) + cols.Theta * omega_end**2)
+        # passivity of what the contact can exchange: the normal energy and the contact
+        # point's effective tangential energy m v_c^2 / (2 mu_t); a spin held fixed
+        # (rotation off) is outside it, so its work on the sphere cannot count as a gain
+        contact0 = v_z0**2 + v_c0**2 / mu_t
+        contact1 = v_z_end**2 + (vc_end * v_c0) ** 2 / mu_t
+        values = {
+            "e_z": np.abs(vz_end),
+            "e_x": np.where(tangential, np.abs(vc_end), np.nan),
+            "beta_x": np.where(tangential, -vc_end, np.nan),
+            "t_contact": out[:, layout.OUT_T_CONTACT] * cols.T,
+            "u_max": out[:, layout.OUT_U_MAX] * cols.d,
+            "a_max": out[:, layout.OUT_B_MAX] * cols.a_H,
+            "energy_ratio": energy1 / energy0,
+            "v_z_end": v_z_end, "v_x_end": v_x_end, "omega_end": omega_end,
+            "mu_eff": np.where(tangential, np.abs(impulse) / (v_z0 - v_z_end), np.nan),
+            "rebound_angle": np.degrees(np.arctan2(v_x_end, -v_z_end)),
+        }
+        gain = contact1 > contact0 * (1.0 + PASSIVITY_SLACK)
+        unresolved = out[:, layout.OUT_T_CONTACT] * steps_per_T < MIN_CONTACT_STEPS
+    incremental = cols.memory == TANGENTIAL_MEMORY.index("incremental")
+    status[ok & gain & incremental & ~explicit_euler] = "unstable"
+    status[ok & gain & incremental & explicit_euler] = "energy_gain"
+    status[ok & (steps_per_T > 0) & unresolved] = "unresolved"
+    ok = status == "ok"
+    status[ok & (values["a_max"] > HALF_SPACE_LIMIT * cols.R)] = "half_space"
+    ok = status == "ok"
+    status[ok & (cols.tangential == TANGENTIAL_EFFECTS.index("none"))] = "normal_only"
+    ok = status == "ok"
+    status[ok & (v_c0 == 0.0)] = "vc0_zero"
+    guard(values, status, tangential)
+    error = np.where(valid, refused, cols.reasons)
+    error = np.where(status == "non_finite", _nan_message(values, status, error), error)
+    with np.errstate(all="ignore"):
+        result = {
+            **values,
+            "t_hertz": cols.t_H, "d_hertz": cols.d, "a_hertz": cols.a_H,
+            "Q1": cols.Q1, "Q2": cols.Q2, "nu": cols.nu,
+            "status": status, "n_steps": out[:, layout.OUT_STEPS].astype(np.int64),
+            "path": path_names, "error": error,
+        }
+    for name in ("t_hertz", "d_hertz", "a_hertz", "Q1", "Q2", "nu"):
+        result[name] = np.where(valid, result[name], np.nan)
+    result["n_steps"] = np.where(valid, result["n_steps"], 0)
+    return {name: result[name] for name in RESULT_FIELDS}
+
+
+def guard(values: dict[str, np.ndarray], status: np.ndarray, tangential: np.ndarray) -> None:
+    """NaN only with a status that says why: outputs of a row whose status is not
+    finished become NaN; a finished row with an unexplained NaN or inf becomes
+    ``non_finite`` (all outputs NaN)."""
+    finished = np.isin(status, FINISHED)
+    bad = np.zeros(status.shape[0], dtype=bool)
+    for name, v in values.items():
+        unexplained = ~np.isfinite(v)
+        if name in TANGENTIAL_OUTPUTS:
+            unexplained &= tangential
+        bad |= finished & unexplained
+    status[bad] = "non_finite"
+    dead = ~np.isin(status, FINISHED)
+    for v in values.values():
+        v[dead] = np.nan
+
+
+def _nan_message(values: dict, status: np.ndarray, error: np.ndarray) -> np.ndarray:
+    """Why a row is ``non_finite``: the kernel said so, or which outputs were not finite."""
+    msg = error.copy()
+    for i in np.flatnonzero(status == "non_finite"):
+        if msg[i] is None:
+            msg[i] = "the integration produced a non-finite value"
+    return msg
