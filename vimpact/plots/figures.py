@@ -467,6 +467,14 @@ class Figure(NamedTuple):
     spec: str | None
 
 
+def _friction(name: str) -> Callable:
+    """A figure of :mod:`vimpact.plots.friction` (imported when drawn)."""
+    def draw(out):
+        import importlib
+        return getattr(importlib.import_module("vimpact.plots.friction"), name)(out)
+    return draw
+
+
 FIGURES: dict[str, Figure] = {
     "fig3_2": Figure(fig3_2, "linear model: e and omega0 t* over zeta", None),
     "fig4_2": Figure(fig4_2, "v_z, v_x, omega during one impact", None),
@@ -480,6 +488,12 @@ FIGURES: dict[str, Figure] = {
                      "sweeps/fig5_4_5_standard_solid_q2.toml (+ sweeps/fig5_4_5_kelvin_voigt.toml)"),
     "fig5_5": Figure(fig5_5, "e_x over Q1, standard solid, family of Q2",
                      "sweeps/fig5_4_5_standard_solid_q2.toml (+ sweeps/fig5_4_5_kelvin_voigt.toml)"),
+    "fig_mbf": Figure(_friction("fig_mbf"), "friction: exit psi2 over incidence psi1, elastic "
+                      "sphere, several chi (Maw, Barber and Fawcett)", None),
+    "fig_beta_psi": Figure(_friction("fig_beta_psi"), "friction: beta_x over psi for several Q1",
+                           None),
+    "fig_chung_ooi": Figure(_friction("fig_chung_ooi"), "friction: rebound angle and spin over "
+                            "the impact angle (Chung and Ooi 2011, test 4)", None),
 }
 
 #: Names accepted by :func:`plot_figure` (also ``"5.2"``, ``"fig5.2"``, ``"fig5_2"``).
