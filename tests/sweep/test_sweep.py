@@ -11,8 +11,8 @@ import pytest
 
 import vimpact as v
 from vimpact import cli
-from vimpact.sweep import spec as sweep
-from vimpact.sweep.spec import SweepInterrupted, load_spec, parts_dir, read_metadata, run_sweep
+from vimpact.sweep import runner, spec as sweep
+from vimpact.sweep import SweepInterrupted, load_spec, parts_dir, read_metadata, run_sweep
 
 SWEEPS = Path(__file__).resolve().parents[2] / "sweeps"
 TINY = v.Numerics(steps=100, elements=20)
@@ -301,7 +301,7 @@ def test_resume_of_a_finished_table_computes_nothing(tmp_path, monkeypatch):
     spec_path = write(tmp_path, GRID_SS)
     path = run_sweep(spec_path, progress=False)
     before = path.read_bytes()
-    monkeypatch.setattr(sweep, "compute_chunk", lambda *a: pytest.fail("recomputed"))
+    monkeypatch.setattr(runner, "compute_chunk", lambda *a: pytest.fail("recomputed"))
     assert run_sweep(spec_path, resume=True, progress=False) == path
     assert path.read_bytes() == before
 
@@ -326,7 +326,7 @@ def test_cli_sweep_and_exit_codes(tmp_path, main, capsys, monkeypatch):
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "bad.toml" in err and "grid.nu" in err
 
-    real = sweep.compute_chunk
+    real = runner.compute_chunk
     calls = []
 
     def flaky(*args):
@@ -334,14 +334,14 @@ def test_cli_sweep_and_exit_codes(tmp_path, main, capsys, monkeypatch):
         if len(calls) == 2:
             raise KeyboardInterrupt
         return real(*args)
-    monkeypatch.setattr(sweep, "compute_chunk", flaky)
+    monkeypatch.setattr(runner, "compute_chunk", flaky)
     again = tmp_path / "again.parquet"
     assert main(["sweep", str(spec_path), "--out", str(again)]) == 130
     err = capsys.readouterr().err
     assert "1 of 3 chunks" in err and "--resume" in err and str(again) in err
     assert main(["sweep", str(spec_path), "--out", str(again)]) == 2  # parts: needs --resume
     assert "--resume" in capsys.readouterr().err
-    monkeypatch.setattr(sweep, "compute_chunk", real)
+    monkeypatch.setattr(runner, "compute_chunk", real)
     assert main(["sweep", str(spec_path), "--out", str(again), "--resume"]) == 0
     assert again.read_bytes() == out.read_bytes()
 
@@ -350,9 +350,10 @@ def test_nan_without_a_status_becomes_non_finite(tmp_path):
     spec = load_spec(write(tmp_path, GRID_SS))
     cols = {"e_z": np.array([0.5, np.nan]), "e_x": np.array([np.nan, 0.1]),
             "beta_x": np.array([np.nan, 0.1])}
-    cols.update({c: np.zeros(2) for c in sweep._OUTPUTS if c not in cols})
-    status, error = ["vc0_zero", "half_space"], [None, None]
-    sweep._guard_nan(cols, status, error, np.array([True, False]))
-    assert status == ["vc0_zero", "non_finite"] and "e_z" in error[1]
+    cols.update({c: np.zeros(2) for c in sweep.OUTPUTS if c not in cols})
+    status = np.array(["vc0_zero", "half_space"], dtype=object)
+    error = np.array([None, None], dtype=object)
+    runner.guard_nan(cols, status, error, np.array([True, False]), np.array([True, True]))
+    assert list(status) == ["vc0_zero", "non_finite"] and "e_z" in error[1]
     assert error[0] is None and math.isnan(cols["t_contact_s"][1])
     assert spec.rows == 12 and dataclasses.asdict(spec.numerics)["steps"] == 100

@@ -1,6 +1,8 @@
 """Restitution tables: read, describe, interpolate, and turn into e(v) curves.
 
-A restitution table is a Parquet file written by the sweep driver (DESIGN.md):
+A restitution table is a Parquet file, or a partitioned Parquet dataset (a
+directory of part files plus ``_common_metadata``), written by the sweep
+driver (:mod:`vimpact.sweep`):
 one row per impact with the columns ``Q1``, ``Q2`` (0 or NaN for Kelvin-Voigt),
 ``nu``, ``e_z``, ``e_x``, ``beta_x``, ``t_contact_s``, ``u_max_m``,
 ``a_max_m``, ``energy_ratio``, ``status`` (optionally ``theta_ratio`` and
@@ -51,8 +53,7 @@ SPEC_HINTS = {
 OUTPUTS = ("e_z", "e_x", "beta_x")
 
 _REQUIRED = ("Q1", "nu", "e_z", "e_x", "beta_x", "status")
-_META_PREFIX = "vimpact."
-_JSON_KEYS = ("units", "numerics")
+_META_PREFIX = "vimpact."  # the sweep's vimpact.sweep.store.META_PREFIX
 #: Theta / (m R^2) of a table without a ``theta_ratio`` column (the solid sphere,
 #: ``Scene``'s default).
 DEFAULT_THETA_RATIO = 0.4
@@ -223,22 +224,34 @@ class RestitutionTable:
     # ---- reading and writing -------------------------------------------
     @classmethod
     def open(cls, path) -> "RestitutionTable":
-        """Read a Parquet restitution table and its ``vimpact.*`` metadata."""
+        """Read a restitution table and its ``vimpact.*`` metadata: one Parquet file, or a
+        partitioned dataset written by a large sweep (a directory of part files plus
+        ``_common_metadata``, which holds the metadata)."""
         import pyarrow.parquet as pq
 
+        from vimpact.sweep.store import COMMON_METADATA
+
         p = Path(path)
-        if not p.is_file():
+        if p.is_dir():
+            if not (p / COMMON_METADATA).is_file():
+                raise ValueError(
+                    f"table = {str(path)!r} is not allowed: a directory without "
+                    f"{COMMON_METADATA} (an unfinished sweep dataset: finish it with "
+                    "`vimpact sweep SPEC --resume`, or --combine after shards)")
+        elif not p.is_file():
             raise ValueError(f"table = {str(path)!r} is not allowed: no such file "
                              "(a Parquet restitution table written by `vimpact sweep`)")
         try:
             arrow = pq.read_table(p)
+            raw = (pq.read_schema(p / COMMON_METADATA) if p.is_dir() else arrow.schema).metadata
         except Exception as exc:  # pyarrow raises several types for a bad file
             why = (str(exc).splitlines() or [""])[0]
             raise ValueError(f"table = {str(path)!r} is not allowed: not a readable Parquet "
                              f"file ({type(exc).__name__}: {why})") from None
-        raw = arrow.schema.metadata or {}
-        meta = {k.decode(): v.decode() for k, v in raw.items()
+        meta = {k.decode(): v.decode() for k, v in (raw or {}).items()
                 if k.decode().startswith(_META_PREFIX)}
+        if p.is_dir():  # the parts' schemas carry per-chunk bookkeeping
+            arrow = arrow.replace_schema_metadata(None)
         return cls(arrow.to_pandas(), meta, path=p)
 
     def save(self, path) -> Path:
@@ -254,16 +267,15 @@ class RestitutionTable:
 
     # ---- metadata --------------------------------------------------------
     def meta(self, key: str, default=None):
-        """Metadata value ``vimpact.<key>`` (JSON keys ``units``, ``numerics`` parsed)."""
+        """Metadata value ``vimpact.<key>``, decoded by the sweep's metadata codec
+        (:func:`vimpact.sweep.store.decode_value`: JSON keys such as ``units``,
+        ``numerics``, ``paths`` parsed, integer keys such as ``rows`` as ints)."""
+        from vimpact.sweep.store import decode_value
+
         value = self.metadata.get(_META_PREFIX + key)
         if value is None:
             return default
-        if key in _JSON_KEYS:
-            try:
-                return json.loads(value)
-            except json.JSONDecodeError:
-                return value
-        return value
+        return decode_value(key, value)
 
     @property
     def model(self) -> str:

@@ -46,11 +46,12 @@ or a preset name as a string) and ``scene`` (required).
 
 Every value is one number: a range or a choice (which a sweep's ``[random]``
 takes) is an error. Unknown keys, missing keys and bad values are
-``ValueError`` naming the file and the key, on one line. The scene is built
-by :meth:`vimpact.sweep.spec.SweepSpec.scene` from these values, so a scene file
-and a sweep whose ``[random]`` values are all fixed give the same
+``ValueError`` naming the file and the key, on one line. The key rules and the
+construction of the scene (:func:`vimpact.model.toml_input.scene_from_values`)
+are those of a sweep specification (:mod:`vimpact.model.toml_input`), so a
+scene file and a sweep whose ``[random]`` values are all fixed give the same
 :class:`~vimpact.Scene` (except ``allow_large_contact``, which a sweep always
-sets, and ``tangential`` / ``rotation``, which are the file's).
+sets).
 
 Python API::
 
@@ -61,20 +62,21 @@ Python API::
 
 from __future__ import annotations
 
-import dataclasses
 from pathlib import Path
 
 from vimpact.model.numerics import Numerics
 from vimpact.model.scene import Scene
-from vimpact.sweep.spec import (_ARM_KEYS, _MATERIAL_KEYS, _RANDOM_DEFAULTS, _SPHERE_KEYS, _TOP_KEYS, Draw,
-                    SweepSpec, _numerics, _Spec, parse_header, parse_toml, read_toml)
+from vimpact.model.toml_input import (ARM_KEYS, PHYSICAL_DEFAULTS, SWEEP_TOP_KEYS,
+                                      TomlSource, parse_header, parse_numerics, parse_toml,
+                                      physical_keys, read_toml, required_keys,
+                                      scene_from_values)
 
 #: Top-level keys of a scene file.
 TOP_KEYS = ("model", "description", "tangential_memory", "tangential", "rotation",
             "allow_large_contact", "numerics", "scene")
 
 #: Defaults of the ``[scene]`` table (those of a sweep's ``[random]``).
-DEFAULTS = {**_RANDOM_DEFAULTS, "eta_Pa_s": 0.0}  # eta_Pa_s: prony only (optional there)
+DEFAULTS = {**PHYSICAL_DEFAULTS, "eta_Pa_s": 0.0}  # eta_Pa_s: prony only (optional there)
 
 _ONE_NUMBER = ("one number (a scene is one impact: ranges and choices belong in a "
                "sweep's [random] table)")
@@ -94,17 +96,13 @@ _CHECKS = {
 def allowed_scene_keys(model: str) -> tuple[str, ...]:
     """Keys of the ``[scene]`` table for ``model`` (those of a sweep's ``[random]``
     without ``rows``)."""
-    return _MATERIAL_KEYS[model] + _SPHERE_KEYS + ("nu", "theta_ratio") + \
-        (("arms",) if model == "prony" else ())
+    return physical_keys(model) + (("arms",) if model == "prony" else ())
 
 
 def required_scene_keys(model: str) -> tuple[str, ...]:
     """Keys that ``[scene]`` must have (besides one of ``E_Pa`` / ``G_Pa`` for
     elastic and Kelvin-Voigt)."""
-    if model == "prony":
-        return ("G_Pa", "R_m", "m_kg", "v_z0_m_s", "nu")
-    return tuple(k for k in _MATERIAL_KEYS[model] if k not in ("E_Pa", "G_Pa")) + \
-        ("R_m", "m_kg", "v_z0_m_s", "nu")
+    return required_keys(model)
 
 
 def load_scene(path) -> tuple[Scene, Numerics | None]:
@@ -117,64 +115,61 @@ def load_scene(path) -> tuple[Scene, Numerics | None]:
     """
     path = Path(path)
     text, data = read_toml(path, "scene file")
-    return _scene(_Spec(path), text, data)
+    return _scene(TomlSource(path), text, data)
 
 
 def scene_from_toml(text: str, source="<string>") -> tuple[Scene, Numerics | None]:
     """:func:`load_scene` of the TOML ``text``; ``source`` names it in error messages."""
-    spec = _Spec(source)
+    spec = TomlSource(source)
     return _scene(spec, text, parse_toml(spec, text))
 
 
-def _scene(spec: _Spec, text: str, data: dict) -> tuple[Scene, Numerics | None]:
+def _scene(spec: TomlSource, text: str, data: dict) -> tuple[Scene, Numerics | None]:
     source = spec.path
     _top_keys(spec, data)
     header = parse_header(spec, data)
     allow_large = spec.flag(data, "allow_large_contact", False)
-    numerics = _numerics(spec, data["numerics"]) if "numerics" in data else None
+    numerics = parse_numerics(spec, data["numerics"]) if "numerics" in data else None
 
     if "scene" not in data:
         raise spec.error("scene", "missing: a [scene] table with the physical values ("
                          + ", ".join(allowed_scene_keys(header.model)) + ")")
-    draws, arms = _scene_table(spec, header.model, data["scene"])
+    values, arms = _scene_table(spec, header.model, data["scene"])
 
-    # One row of a sweep with fixed draws: the same key names, defaults and
-    # construction as SweepSpec.scene, so the two formats cannot drift apart.
-    sweep = SweepSpec(path=Path(str(source)), text=text, model=header.model, mode="random",
-                      seed=0, chunk_size=1, output=Path(str(source) + ".parquet"),
-                      numerics=numerics or Numerics(),
-                      tangential_memory=header.tangential_memory,
-                      description=header.description, rows=1, draws=draws, arms=arms,
-                      tangential=header.tangential, rotation=header.rotation)
+    # The same key names, defaults and construction as a sweep row
+    # (vimpact.model.toml_input), so the two formats cannot drift apart.
     try:
-        scene = sweep.scene(sweep.parameters(), 0)
+        scene = scene_from_values(header.model, values, arms,
+                                  tangential_memory=header.tangential_memory,
+                                  tangential=header.tangential, rotation=header.rotation,
+                                  allow_large_contact=allow_large)
     except ValueError as exc:
         raise ValueError(f"{source}: scene: {exc}") from None
-    return dataclasses.replace(scene, allow_large_contact=allow_large), numerics
+    return scene, numerics
 
 
-def _top_keys(spec: _Spec, data: dict) -> None:
+def _top_keys(spec: TomlSource, data: dict) -> None:
     for key in data:
         if key in TOP_KEYS:
             continue
         if key == "random":
             raise spec.error("random", "a scene file takes its values in [scene]: a sweep's "
                              "[random] table with one number per key and without 'rows'")
-        if key in _TOP_KEYS:
+        if key in SWEEP_TOP_KEYS:
             raise spec.error(key, "a sweep key, not a scene key (allowed: "
                              + ", ".join(TOP_KEYS) + ")")
         spec.unknown({key: None}, TOP_KEYS)
 
 
-def _number(spec: _Spec, key: str, value, name: str) -> float:
+def _number(spec: TomlSource, key: str, value, name: str) -> float:
     if isinstance(value, (list, dict)):
         raise spec.bad(key, value, _ONE_NUMBER)
     check, allowed = _CHECKS.get(name, (None, "a finite number"))
     return spec.number(key, value, check, allowed)
 
 
-def _scene_table(spec: _Spec, model: str, table) -> tuple[dict, tuple]:
-    """The ``[scene]`` values as fixed sweep draws (and arms)."""
+def _scene_table(spec: TomlSource, model: str, table) -> tuple[dict, tuple]:
+    """The ``[scene]`` values (key -> number) and the arms ``((G_Pa, tau_s), ...)``."""
     if not isinstance(table, dict):
         raise spec.bad("scene", table, "a table [scene]")
     spec.unknown(table, allowed_scene_keys(model), "scene")
@@ -185,14 +180,14 @@ def _scene_table(spec: _Spec, model: str, table) -> tuple[dict, tuple]:
     if model in ("elastic", "kelvin_voigt") and ("E_Pa" in table) == ("G_Pa" in table):
         raise spec.error("scene.E_Pa/G_Pa", "give exactly one of E_Pa or G_Pa")
     draws = {}
-    for key in _MATERIAL_KEYS[model] + _SPHERE_KEYS + ("nu", "theta_ratio"):
+    for key in physical_keys(model):
         if key in table:
             value = _number(spec, f"scene.{key}", table[key], key)
         elif key in DEFAULTS:
             value = DEFAULTS[key]
         else:  # the other of E_Pa / G_Pa
             continue
-        draws[key] = Draw("fixed", (value,))
+        draws[key] = value
     arms = []
     if model == "prony":
         listed = table.get("arms", [])
@@ -200,12 +195,11 @@ def _scene_table(spec: _Spec, model: str, table) -> tuple[dict, tuple]:
             raise spec.bad("scene.arms", listed, "a list of tables [[scene.arms]]")
         for i, arm in enumerate(listed, start=1):
             where = f"scene.arms[{i}]"
-            spec.unknown(arm, _ARM_KEYS, where)
-            absent = [f"{where}.{k}" for k in _ARM_KEYS if k not in arm]
+            spec.unknown(arm, ARM_KEYS, where)
+            absent = [f"{where}.{k}" for k in ARM_KEYS if k not in arm]
             if absent:
                 raise spec.error(", ".join(absent), "missing")
-            arms.append({k: Draw("fixed", (_number(spec, f"{where}.{k}", arm[k], k),))
-                         for k in _ARM_KEYS})
+            arms.append(tuple(_number(spec, f"{where}.{k}", arm[k], k) for k in ARM_KEYS))
     return draws, tuple(arms)
 
 

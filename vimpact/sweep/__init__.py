@@ -1,10 +1,20 @@
 """Sweeps: TOML specifications, parameters per chunk, runners and the Parquet store.
 
-The public names are re-exported here::
+Modules: :mod:`~vimpact.sweep.spec` (TOML -> :class:`SweepSpec`),
+:mod:`~vimpact.sweep.parameters` (parameter sets per chunk),
+:mod:`~vimpact.sweep.runner` (in-process, shards, Dask),
+:mod:`~vimpact.sweep.store` (part files, file or dataset, metadata codec),
+:mod:`~vimpact.sweep.progress`. The public names are re-exported here::
 
     from vimpact.sweep import run_sweep, load_spec, read_metadata
 """
 
+from vimpact.sweep.runner import (  # noqa: F401
+    SweepInterrupted, chunk_summary, compute_chunk, run_sweep)
 from vimpact.sweep.spec import (  # noqa: F401
-    COLUMNS, SCHEMA_VERSION, SWEEP_STATUSES, Draw, SweepInterrupted, SweepSpec, compute_chunk,
-    load_spec, parts_dir, read_metadata, run_sweep, summary)
+    COLUMNS, SCHEMA_VERSION, SWEEP_STATUSES, Draw, SweepSpec, load_spec)
+from vimpact.sweep.store import parts_dir, read_metadata, summary  # noqa: F401
+
+__all__ = ["COLUMNS", "Draw", "SCHEMA_VERSION", "SWEEP_STATUSES", "SweepInterrupted",
+           "SweepSpec", "chunk_summary", "compute_chunk", "load_spec", "parts_dir",
+           "read_metadata", "run_sweep", "summary"]

@@ -1,4 +1,4 @@
-"""Sweeps: many impacts from one TOML specification into one Parquet table.
+"""Sweep specifications: a TOML file -> a validated :class:`SweepSpec`.
 
 A specification (``sweeps/*.toml``, read with :mod:`tomllib`) describes one
 table. Example (a Kelvin-Voigt lookup table on a grid of dimensionless
@@ -6,37 +6,39 @@ parameters)::
 
     description = "Kelvin-Voigt restitution table"
     model = "kelvin_voigt"        # elastic | kelvin_voigt | standard_solid | prony
-    seed = 1                      # numpy default_rng(seed); required for [random]
-    chunk_size = 128              # rows per part file (and per parallel batch)
+    seed = 1                      # root of the random draws; required for [random]
+    chunk_size = 128              # rows per chunk: one part file, one parallel batch, one task
     output = "tables/kv.parquet"      # relative to THIS FILE's directory
+    layout = "auto"               # file | dataset | auto (file up to 1e6 rows)
     tangential_memory = "incremental" # or "seed" (thesis eq. 4.16)
 
     [numerics]                    # optional; default: preset "default"
-    preset = "default"            # default | fast | thesis
-    steps = 1000                  # overrides: integrator, steps, elements,
-                                  # row_width, max_time (see vimpact.Numerics)
+    preset = "default"            # default | fast | precise | thesis
+    steps = 1000                  # overrides: any field of vimpact.Numerics
     [grid]
     Q1 = { start = 1e-3, stop = 100, per_decade = 10 }
     nu = [0.0, 0.1, 0.2, 0.3, 0.4, 0.5]
 
 Top-level keys: ``model`` (required), ``description``, ``seed``,
 ``chunk_size`` (default 64), ``output`` (default: the spec's name with
-``.parquet`` beside it), ``tangential_memory``, ``numerics`` (a table, or a
-preset name as a string) and exactly one of ``[random]`` or ``[grid]``.
-Unknown keys and bad values are errors (``ValueError``) that name the file
-and the key.
+``.parquet`` beside it), ``layout``, ``tangential_memory``, ``tangential``,
+``rotation``, ``numerics`` (a table, or a preset name as a string) and exactly
+one of ``[random]`` or ``[grid]``. Unknown keys and bad values are errors
+(``ValueError``) that name the file and the key. The key rules shared with
+scene files live in :mod:`vimpact.model.toml_input`.
 
-``[grid]``: parameter sets on a grid of the dimensionless parameters, built
-with :meth:`vimpact.Scene.from_dimensionless` (the grid is the product of
-all axes; ``Q1`` runs fastest, then ``Q2``, ``nu``, ``theta_ratio``). Keys:
-``Q1`` (kelvin_voigt, standard_solid; >= 0), ``Q2`` (standard_solid; > 0),
-``nu`` (required; in [0, 0.5]), ``theta_ratio`` (Theta / (m R^2), default
-0.4). An axis is a number, a list of numbers, or a table
-``{ start, stop, per_decade }`` (log-spaced, both ends included) or
+``[grid]``: parameter sets on a grid of the dimensionless parameters, simulated
+on the reference scene of :meth:`vimpact.Scene.from_dimensionless` (the grid is
+the product of all axes; ``Q1`` runs fastest, then ``Q2``, ``nu``,
+``theta_ratio``). Keys: ``Q1`` (kelvin_voigt, standard_solid; >= 0), ``Q2``
+(standard_solid; > 0), ``nu`` (required; in [0, 0.5]), ``theta_ratio``
+(Theta / (m R^2), default 0.4). An axis is a number, a list of numbers, or a
+table ``{ start, stop, per_decade }`` (log-spaced, both ends included) or
 ``{ start, stop, num, log = true|false }`` (``num`` points; ``log`` defaults
 to the rule below). With ``per_decade`` the number of intervals is
-``round(per_decade * log10(stop / start))``, so both ends are exact. An elastic grid has ``nu`` and ``theta_ratio`` only
-(``Q1 = 0``); a Prony series has no dimensionless grid.
+``round(per_decade * log10(stop / start))``, so both ends are exact. An
+elastic grid has ``nu`` and ``theta_ratio`` only (``Q1 = 0``); a Prony series
+has no dimensionless grid.
 
 ``[random]``: physical parameter sets drawn at random, as the thesis does to
 show that results collapse onto ``Q1`` (and ``Q2``). ``rows`` (required) is
@@ -57,48 +59,28 @@ Each value is a number (fixed), a range ``[lo, hi]`` or
 (one of the values, equally likely). A range is drawn **log-uniformly when
 ``lo > 0`` and ``hi / lo > 10``** (it spans more than a decade), uniformly
 otherwise; ``log`` overrides that (``log = true`` needs ``lo > 0``).
-Draws are not checked against the physics: a drawn combination that
-:class:`vimpact.Scene` rejects becomes a row with status ``invalid`` and the
-reason in the ``error`` column.
+Draws are not checked against the physics: a drawn combination that is not a
+valid scene becomes a row with status ``invalid`` and the reason in the
+``error`` column.
+
+Random draws per chunk (schema version 3): the rows of chunk ``c`` are drawn
+from ``numpy.random.default_rng(SeedSequence(seed, spawn_key=(c,)))``, each key
+for all rows of the chunk in a fixed order (material, sphere, ``nu``,
+``theta_ratio``, arms), so any chunk can be computed anywhere and in any order
+with the same rows (:mod:`vimpact.sweep.parameters`). The draws therefore
+depend on ``seed`` and ``chunk_size``; tables of schema version 2 drew all rows
+from one ``default_rng(seed)`` and have other draws.
 
 Output paths: ``output`` in the spec is relative to the spec file's
-directory; ``out=`` / ``--out`` is relative to the current directory.
-
-The table (:func:`run_sweep`): one row per parameter set, in the order
-generated, with columns ``row`` (0-based index), the physical inputs (unit
-suffixes: ``E_Pa``, ``G_Pa``, ``G1_Pa``, ``G2_Pa``, ``eta_Pa_s``, ``R_m``,
-``m_kg``, ``v_z0_m_s``, ``v_x0_m_s``, ``omega0_rad_s``; for a grid those of
-the reference scene that was simulated), the dimensionless parameters
-``Q1``, ``Q2`` (``Q2 = 0`` for Kelvin-Voigt and elastic, the limit
-``G2 -> inf``; neither for a Prony series), ``nu``, ``theta_ratio``, the
-results (``e_z``, ``e_x``, ``beta_x``, ``energy_ratio``, ``t_contact_s``,
-``u_max_m``, ``a_max_m``, the Hertz scales ``t_hertz_s``, ``d_hertz_m``,
-``a_hertz_m``, their ratios ``t_contact_rel``, ``u_max_rel``, ``a_max_rel``,
-end velocities ``v_z_end_m_s``, ``v_x_end_m_s``, ``omega_end_rad_s``),
-``status`` (:data:`SWEEP_STATUSES`) and ``error`` (null unless the row
-failed before the kernel). NaN appears only in a row whose status says why.
-Units and descriptions of all columns, the numerics, model, seed, package
-version and the spec text are in the Parquet key-value metadata
-(:func:`read_metadata`).
-
-Crash safety: every finished chunk goes atomically (temporary file, fsync,
-``os.replace``) to ``<out>.parts/part-NNNNN.parquet``; at the end the parts
-are combined, atomically, into ``<out>`` and the directory is removed.
-``resume=True`` computes only the missing chunks; parts of another spec or
-package version are refused (each part stores a SHA-256 of the spec text,
-the resolved numerics and the package version: editing the spec, even a
-comment, invalidates the parts). The result is byte for byte that of an
-uninterrupted run. Two runs writing the same output at the same time are
-not supported.
+directory; ``out=`` / ``--out`` is relative to the current directory. The
+table layout and the runners are described in :mod:`vimpact.sweep.store` and
+:mod:`vimpact.sweep.runner`.
 
 Python API::
 
-    from vimpact.sweep.spec import run_sweep, load_spec, read_metadata
-    path = run_sweep("sweeps/kelvin_voigt_table.toml", out=None, resume=False,
-                     progress=None)            # -> Path of the table
+    from vimpact.sweep import load_spec
     spec = load_spec("sweeps/kelvin_voigt_table.toml")   # validated SweepSpec
-    params = spec.parameters()                 # every parameter set, up front
-    meta = read_metadata(path)                 # model, numerics, units, spec, ...
+    params = spec.chunk_parameters(0)          # the parameter sets of chunk 0
 """
 
 from __future__ import annotations
@@ -107,49 +89,50 @@ import dataclasses
 import hashlib
 import json
 import math
-import os
-import shutil
-import sys
-import tomllib
-from collections.abc import Callable
-from typing import NamedTuple
 from pathlib import Path
 
-import numba
 import numpy as np
-import pyarrow as pa
-import pyarrow.parquet as pq
 
 from vimpact import __version__
-from vimpact.model.material import MODELS, Material, shear_modulus
-from vimpact.model.numerics import PRESETS, Numerics
-from vimpact.engine.routing import choose_path
-from vimpact.engine.result import FINISHED, STATUSES
-from vimpact.model.scene import TANGENTIAL_EFFECTS, TANGENTIAL_MEMORY, Scene
-from vimpact.engine.simulate import simulate_batch
+from vimpact.model.numerics import Numerics
+from vimpact.model.scene import Scene
+from vimpact.model.toml_input import (ARM_KEYS, MATERIAL_KEYS, PHYSICAL_DEFAULTS, SPHERE_KEYS,
+                                      SWEEP_TOP_KEYS, TomlSource, is_number, parse_header,
+                                      parse_numerics, physical_keys, read_toml, required_keys,
+                                      scene_from_values)
 
-#: Version of the table layout (columns and metadata keys).
-SCHEMA_VERSION = 2
-
-#: Prefix of every key-value metadata key the sweep writes.
-META_PREFIX = "vimpact."
+#: Version of the table layout (columns, metadata keys and random draws): 3 since
+#: the draws are made per chunk from ``SeedSequence(seed, spawn_key=(chunk,))``.
+SCHEMA_VERSION = 3
 
 #: Row statuses of a sweep table: those of :data:`vimpact.STATUSES` and two more.
-SWEEP_STATUSES = {
-    **STATUSES,
-    "invalid": "the drawn parameters are not a valid scene (reason in the error column); "
-               "outputs NaN",
-    "failed": "the simulation raised an error (message in the error column); outputs NaN",
-}
+def _statuses() -> dict:
+    from vimpact.engine.result import STATUSES
+    return {
+        **STATUSES,
+        "invalid": "the parameters are not a valid scene (reason in the error column); "
+                   "outputs NaN",
+        "failed": "the simulation raised an error (message in the error column); outputs NaN",
+    }
+
+
+SWEEP_STATUSES = _statuses()
 
 DEFAULT_CHUNK_SIZE = 64
-MAX_ROWS = 10_000_000
+#: Rows of one sweep at most (a grid axis has at most as many points).
+MAX_ROWS = 10**12
+#: Table layouts: one Parquet file, or a partitioned dataset (a directory).
+LAYOUTS = ("auto", "file", "dataset")
+#: ``layout = "auto"`` writes one file up to this many rows, a dataset above.
+FILE_LAYOUT_MAX_ROWS = 1_000_000
+#: Points of one grid axis at most (the axes are held in memory, the grid is not).
+MAX_AXIS_POINTS = 10**7
 
 # ---- columns ----------------------------------------------------------------
 
 #: Unit and meaning of every column a sweep table can have.
 COLUMNS = {
-    "row": ("", "row index, 0-based, in the order the parameter sets were generated"),
+    "row": ("", "row index, 0-based: chunk c holds rows c * chunk_size ..."),
     "E_Pa": ("Pa", "Young's modulus (relaxed) as drawn"),
     "G_Pa": ("Pa", "shear modulus (Kelvin-Voigt, elastic) or relaxed modulus G_inf (Prony)"),
     "G1_Pa": ("Pa", "standard solid: parallel spring G1 (relaxed modulus)"),
@@ -187,38 +170,23 @@ COLUMNS = {
 }
 
 #: Result columns: sweep name -> column of :func:`vimpact.simulate_batch`.
-_RESULTS = {
+RESULTS = {
     "e_z": "e_z", "e_x": "e_x", "beta_x": "beta_x", "energy_ratio": "energy_ratio",
     "t_contact_s": "t_contact", "u_max_m": "u_max", "a_max_m": "a_max",
     "t_hertz_s": "t_hertz", "d_hertz_m": "d_hertz", "a_hertz_m": "a_hertz",
     "v_z_end_m_s": "v_z_end", "v_x_end_m_s": "v_x_end", "omega_end_rad_s": "omega_end",
 }
-_RELATIVE = {"t_contact_rel": ("t_contact_s", "t_hertz_s"), "u_max_rel": ("u_max_m", "d_hertz_m"),
+RELATIVE = {"t_contact_rel": ("t_contact_s", "t_hertz_s"), "u_max_rel": ("u_max_m", "d_hertz_m"),
              "a_max_rel": ("a_max_m", "a_hertz_m")}
-_OUTPUTS = ("e_z", "e_x", "beta_x", "energy_ratio", "t_contact_s", "u_max_m", "a_max_m",
+OUTPUTS = ("e_z", "e_x", "beta_x", "energy_ratio", "t_contact_s", "u_max_m", "a_max_m",
             "t_hertz_s", "d_hertz_m", "a_hertz_m", "t_contact_rel", "u_max_rel", "a_max_rel",
             "v_z_end_m_s", "v_x_end_m_s", "omega_end_rad_s")
 #: Outputs that are NaN when v_c0 = 0 (no tangential force).
-_TANGENTIAL = ("e_x", "beta_x")
-_SCALES = ("t_hertz_s", "d_hertz_m", "a_hertz_m")
+TANGENTIAL_OUTPUTS = ("e_x", "beta_x")
 #: String columns (null where not applicable: path of a row that never ran, error of a good row).
-_LABELS = ("path", "status", "error")
+LABELS = ("path", "status", "error")
 
-# ---- spec keys --------------------------------------------------------------
-
-_TOP_KEYS = ("model", "description", "seed", "chunk_size", "output", "tangential_memory",
-             "tangential", "rotation", "numerics", "random", "grid")
-_NUMERICS_KEYS = ("preset",) + tuple(f.name for f in dataclasses.fields(Numerics))
-
-_MATERIAL_KEYS = {
-    "elastic": ("E_Pa", "G_Pa"),
-    "kelvin_voigt": ("E_Pa", "G_Pa", "eta_Pa_s"),
-    "standard_solid": ("G1_Pa", "G2_Pa", "eta_Pa_s"),
-    "prony": ("G_Pa", "eta_Pa_s"),
-}
-_SPHERE_KEYS = ("R_m", "m_kg", "v_z0_m_s", "v_x0_m_s", "omega0_rad_s")
-_RANDOM_DEFAULTS = {"v_x0_m_s": 0.0, "omega0_rad_s": 0.0, "theta_ratio": 0.4}
-_ARM_KEYS = ("G_Pa", "tau_s")
+# ---- spec keys -------------------------------------------------------------
 
 _GRID_KEYS = {
     "elastic": ("theta_ratio", "nu"),
@@ -231,109 +199,6 @@ _GRID_CHECKS = {
     "nu": (lambda x: 0.0 <= x <= 0.5, "in [0, 0.5]"),
     "theta_ratio": (lambda x: x > 0.0, "a finite number > 0"),
 }
-
-
-class SweepInterrupted(KeyboardInterrupt):
-    """A sweep stopped by Ctrl-C (or a progress callback); finished chunks stay on disk."""
-
-    def __init__(self, message: str, parts_dir: Path, done: int, total: int):
-        super().__init__(message)
-        self.message, self.parts_dir, self.done, self.total = message, parts_dir, done, total
-
-    def __str__(self) -> str:
-        return self.message
-
-
-# ---- parsing ----------------------------------------------------------------
-
-def _is_number(x) -> bool:
-    return isinstance(x, (int, float)) and not isinstance(x, bool)
-
-
-class _Spec:
-    """Error helper: messages that name the file and the key."""
-
-    def __init__(self, path: Path):
-        self.path = path
-
-    def error(self, key: str, message: str) -> ValueError:
-        return ValueError(f"{self.path}: {key}: {message}")
-
-    def bad(self, key: str, value, allowed: str) -> ValueError:
-        return ValueError(f"{self.path}: {key} = {value!r} is not allowed: must be {allowed}")
-
-    def unknown(self, table: dict, allowed, where: str = "") -> None:
-        for key in table:
-            if key not in allowed:
-                name = f"{where}.{key}" if where else key
-                raise ValueError(f"{self.path}: unknown key {name!r} (allowed: "
-                                 f"{', '.join(allowed)})")
-
-    def number(self, key: str, value, check=None, allowed="a finite number") -> float:
-        if not _is_number(value) or not math.isfinite(value) or (check and not check(value)):
-            raise self.bad(key, value, allowed)
-        return float(value)
-
-    def integer(self, key: str, value, minimum: int) -> int:
-        if not isinstance(value, int) or isinstance(value, bool) or value < minimum:
-            raise self.bad(key, value, f"an integer >= {minimum}")
-        return value
-
-    def choice(self, data: dict, key: str, choices, default: str) -> str:
-        value = data.get(key, default)
-        if value not in choices:
-            raise self.bad(key, value, "one of " + ", ".join(map(repr, choices)))
-        return value
-
-    def flag(self, data: dict, key: str, default: bool) -> bool:
-        value = data.get(key, default)
-        if not isinstance(value, bool):
-            raise self.bad(key, value, "true or false")
-        return value
-
-
-def read_toml(path: Path, what: str) -> tuple[str, dict]:
-    """Text and parsed content of the TOML file ``path`` (``what`` names it in errors)."""
-    try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise ValueError(f"{path}: {what} not found") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise ValueError(f"{path}: cannot read the {what}: {exc}") from None
-    return text, parse_toml(_Spec(path), text)
-
-
-def parse_toml(spec: _Spec, text: str) -> dict:
-    try:
-        return tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise ValueError(f"{spec.path}: not valid TOML: {exc}") from None
-
-
-class Header(NamedTuple):
-    """The top-level keys a sweep spec and a scene file share."""
-
-    model: str
-    description: str
-    tangential_memory: str
-    tangential: str
-    rotation: bool
-
-
-def parse_header(spec: _Spec, data: dict) -> Header:
-    """``model`` (required), ``description``, ``tangential_memory``, ``tangential``, ``rotation``."""
-    model = data.get("model")
-    if model is None:
-        raise spec.error("model", f"missing (one of {', '.join(MODELS)})")
-    if model not in MODELS:
-        raise spec.bad("model", model, "one of " + ", ".join(map(repr, MODELS)))
-    description = data.get("description", "")
-    if not isinstance(description, str):
-        raise spec.bad("description", description, "a string")
-    return Header(model, description,
-                  spec.choice(data, "tangential_memory", TANGENTIAL_MEMORY, "incremental"),
-                  spec.choice(data, "tangential", TANGENTIAL_EFFECTS, "auto"),
-                  spec.flag(data, "rotation", True))
 
 
 @dataclasses.dataclass(frozen=True)
@@ -355,8 +220,8 @@ class Draw:
         return rng.choice(np.asarray(self.values, dtype=float), n)
 
 
-def _draw(spec: _Spec, key: str, value) -> Draw:
-    if _is_number(value):
+def _draw(spec: TomlSource, key: str, value) -> Draw:
+    if is_number(value):
         return Draw("fixed", (spec.number(key, value),))
     log = None
     if isinstance(value, dict):
@@ -387,8 +252,8 @@ def _draw(spec: _Spec, key: str, value) -> Draw:
     return Draw("log_uniform" if log else "uniform", (lo, hi))
 
 
-def _axis(spec: _Spec, key: str, value) -> np.ndarray:
-    if _is_number(value):
+def _axis(spec: TomlSource, key: str, value) -> np.ndarray:
+    if is_number(value):
         values = [value]
     elif isinstance(value, list):
         if not value:
@@ -423,8 +288,8 @@ def _axis(spec: _Spec, key: str, value) -> np.ndarray:
                 raise spec.bad(f"{key}.log", log, "true or false")
             if log and start <= 0.0:
                 raise spec.bad(f"{key}.start", value["start"], "> 0 for a log-spaced axis")
-        if num > MAX_ROWS:
-            raise spec.bad(key, value, f"at most {MAX_ROWS} points")
+        if num > MAX_AXIS_POINTS:
+            raise spec.bad(key, value, f"at most {MAX_AXIS_POINTS} points")
         if num == 1:
             return np.array([start])
         if log:
@@ -448,8 +313,8 @@ class SweepSpec:
     text : its text (stored in the table's metadata)
     model : one of ``vimpact.MODELS``
     mode : ``"random"`` or ``"grid"``
-    seed : seed of ``numpy.random.default_rng`` (recorded also for a grid)
-    chunk_size : rows per chunk (one part file, one parallel batch)
+    seed : root of the per-chunk random draws (recorded also for a grid)
+    chunk_size : rows per chunk (one part file, one parallel batch, one task)
     output : default output path (resolved against the spec's directory)
     numerics : the discretization of every impact
     tangential_memory : ``"incremental"`` or ``"seed"``
@@ -460,6 +325,8 @@ class SweepSpec:
     axes : grid mode: axis name -> values, outermost first
     tangential : ``"auto"``, ``"stick"`` or ``"none"`` (:class:`vimpact.Scene`)
     rotation : the sphere may spin
+    layout : ``"auto"``, ``"file"`` or ``"dataset"`` as written (:attr:`table_layout`
+        resolves ``"auto"``)
     """
 
     path: Path
@@ -478,15 +345,28 @@ class SweepSpec:
     axes: dict = dataclasses.field(default_factory=dict)
     tangential: str = "auto"
     rotation: bool = True
+    layout: str = "auto"
 
     @property
     def n_chunks(self) -> int:
         return -(-self.rows // self.chunk_size)
 
     @property
+    def table_layout(self) -> str:
+        """``"file"`` (one Parquet file) or ``"dataset"`` (a directory of part files)."""
+        if self.layout != "auto":
+            return self.layout
+        return "file" if self.rows <= FILE_LAYOUT_MAX_ROWS else "dataset"
+
+    def chunk_rows(self, chunk: int) -> tuple[int, int]:
+        """First row and one past the last row of ``chunk``."""
+        start = chunk * self.chunk_size
+        return start, min(self.rows, start + self.chunk_size)
+
+    @property
     def sweep_hash(self) -> str:
-        """SHA-256 of the spec text, the resolved numerics and the package version:
-        parts of a run can be resumed only by a run with the same hash."""
+        """SHA-256 of the spec text, the resolved numerics, the package and schema
+        version: parts of a run can be resumed only by a run with the same hash."""
         h = hashlib.sha256()
         for piece in (self.text, json.dumps(dataclasses.asdict(self.numerics), sort_keys=True),
                       __version__, str(SCHEMA_VERSION)):
@@ -495,55 +375,37 @@ class SweepSpec:
         return h.hexdigest()
 
     # ---- parameter sets ---------------------------------------------------
-    def parameters(self) -> dict[str, np.ndarray]:
-        """All parameter sets, one array per input, generated from the seed.
+    def chunk_parameters(self, chunk: int) -> dict[str, np.ndarray]:
+        """The parameter sets of ``chunk`` (:func:`vimpact.sweep.parameters.chunk_parameters`)."""
+        from vimpact.sweep.parameters import chunk_parameters
+        return chunk_parameters(self, chunk)
 
-        Random mode: the drawn physical inputs (each key drawn for all rows
-        in a fixed order: material, sphere, ``nu``, ``theta_ratio``, arms).
-        Grid mode: the axes expanded to their product (``Q1`` fastest).
-        """
-        if self.mode == "grid":
-            names = list(self.axes)
-            mesh = np.meshgrid(*(self.axes[k] for k in names), indexing="ij")
-            return {k: m.ravel().copy() for k, m in zip(names, mesh)}
-        rng = np.random.default_rng(self.seed)
-        out = {key: draw.sample(rng, self.rows) for key, draw in self.draws.items()}
-        for i, arm in enumerate(self.arms, start=1):
-            out[f"G_arm{i}_Pa"] = arm["G_Pa"].sample(rng, self.rows)
-            out[f"tau_arm{i}_s"] = arm["tau_s"].sample(rng, self.rows)
-        return out
+    def parameters(self) -> dict[str, np.ndarray]:
+        """All parameter sets, chunk after chunk (memory grows with ``rows``: for
+        small sweeps and tests; the runners use :meth:`chunk_parameters`)."""
+        chunks = [self.chunk_parameters(c) for c in range(self.n_chunks)]
+        return {k: np.concatenate([c[k] for c in chunks]) for k in chunks[0]}
 
     def scene(self, params: dict, i: int) -> Scene:
-        """The scene of row ``i`` of ``params`` (:meth:`parameters`); raises
-        ``ValueError`` for an invalid combination."""
+        """The scene of row ``i`` of ``params`` (one Python object: to explain a
+        row, not to run a sweep); raises ``ValueError`` for an invalid combination."""
         p = {k: float(v[i]) for k, v in params.items()}
         if self.mode == "grid":
-            Q1 = p.get("Q1", 0.0)
-            scene = Scene.from_dimensionless(Q1, p["nu"], p.get("Q2"),
+            scene = Scene.from_dimensionless(p.get("Q1", 0.0), p["nu"], p.get("Q2"),
                                              theta_ratio=p["theta_ratio"],
                                              tangential_memory=self.tangential_memory,
                                              tangential=self.tangential, rotation=self.rotation)
             if self.model == "elastic":
+                from vimpact.model.material import Material
                 scene = dataclasses.replace(
                     scene, material=Material.elastic(nu=p["nu"], G=scene.material.G_inf))
             return dataclasses.replace(scene, allow_large_contact=True)
-        nu = p["nu"]
-        if self.model == "standard_solid":
-            mat = Material.standard_solid(nu=nu, G1=p["G1_Pa"], G2=p["G2_Pa"], eta=p["eta_Pa_s"])
-        elif self.model == "prony":
-            arms = [(p[f"G_arm{k}_Pa"], p[f"tau_arm{k}_s"]) for k in range(1, len(self.arms) + 1)]
-            mat = Material.prony(nu=nu, G_inf=p["G_Pa"], arms=arms, eta0=p["eta_Pa_s"])
-        else:
-            G, E = p.get("G_Pa"), p.get("E_Pa")
-            if self.model == "kelvin_voigt":
-                mat = Material.kelvin_voigt(nu=nu, eta=p["eta_Pa_s"], G=G, E=E)
-            else:
-                mat = Material.elastic(nu=nu, G=G, E=E)
-        R, m = p["R_m"], p["m_kg"]
-        return Scene(mat, R=R, m=m, v_z0=p["v_z0_m_s"], v_x0=p["v_x0_m_s"],
-                     omega0=p["omega0_rad_s"], Theta=p["theta_ratio"] * m * R**2,
-                     tangential_memory=self.tangential_memory, allow_large_contact=True,
-                     tangential=self.tangential, rotation=self.rotation)
+        arms = [(p[f"G_arm{k}_Pa"], p[f"tau_arm{k}_s"]) for k in range(1, len(self.arms) + 1)]
+        values = {k: v for k, v in p.items() if "_arm" not in k}
+        return scene_from_values(self.model, values, arms,
+                                 tangential_memory=self.tangential_memory,
+                                 tangential=self.tangential, rotation=self.rotation,
+                                 allow_large_contact=True)
 
     # ---- table layout -------------------------------------------------------
     def input_columns(self) -> list[str]:
@@ -554,45 +416,50 @@ class SweepSpec:
         elif self.model in ("elastic", "kelvin_voigt"):
             material = [k for k in ("E_Pa", "G_Pa", "eta_Pa_s") if k in self.draws or k == "G_Pa"]
         else:
-            material = [k for k in _MATERIAL_KEYS[self.model]]
+            material = list(MATERIAL_KEYS[self.model])
             for i in range(1, len(self.arms) + 1):
                 material += [f"G_arm{i}_Pa", f"tau_arm{i}_s"]
-        return material + list(_SPHERE_KEYS)
+        return material + list(SPHERE_KEYS)
 
     def columns(self) -> list[str]:
         """All columns of the table, in order."""
         dimensionless = ["nu", "theta_ratio"] if self.model == "prony" else \
             ["Q1", "Q2", "nu", "theta_ratio"]
-        return (["row"] + self.input_columns() + dimensionless + list(_OUTPUTS)
+        return (["row"] + self.input_columns() + dimensionless + list(OUTPUTS)
                 + ["path", "status", "error"])
 
     def units(self) -> dict[str, str]:
         """Unit of every column (``"1"`` dimensionless, ``""`` for labels)."""
         return {c: _unit(c) for c in self.columns()}
 
-    def schema(self) -> pa.Schema:
+    def schema(self):
+        """The ``pyarrow`` schema of the table (``row`` int64, labels string, else float64)."""
+        import pyarrow as pa
         fields = []
         for c in self.columns():
-            kind = pa.int64() if c == "row" else pa.string() if c in _LABELS else pa.float64()
+            kind = pa.int64() if c == "row" else pa.string() if c in LABELS else pa.float64()
             fields.append(pa.field(c, kind, nullable=(c in ("path", "error"))))
         return pa.schema(fields)
 
-    def metadata(self) -> dict[str, str]:
-        """Key-value metadata of the final table (without the ``vimpact.`` prefix)."""
+    def metadata(self) -> dict:
+        """Metadata of the table (keys without the ``vimpact.`` prefix; values as Python
+        objects, encoded by :func:`vimpact.sweep.store.encode_metadata`)."""
         return {
-            "schema_version": str(SCHEMA_VERSION),
+            "schema_version": SCHEMA_VERSION,
             "version": __version__,
             "model": self.model,
             "mode": self.mode,
-            "seed": str(self.seed),
-            "rows": str(self.rows),
-            "numerics": json.dumps(dataclasses.asdict(self.numerics)),
+            "seed": self.seed,
+            "rows": self.rows,
+            "chunk_size": self.chunk_size,
+            "layout": self.table_layout,
+            "numerics": dataclasses.asdict(self.numerics),
             "tangential_memory": self.tangential_memory,
             "tangential": self.tangential,
-            "rotation": json.dumps(self.rotation),
-            "units": json.dumps(self.units()),
-            "columns": json.dumps({c: _describe(c) for c in self.columns()}),
-            "statuses": json.dumps(SWEEP_STATUSES),
+            "rotation": self.rotation,
+            "units": self.units(),
+            "columns": {c: _describe(c) for c in self.columns()},
+            "statuses": SWEEP_STATUSES,
             "description": self.description,
             "spec": self.text,
             "spec_name": self.path.name,
@@ -622,8 +489,8 @@ def load_spec(path) -> SweepSpec:
     """
     path = Path(path)
     text, data = read_toml(path, "sweep specification")
-    spec = _Spec(path)
-    spec.unknown(data, _TOP_KEYS)
+    spec = TomlSource(path)
+    spec.unknown(data, SWEEP_TOP_KEYS)
     header = parse_header(spec, data)
     model = header.model
     chunk_size = spec.integer("chunk_size", data.get("chunk_size", DEFAULT_CHUNK_SIZE), 1)
@@ -631,7 +498,8 @@ def load_spec(path) -> SweepSpec:
     if not isinstance(output, str) or not output.strip():
         raise spec.bad("output", output, "a path (relative to the spec's directory)")
     output = (path.parent / output) if not Path(output).is_absolute() else Path(output)
-    numerics = _numerics(spec, data.get("numerics", {}))
+    numerics = parse_numerics(spec, data.get("numerics", {}))
+    layout = spec.choice(data, "layout", LAYOUTS, "auto")
 
     if ("random" in data) == ("grid" in data):
         raise spec.error("random/grid", "give exactly one of the tables [random] or [grid]")
@@ -646,7 +514,7 @@ def load_spec(path) -> SweepSpec:
         mode = "grid"
         seed = spec.integer("seed", data.get("seed", 0), 0)
         axes = _grid(spec, model, data["grid"])
-        rows = int(np.prod([len(v) for v in axes.values()]))
+        rows = math.prod(len(v) for v in axes.values())
         if rows > MAX_ROWS:
             raise spec.error("grid", f"{rows} rows; at most {MAX_ROWS} are allowed")
         draws, arms = {}, ()
@@ -654,34 +522,15 @@ def load_spec(path) -> SweepSpec:
                      chunk_size=chunk_size, output=output, numerics=numerics,
                      tangential_memory=header.tangential_memory,
                      description=header.description, rows=rows, draws=draws, arms=arms,
-                     axes=axes, tangential=header.tangential, rotation=header.rotation)
+                     axes=axes, tangential=header.tangential, rotation=header.rotation,
+                     layout=layout)
 
 
-def _numerics(spec: _Spec, table) -> Numerics:
-    if isinstance(table, str):
-        table = {"preset": table}
-    if not isinstance(table, dict):
-        raise spec.bad("numerics", table, "a table (or a preset name)")
-    spec.unknown(table, _NUMERICS_KEYS, "numerics")
-    preset = table.get("preset", "default")
-    if preset not in PRESETS:
-        raise spec.bad("numerics.preset", preset, "one of " + ", ".join(map(repr, PRESETS)))
-    numerics = PRESETS[preset]
-    for key, value in table.items():
-        if key == "preset":
-            continue
-        try:
-            numerics = numerics.with_(**{key: value})
-        except ValueError as exc:
-            raise ValueError(f"{spec.path}: numerics.{exc}") from None
-    return numerics
-
-
-def _random(spec: _Spec, model: str, table) -> tuple[dict, tuple, int]:
+def _random(spec: TomlSource, model: str, table) -> tuple[dict, tuple, int]:
     if not isinstance(table, dict):
         raise spec.bad("random", table, "a table")
-    material = _MATERIAL_KEYS[model]
-    allowed = ("rows",) + material + _SPHERE_KEYS + ("nu", "theta_ratio") + \
+    material = MATERIAL_KEYS[model]
+    allowed = ("rows",) + material + SPHERE_KEYS + ("nu", "theta_ratio") + \
         (("arms",) if model == "prony" else ())
     spec.unknown(table, allowed, "random")
     if "rows" not in table:
@@ -692,19 +541,15 @@ def _random(spec: _Spec, model: str, table) -> tuple[dict, tuple, int]:
     if model in ("elastic", "kelvin_voigt"):
         if ("E_Pa" in table) == ("G_Pa" in table):
             raise spec.error("random.E_Pa/G_Pa", "give exactly one of E_Pa or G_Pa")
-    required = [k for k in material if k not in ("E_Pa", "G_Pa")] + ["R_m", "m_kg", "v_z0_m_s",
-                                                                      "nu"]
-    if model == "prony":
-        required = ["G_Pa", "R_m", "m_kg", "v_z0_m_s", "nu"]
-    for key in required:
+    for key in required_keys(model):
         if key not in table:
             raise spec.error(f"random.{key}", "missing")
     draws = {}
-    for key in material + _SPHERE_KEYS + ("nu", "theta_ratio"):
+    for key in physical_keys(model):
         if key in table:
             draws[key] = _draw(spec, f"random.{key}", table[key])
-        elif key in _RANDOM_DEFAULTS or key == "eta_Pa_s":
-            draws[key] = Draw("fixed", (_RANDOM_DEFAULTS.get(key, 0.0),))
+        elif key in PHYSICAL_DEFAULTS or key == "eta_Pa_s":
+            draws[key] = Draw("fixed", (PHYSICAL_DEFAULTS.get(key, 0.0),))
     arms = ()
     if model == "prony":
         listed = table.get("arms", [])
@@ -713,16 +558,16 @@ def _random(spec: _Spec, model: str, table) -> tuple[dict, tuple, int]:
         parsed = []
         for i, arm in enumerate(listed, start=1):
             where = f"random.arms[{i}]"
-            spec.unknown(arm, _ARM_KEYS, where)
-            for key in _ARM_KEYS:
+            spec.unknown(arm, ARM_KEYS, where)
+            for key in ARM_KEYS:
                 if key not in arm:
                     raise spec.error(f"{where}.{key}", "missing")
-            parsed.append({k: _draw(spec, f"{where}.{k}", arm[k]) for k in _ARM_KEYS})
+            parsed.append({k: _draw(spec, f"{where}.{k}", arm[k]) for k in ARM_KEYS})
         arms = tuple(parsed)
     return draws, arms, rows
 
 
-def _grid(spec: _Spec, model: str, table) -> dict[str, np.ndarray]:
+def _grid(spec: TomlSource, model: str, table) -> dict[str, np.ndarray]:
     if model not in _GRID_KEYS:
         raise spec.error("grid", f"model {model!r} has no dimensionless grid; use [random]")
     if not isinstance(table, dict):
@@ -745,360 +590,5 @@ def _grid(spec: _Spec, model: str, table) -> dict[str, np.ndarray]:
     return axes
 
 
-# ---- running ----------------------------------------------------------------
-
-def _interleave(n: int, threads: int) -> np.ndarray:
-    """An order that hands every thread of a static ``prange`` split a mix of the
-    chunk's rows (neighbouring grid rows cost alike)."""
-    return np.concatenate([np.arange(k, n, threads) for k in range(threads)])
-
-
-def _threads() -> int:
-    return max(1, numba.get_num_threads())
-
-
-def compute_chunk(spec: SweepSpec, params: dict, start: int, stop: int) -> pa.Table:
-    """Simulate rows ``start:stop`` of ``params`` and return them as a table.
-
-    No row raises: an invalid scene gets status ``invalid``, a failing
-    simulation ``failed``, each with NaN outputs and a message in ``error``.
-    """
-    n = stop - start
-    cols: dict[str, np.ndarray | list] = {"row": np.arange(start, stop, dtype=np.int64)}
-    for c in spec.columns():
-        if c not in ("row",) + _LABELS:
-            cols[c] = np.full(n, np.nan)
-    status: list[str] = ["invalid"] * n
-    error: list[str | None] = [None] * n
-    path: list[str | None] = [None] * n
-
-    scenes, index = [], []
-    for k in range(n):
-        try:
-            scene = spec.scene(params, start + k)
-        except ValueError as exc:
-            error[k] = str(exc)
-            continue
-        scenes.append(scene)
-        index.append(k)
-
-    # inputs as given
-    for key, values in params.items():
-        if key in cols:
-            cols[key][:] = values[start:stop]
-    if spec.mode == "random" and "E_Pa" in params:
-        cols["G_Pa"][:] = shear_modulus(params["E_Pa"][start:stop], params["nu"][start:stop])
-
-    results = _simulate(scenes, spec.numerics)
-    vc0_zero = np.zeros(n, dtype=bool)
-    for (k, scene), (res, message) in zip(zip(index, scenes), results):
-        vc0_zero[k] = scene.v_c0 == 0.0
-        mat = scene.material
-        if spec.mode == "grid":  # the physical inputs of the reference scene
-            physical = {"R_m": scene.R, "m_kg": scene.m, "v_z0_m_s": scene.v_z0,
-                        "v_x0_m_s": scene.v_x0, "omega0_rad_s": scene.omega0}
-            if spec.model == "standard_solid":
-                physical.update(G1_Pa=mat.G_inf, G2_Pa=mat.G_inf / params["Q2"][start + k],
-                                eta_Pa_s=mat.G_inf * mat.viscous_time())
-            else:
-                physical["G_Pa"] = mat.G_inf
-                if spec.model == "kelvin_voigt":
-                    physical["eta_Pa_s"] = mat.eta0
-            for key, value in physical.items():
-                cols[key][k] = value
-        if spec.model != "prony":
-            if spec.mode == "random" or spec.model == "elastic":
-                cols["Q1"][k] = scene.Q1
-            if spec.model != "standard_solid":
-                cols["Q2"][k] = 0.0  # the Kelvin-Voigt limit G2 -> inf
-            elif spec.mode == "random":
-                cols["Q2"][k] = scene.Q2
-        if res is None:
-            status[k], error[k] = "failed", message
-            continue
-        status[k], path[k] = res["status"], res["path"]
-        for name, source in _RESULTS.items():
-            cols[name][k] = res[source]
-        for name, (num, den) in _RELATIVE.items():
-            cols[name][k] = cols[num][k] / cols[den][k]
-
-    _guard_nan(cols, status, error, vc0_zero)
-    labels = {"path": path, "status": status, "error": error}
-    arrays = [pa.array(labels[c] if c in labels else cols[c], type=f.type)
-              for c, f in zip(spec.columns(), spec.schema())]
-    return pa.Table.from_arrays(arrays, schema=spec.schema())
-
-
-def _simulate(scenes: list[Scene], numerics: Numerics) -> list[tuple[dict | None, str | None]]:
-    """Results (as dicts) of ``scenes`` in one parallel batch; if the batch raises,
-    each scene alone, so that one bad scene cannot stop the others."""
-    if not scenes:
-        return []
-    order = _interleave(len(scenes), _threads())
-    try:
-        df = simulate_batch([scenes[i] for i in order], numerics)
-    except Exception:  # noqa: BLE001 - isolate the failing row below
-        out = []
-        for scene in scenes:
-            try:
-                out.append((simulate_batch([scene], numerics).iloc[0].to_dict(), None))
-            except Exception as exc:  # noqa: BLE001 - recorded as the row's status
-                out.append((None, f"{type(exc).__name__}: {exc}"))
-        return out
-    records = df.to_dict("records")
-    out: list = [None] * len(scenes)
-    for pos, i in enumerate(order):
-        out[i] = (records[pos], None)
-    return out
-
-
-def _guard_nan(cols: dict, status: list, error: list, vc0_zero: np.ndarray) -> None:
-    """NaN only with a status that explains it: a NaN that no status explains
-    turns its row into ``non_finite`` (all outputs NaN) with a message."""
-    for k, st in enumerate(status):
-        if st not in FINISHED:
-            continue
-        bad = [c for c, v in cols.items()
-               if c not in ("row",) + _LABELS and not isinstance(v, list)
-               and np.isnan(v[k])
-               and not (c in _TANGENTIAL and vc0_zero[k])]
-        if bad:
-            status[k] = "non_finite"
-            error[k] = f"NaN in {', '.join(bad)} of a row with status {st!r}"
-            for c in _OUTPUTS:
-                cols[c][k] = np.nan
-
-
-# ---- files ------------------------------------------------------------------
-
-def _meta(values: dict[str, str]) -> dict[bytes, bytes]:
-    return {(META_PREFIX + k).encode(): str(v).encode() for k, v in values.items()}
-
-
-def _fsync_dir(path: Path) -> None:
-    try:
-        fd = os.open(path, os.O_RDONLY)
-    except OSError:  # pragma: no cover - not possible on every platform
-        return
-    try:
-        os.fsync(fd)
-    except OSError:  # pragma: no cover
-        pass
-    finally:
-        os.close(fd)
-
-
-def _write_atomic(table: pa.Table, path: Path) -> None:
-    """Write ``table`` to ``path``: a temporary file in the same directory,
-    fsync, ``os.replace``, fsync of the directory."""
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    try:
-        with open(tmp, "wb") as f:
-            pq.write_table(table, f)
-            f.flush()
-            os.fsync(f.fileno())
-        os.replace(tmp, path)
-    finally:
-        if tmp.exists():
-            tmp.unlink()
-    _fsync_dir(path.parent)
-
-
-def parts_dir(out) -> Path:
-    """Directory of the finished chunks of a run writing ``out``."""
-    out = Path(out)
-    return out.with_name(out.name + ".parts")
-
-
-def _part_path(parts: Path, chunk: int) -> Path:
-    return parts / f"part-{chunk:05d}.parquet"
-
-
-def _existing_parts(spec: SweepSpec, parts: Path) -> dict[int, Path]:
-    """Finished chunks in ``parts``; refuses parts of another sweep."""
-    found = {}
-    for tmp in parts.glob(".*.tmp"):  # a write cut short (kill -9)
-        tmp.unlink()
-    for path in sorted(parts.glob("part-*.parquet")):
-        try:
-            meta = pq.read_schema(path).metadata or {}
-        except Exception:  # noqa: BLE001 - an unreadable part is computed again
-            print(f"vimpact sweep: {path} is unreadable; computing it again", file=sys.stderr)
-            path.unlink()
-            continue
-        got = meta.get((META_PREFIX + "sweep_hash").encode(), b"").decode()
-        if got != spec.sweep_hash:
-            raise ValueError(
-                f"{path} belongs to another sweep (a different spec, numerics or vimpact "
-                f"version: hash {got[:12] or 'missing'} != {spec.sweep_hash[:12]}); "
-                f"remove {parts} to start over")
-        chunk = int(meta[(META_PREFIX + "chunk").encode()])
-        if path != _part_path(parts, chunk) or chunk >= spec.n_chunks:
-            raise ValueError(f"{path} does not fit this sweep (chunk {chunk}); "
-                             f"remove {parts} to start over")
-        found[chunk] = path
-    return found
-
-
-def run_sweep(spec_path, out=None, resume: bool = False,
-              progress: Callable[[int, int], None] | None | bool = None) -> Path:
-    """Run the sweep of a TOML specification and write its Parquet table.
-
-    Parameters
-    ----------
-    spec_path : the specification (format: module docstring)
-    out : output path (relative to the current directory); default the spec's
-        ``output`` (relative to the spec's directory)
-    resume : continue an interrupted run: compute only the chunks missing in
-        ``<out>.parts/``. Without it, existing parts are an error.
-    progress : ``None`` (default) shows a tqdm bar with rate and ETA on a
-        terminal (quiet when stderr is not a TTY or ``CI`` is set); a callable
-        is called as ``progress(rows_done, rows_total)`` after every chunk
-        written instead; ``False`` shows nothing.
-
-    Returns
-    -------
-    The path of the table.
-
-    Raises
-    ------
-    ValueError
-        for a bad spec, parts of another run, or parts without ``resume``.
-    SweepInterrupted
-        (a ``KeyboardInterrupt``) on Ctrl-C: finished chunks stay in
-        ``<out>.parts/``; the message says how to resume.
-    """
-    spec = load_spec(spec_path)
-    out = Path(out) if out is not None else spec.output
-    parts = parts_dir(out)
-    for stale in out.parent.glob(f".{out.name}.*.tmp"):  # a final write cut short
-        stale.unlink()
-    done: dict[int, Path] = {}
-    if parts.exists():
-        if not parts.is_dir():
-            raise ValueError(f"{parts} is in the way: it should be the directory of the "
-                             "finished chunks; remove it")
-        done = _existing_parts(spec, parts)
-        if done and not resume:
-            raise ValueError(
-                f"{parts} holds {len(done)} finished chunk(s) of an earlier run: use --resume "
-                f"(resume=True) to continue it, or remove {parts} to start over")
-    elif resume and out.exists() and _is_complete(spec, out):
-        return out
-    parts.mkdir(parents=True, exist_ok=True)
-
-    params = spec.parameters()
-    todo = [c for c in range(spec.n_chunks) if c not in done]
-    total = spec.rows
-    rows_done = sum(_chunk_rows(spec, c) for c in done)
-    bar = _bar(spec, total, rows_done) if progress is None else None
-    try:
-        for chunk in todo:
-            start, stop = chunk * spec.chunk_size, min(total, (chunk + 1) * spec.chunk_size)
-            table = compute_chunk(spec, params, start, stop)
-            meta = {**spec.metadata(), "chunk": str(chunk), "row_start": str(start),
-                    "row_stop": str(stop), "n_chunks": str(spec.n_chunks)}
-            _write_atomic(table.replace_schema_metadata(_meta(meta)), _part_path(parts, chunk))
-            done[chunk] = _part_path(parts, chunk)
-            rows_done += stop - start
-            if bar is not None:
-                bar.update(stop - start)
-            elif callable(progress):
-                progress(rows_done, total)
-        if bar is not None:
-            bar.close()
-            bar = None
-        _combine(spec, parts, out)
-    except KeyboardInterrupt:
-        if bar is not None:
-            bar.close()
-        hint = f"vimpact sweep {spec_path}" + (f" --out {out}" if out != spec.output else "")
-        raise SweepInterrupted(
-            f"interrupted: {len(done)} of {spec.n_chunks} chunks are saved in {parts}; "
-            f"resume with: {hint} --resume", parts, len(done), spec.n_chunks) from None
-    return out
-
-
-def _chunk_rows(spec: SweepSpec, chunk: int) -> int:
-    return min(spec.rows, (chunk + 1) * spec.chunk_size) - chunk * spec.chunk_size
-
-
-def _is_complete(spec: SweepSpec, out: Path) -> bool:
-    try:
-        meta = pq.read_schema(out).metadata or {}
-    except Exception:  # noqa: BLE001
-        return False
-    return meta.get((META_PREFIX + "sweep_hash").encode(), b"").decode() == spec.sweep_hash
-
-
-def _combine(spec: SweepSpec, parts: Path, out: Path) -> None:
-    tables = [pq.read_table(_part_path(parts, c)) for c in range(spec.n_chunks)]
-    table = pa.concat_tables([t.replace_schema_metadata(None) for t in tables])
-    rows = table.column("row").to_numpy()
-    if len(rows) != spec.rows or not np.array_equal(rows, np.arange(spec.rows)):
-        raise ValueError(f"{parts}: the parts do not add up to rows 0..{spec.rows - 1}; "
-                         f"remove {parts} to start over")
-    out.parent.mkdir(parents=True, exist_ok=True)
-    meta = {**spec.metadata(), "paths": json.dumps(_paths_explained(spec, table))}
-    _write_atomic(table.replace_schema_metadata(_meta(meta)), out)
-    shutil.rmtree(parts)
-
-
-def _paths_explained(spec: SweepSpec, table: pa.Table) -> dict:
-    """Each kernel path of the table: its row count and why it ran (from its first row)."""
-    names = table.column("path").to_pylist()
-    params = spec.parameters()
-    out: dict = {}
-    for i, name in enumerate(names):
-        if name is None:
-            continue
-        if name not in out:
-            reasons = choose_path(spec.scene(params, i), spec.numerics).reasons
-            out[name] = {"rows": 0, "first_row": i, "reasons": list(reasons)}
-        out[name]["rows"] += 1
-    return out
-
-
-def _bar(spec: SweepSpec, total: int, initial: int):
-    quiet = not sys.stderr.isatty() or bool(os.environ.get("CI"))
-    if quiet:
-        return None
-    from tqdm import tqdm
-    try:
-        sized = os.get_terminal_size(sys.stderr.fileno()).columns > 0
-    except (OSError, ValueError, AttributeError):
-        sized = False
-    # a terminal that reports no size (0 x 0) would get no bar at all
-    return tqdm(total=total, initial=initial, unit="row", desc=spec.path.stem,
-                file=sys.stderr, dynamic_ncols=sized, ncols=None if sized else 100,
-                nrows=None if sized else 24, smoothing=0.1)
-
-
-def read_metadata(path) -> dict:
-    """The sweep metadata of a table (or part) at ``path``, keys without the
-    ``vimpact.`` prefix; ``numerics``, ``units``, ``columns``, ``statuses``,
-    ``paths`` (kernel path -> rows and reasons) and ``rotation`` decoded from JSON, ``schema_version``, ``seed`` and ``rows`` as ints."""
-    raw = pq.read_schema(path).metadata or {}
-    meta = {k.decode()[len(META_PREFIX):]: v.decode() for k, v in raw.items()
-            if k.decode().startswith(META_PREFIX)}
-    for key in ("numerics", "units", "columns", "statuses", "paths", "rotation"):
-        if key in meta:
-            meta[key] = json.loads(meta[key])
-    for key in ("schema_version", "seed", "rows", "chunk", "row_start", "row_stop", "n_chunks"):
-        if key in meta:
-            meta[key] = int(meta[key])
-    return meta
-
-
-def summary(path) -> dict[str, int]:
-    """Number of rows per status in the table at ``path``."""
-    status = pq.read_table(path, columns=["status"]).column("status").to_pylist()
-    counts: dict[str, int] = {}
-    for s in status:
-        counts[s] = counts.get(s, 0) + 1
-    return counts
-
-
-__all__ = ["COLUMNS", "Draw", "SCHEMA_VERSION", "SWEEP_STATUSES", "SweepInterrupted",
-           "SweepSpec", "compute_chunk", "load_spec", "parts_dir", "read_metadata",
-           "run_sweep", "summary"]
+__all__ = ["COLUMNS", "Draw", "FILE_LAYOUT_MAX_ROWS", "LAYOUTS", "MAX_ROWS", "OUTPUTS",
+           "SCHEMA_VERSION", "SWEEP_STATUSES", "SweepSpec", "load_spec"]

@@ -1,0 +1,215 @@
+"""TOML input rules shared by sweep specifications and scene files.
+
+One place for what both formats accept, so that the two cannot drift apart:
+
+- :class:`TomlSource`: error messages that name the file and the key (one line,
+  ``ValueError``);
+- :func:`read_toml`, :func:`parse_toml`: the file's text and content;
+- :func:`parse_header`: the top-level keys both share (``model``,
+  ``description``, ``tangential_memory``, ``tangential``, ``rotation``);
+- :func:`parse_numerics`: a ``[numerics]`` table (or a preset name);
+- the physical value keys (:data:`MATERIAL_KEYS`, :data:`SPHERE_KEYS`,
+  :data:`PHYSICAL_DEFAULTS`, :data:`ARM_KEYS`), named like the table columns
+  with their unit as suffix (``E_Pa``, ``eta_Pa_s``, ``R_m``, ``m_kg``,
+  ``v_z0_m_s``, ``v_x0_m_s``, ``omega0_rad_s``, ``theta_ratio``, arms
+  ``G_Pa`` and ``tau_s``);
+- :func:`scene_from_values`: one :class:`~vimpact.model.scene.Scene` from
+  such named values (a scene file; one row of a sweep when it is explained).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import tomllib
+from pathlib import Path
+from typing import NamedTuple
+
+from vimpact.model.material import MODELS, Material
+from vimpact.model.numerics import PRESETS, Numerics
+from vimpact.model.scene import TANGENTIAL_EFFECTS, TANGENTIAL_MEMORY, Scene
+
+#: Material keys per model (Pa, Pa s).
+MATERIAL_KEYS = {
+    "elastic": ("E_Pa", "G_Pa"),
+    "kelvin_voigt": ("E_Pa", "G_Pa", "eta_Pa_s"),
+    "standard_solid": ("G1_Pa", "G2_Pa", "eta_Pa_s"),
+    "prony": ("G_Pa", "eta_Pa_s"),
+}
+#: Sphere and initial-velocity keys (m, kg, m/s, m/s, rad/s).
+SPHERE_KEYS = ("R_m", "m_kg", "v_z0_m_s", "v_x0_m_s", "omega0_rad_s")
+#: Defaults of the optional physical keys (``eta_Pa_s``: optional for Prony only).
+PHYSICAL_DEFAULTS = {"v_x0_m_s": 0.0, "omega0_rad_s": 0.0, "theta_ratio": 0.4}
+#: Keys of one Maxwell arm of a Prony series (Pa, s).
+ARM_KEYS = ("G_Pa", "tau_s")
+#: Top-level keys of a sweep specification.
+SWEEP_TOP_KEYS = ("model", "description", "seed", "chunk_size", "output", "layout",
+                  "tangential_memory", "tangential", "rotation", "numerics", "random", "grid")
+#: Keys of a ``[numerics]`` table.
+NUMERICS_KEYS = ("preset",) + tuple(f.name for f in dataclasses.fields(Numerics))
+
+
+def physical_keys(model: str) -> tuple[str, ...]:
+    """Physical value keys of ``model`` in their fixed order: material, sphere,
+    ``nu``, ``theta_ratio`` (arms separately)."""
+    return MATERIAL_KEYS[model] + SPHERE_KEYS + ("nu", "theta_ratio")
+
+
+def required_keys(model: str) -> tuple[str, ...]:
+    """Keys that must be given (besides one of ``E_Pa`` / ``G_Pa`` for elastic and
+    Kelvin-Voigt)."""
+    if model == "prony":
+        return ("G_Pa", "R_m", "m_kg", "v_z0_m_s", "nu")
+    return tuple(k for k in MATERIAL_KEYS[model] if k not in ("E_Pa", "G_Pa")) + \
+        ("R_m", "m_kg", "v_z0_m_s", "nu")
+
+
+def is_number(x) -> bool:
+    """A TOML integer or float (not a bool)."""
+    return isinstance(x, (int, float)) and not isinstance(x, bool)
+
+
+class TomlSource:
+    """A TOML input being read: error messages that name the file and the key."""
+
+    def __init__(self, path):
+        self.path = path
+
+    def error(self, key: str, message: str) -> ValueError:
+        return ValueError(f"{self.path}: {key}: {message}")
+
+    def bad(self, key: str, value, allowed: str) -> ValueError:
+        return ValueError(f"{self.path}: {key} = {value!r} is not allowed: must be {allowed}")
+
+    def unknown(self, table: dict, allowed, where: str = "") -> None:
+        for key in table:
+            if key not in allowed:
+                name = f"{where}.{key}" if where else key
+                raise ValueError(f"{self.path}: unknown key {name!r} (allowed: "
+                                 f"{', '.join(allowed)})")
+
+    def number(self, key: str, value, check=None, allowed="a finite number") -> float:
+        if not is_number(value) or not math.isfinite(value) or (check and not check(value)):
+            raise self.bad(key, value, allowed)
+        return float(value)
+
+    def integer(self, key: str, value, minimum: int) -> int:
+        if not isinstance(value, int) or isinstance(value, bool) or value < minimum:
+            raise self.bad(key, value, f"an integer >= {minimum}")
+        return value
+
+    def choice(self, data: dict, key: str, choices, default: str) -> str:
+        value = data.get(key, default)
+        if value not in choices:
+            raise self.bad(key, value, "one of " + ", ".join(map(repr, choices)))
+        return value
+
+    def flag(self, data: dict, key: str, default: bool) -> bool:
+        value = data.get(key, default)
+        if not isinstance(value, bool):
+            raise self.bad(key, value, "true or false")
+        return value
+
+
+def read_toml(path: Path, what: str) -> tuple[str, dict]:
+    """Text and parsed content of the TOML file ``path`` (``what`` names it in errors)."""
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise ValueError(f"{path}: {what} not found") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ValueError(f"{path}: cannot read the {what}: {exc}") from None
+    return text, parse_toml(TomlSource(path), text)
+
+
+def parse_toml(source: TomlSource, text: str) -> dict:
+    """The content of the TOML ``text``; ``ValueError`` naming ``source`` if it is not TOML."""
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ValueError(f"{source.path}: not valid TOML: {exc}") from None
+
+
+class Header(NamedTuple):
+    """The top-level keys a sweep spec and a scene file share."""
+
+    model: str
+    description: str
+    tangential_memory: str
+    tangential: str
+    rotation: bool
+
+
+def parse_header(source: TomlSource, data: dict) -> Header:
+    """``model`` (required), ``description``, ``tangential_memory``, ``tangential``, ``rotation``."""
+    model = data.get("model")
+    if model is None:
+        raise source.error("model", f"missing (one of {', '.join(MODELS)})")
+    if model not in MODELS:
+        raise source.bad("model", model, "one of " + ", ".join(map(repr, MODELS)))
+    description = data.get("description", "")
+    if not isinstance(description, str):
+        raise source.bad("description", description, "a string")
+    return Header(model, description,
+                  source.choice(data, "tangential_memory", TANGENTIAL_MEMORY, "incremental"),
+                  source.choice(data, "tangential", TANGENTIAL_EFFECTS, "auto"),
+                  source.flag(data, "rotation", True))
+
+
+def parse_numerics(source: TomlSource, table) -> Numerics:
+    """A ``[numerics]`` table: ``preset`` (default ``"default"``) then overrides of any
+    field of :class:`~vimpact.model.numerics.Numerics`; a string is a preset name."""
+    if isinstance(table, str):
+        table = {"preset": table}
+    if not isinstance(table, dict):
+        raise source.bad("numerics", table, "a table (or a preset name)")
+    source.unknown(table, NUMERICS_KEYS, "numerics")
+    preset = table.get("preset", "default")
+    if preset not in PRESETS:
+        raise source.bad("numerics.preset", preset, "one of " + ", ".join(map(repr, PRESETS)))
+    numerics = PRESETS[preset]
+    for key, value in table.items():
+        if key == "preset":
+            continue
+        try:
+            numerics = numerics.with_(**{key: value})
+        except ValueError as exc:
+            raise ValueError(f"{source.path}: numerics.{exc}") from None
+    return numerics
+
+
+def scene_from_values(model: str, values: dict, arms=(), *, tangential_memory="incremental",
+                      tangential="auto", rotation=True, allow_large_contact=False) -> Scene:
+    """The scene of one set of named physical values.
+
+    Parameters
+    ----------
+    model : one of ``vimpact.MODELS``
+    values : key -> number, keys of :func:`physical_keys` (missing optional keys take
+        :data:`PHYSICAL_DEFAULTS`; ``eta_Pa_s`` defaults to 0 for Prony)
+    arms : Prony series: ``[(G_Pa, tau_s), ...]``
+
+    Raises ``ValueError`` (``InputError``) for an invalid combination.
+    """
+    p = {**PHYSICAL_DEFAULTS, **{k: float(v) for k, v in values.items()}}
+    nu = p["nu"]
+    if model == "standard_solid":
+        mat = Material.standard_solid(nu=nu, G1=p["G1_Pa"], G2=p["G2_Pa"], eta=p["eta_Pa_s"])
+    elif model == "prony":
+        mat = Material.prony(nu=nu, G_inf=p["G_Pa"], arms=list(arms),
+                             eta0=p.get("eta_Pa_s", 0.0))
+    elif model == "kelvin_voigt":
+        mat = Material.kelvin_voigt(nu=nu, eta=p["eta_Pa_s"], G=p.get("G_Pa"), E=p.get("E_Pa"))
+    else:
+        mat = Material.elastic(nu=nu, G=p.get("G_Pa"), E=p.get("E_Pa"))
+    R, m = p["R_m"], p["m_kg"]
+    return Scene(mat, R=R, m=m, v_z0=p["v_z0_m_s"], v_x0=p["v_x0_m_s"], omega0=p["omega0_rad_s"],
+                 Theta=p["theta_ratio"] * m * R**2, tangential_memory=tangential_memory,
+                 allow_large_contact=allow_large_contact, tangential=tangential,
+                 rotation=rotation)
+
+
+__all__ = ["ARM_KEYS", "Header", "MATERIAL_KEYS", "NUMERICS_KEYS", "PHYSICAL_DEFAULTS",
+           "SPHERE_KEYS", "SWEEP_TOP_KEYS", "TomlSource", "is_number", "parse_header",
+           "parse_numerics", "parse_toml", "physical_keys", "read_toml", "required_keys",
+           "scene_from_values"]

@@ -1,0 +1,377 @@
+"""Run a sweep: chunks computed in-process, as shards, or as tasks on a Dask cluster.
+
+Backends (:func:`run_sweep`):
+
+- in-process (default): chunk after chunk, each one parallel batch over the
+  numba threads (``prange``);
+- ``workers=N``: a ``dask.distributed.LocalCluster`` of ``N`` worker processes
+  with one thread each on this machine (``NUMBA_NUM_THREADS=1`` in their
+  environment before numba loads); ``scheduler=ADDRESS``: a running cluster.
+  Each chunk is a task that writes its own part file atomically and returns
+  only a small summary. The kernels the spec needs are compiled once in this
+  process first, so that the workers load them from numba's cache;
+- ``shard=(I, N)``: only the chunks ``c % N == I`` (e.g. one SLURM array task
+  each); the parts stay; ``combine=True`` then checks that every chunk is there
+  and writes the table.
+
+Every backend writes the same part files (:mod:`vimpact.sweep.store`), so they
+can be mixed: a sweep started on a cluster can be resumed in-process, shards
+can be combined anywhere, and the table is the same bit for bit.
+
+Python API::
+
+    from vimpact.sweep import run_sweep
+    path = run_sweep("sweeps/kelvin_voigt_table.toml", out=None, resume=False,
+                     progress=None, workers=None, scheduler=None, shard=None,
+                     combine=False)            # -> Path of the table (or of the parts)
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+
+from vimpact.sweep import store
+from vimpact.sweep.progress import Progress
+from vimpact.sweep.spec import (LABELS, OUTPUTS, RELATIVE, RESULTS, TANGENTIAL_OUTPUTS, SweepSpec,
+                                 load_spec)
+
+
+class SweepInterrupted(KeyboardInterrupt):
+    """A sweep stopped by Ctrl-C (or a progress callback); finished chunks stay on disk."""
+
+    def __init__(self, message: str, parts_dir: Path, done: int, total: int):
+        super().__init__(message)
+        self.message, self.parts_dir, self.done, self.total = message, parts_dir, done, total
+
+    def __str__(self) -> str:
+        return self.message
+
+
+# ---- one chunk ---------------------------------------------------------------------
+
+def compute_chunk(spec: SweepSpec, chunk: int, timings: dict | None = None):
+    """Simulate the rows of ``chunk`` and return them as a ``pyarrow`` table.
+
+    Columnar: the chunk's parameters (:mod:`vimpact.sweep.parameters`) become scene
+    columns of :func:`vimpact.simulate_batch` and its result frame the table's
+    columns, with NumPy (no Python object per row). No row raises: an invalid
+    scene gets status ``invalid``, a batch that raises ``failed``, each with NaN
+    outputs and a message in ``error``. ``timings`` (a dict) receives
+    ``kernel_s`` and ``total_s`` summed over calls.
+    """
+    import pyarrow as pa
+
+    from vimpact.engine.result import FINISHED
+    from vimpact.engine.simulate import simulate_batch
+    from vimpact.sweep.parameters import engine_columns
+
+    start, stop = spec.chunk_rows(chunk)
+    n = stop - start
+    params = spec.chunk_parameters(chunk)
+    batches, inputs = engine_columns(spec, params)
+    cols: dict[str, np.ndarray] = {"row": np.arange(start, stop, dtype=np.int64)}
+    for c in spec.columns():
+        if c not in ("row",) + LABELS:
+            cols[c] = np.full(n, np.nan)
+    for key, values in {**params, **inputs}.items():
+        if key in cols:
+            cols[key][:] = values
+    status = np.full(n, "invalid", dtype=object)
+    error = np.full(n, None, dtype=object)
+    path = np.full(n, None, dtype=object)
+    for rows, scene_cols in batches:
+        if len(rows) == 0:
+            continue
+        try:
+            frame = simulate_batch(scene_cols, spec.numerics, timings=timings)
+        except Exception as exc:  # noqa: BLE001 - recorded as the rows' status
+            status[rows], error[rows] = "failed", f"{type(exc).__name__}: {exc}"
+            continue
+        st = frame["status"].to_numpy(dtype=object)
+        status[rows] = st
+        if "error" in frame:
+            err = frame["error"].to_numpy(dtype=object)
+            error[rows] = np.where(_isnull(err), None, err)
+        pth = frame["path"].to_numpy(dtype=object)
+        path[rows] = np.where(_isnull(pth), None, pth)
+        for name, source in RESULTS.items():
+            cols[name][rows] = frame[source].to_numpy(dtype=float)
+        valid = st != "invalid"
+        if spec.mode == "random" and spec.model != "prony":
+            cols["Q1"][rows] = frame["Q1"].to_numpy(dtype=float)
+            if spec.model == "standard_solid":
+                cols["Q2"][rows] = frame["Q2"].to_numpy(dtype=float)
+            else:
+                cols["Q2"][rows] = np.where(valid, 0.0, np.nan)  # the Kelvin-Voigt limit G2 -> inf
+        if spec.mode == "grid" and spec.model == "elastic":
+            cols["Q1"][rows] = np.where(valid, 0.0, np.nan)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        for name, (num, den) in RELATIVE.items():
+            cols[name] = cols[num] / cols[den]
+    if spec.mode == "random":
+        vc0 = params["v_x0_m_s"] + params["R_m"] * params["omega0_rad_s"]
+    else:
+        vc0 = np.ones(n)
+    guard_nan(cols, status, error, (vc0 == 0.0) | (spec.tangential == "none"),
+              np.isin(status, list(FINISHED)))
+    labels = {"path": path, "status": status, "error": error}
+    schema = spec.schema()
+    arrays = [pa.array(labels[c] if c in labels else cols[c], type=f.type)
+              for c, f in zip(spec.columns(), schema)]
+    return pa.Table.from_arrays(arrays, schema=schema)
+
+
+def _isnull(values: np.ndarray) -> np.ndarray:
+    import pandas as pd
+    return pd.isna(values)
+
+
+def guard_nan(cols: dict, status: np.ndarray, error: np.ndarray, vc0_zero: np.ndarray,
+              finished: np.ndarray) -> None:
+    """NaN only with a status that explains it: a finished row with a NaN output that no
+    status explains (``e_x``, ``beta_x`` are NaN when ``v_c0 = 0``) becomes
+    ``non_finite`` with all outputs NaN and the columns named in ``error``."""
+    explained = np.broadcast_to(np.asarray(vc0_zero, dtype=bool), finished.shape)
+    nothing = np.zeros(finished.shape, dtype=bool)
+    bad_cols = {c: np.isnan(cols[c]) & finished
+                & ~(explained if c in TANGENTIAL_OUTPUTS else nothing) for c in OUTPUTS}
+    bad = np.logical_or.reduce(list(bad_cols.values()))
+    for k in np.flatnonzero(bad):  # rare: the message names this row's columns
+        names = ", ".join(c for c, m in bad_cols.items() if m[k])
+        error[k] = f"NaN in {names} of a row with status {status[k]!r}"
+    status[bad] = "non_finite"
+    for c in OUTPUTS:
+        cols[c][bad] = np.nan
+
+
+def chunk_summary(table) -> dict:
+    """The small summary a part stores and a task returns: rows per status (``counts``)
+    and rows and first row per kernel path (``paths``)."""
+    status = table.column("status").to_numpy(zero_copy_only=False)
+    names, counts = np.unique(status.astype(str), return_counts=True)
+    path = np.asarray(table.column("path").to_pylist(), dtype=object)
+    rows = table.column("row").to_numpy()
+    paths = {}
+    has = ~_isnull(path)
+    if has.any():
+        labels, first, count = np.unique(path[has].astype(str), return_index=True,
+                                         return_counts=True)
+        paths = {str(lab): {"rows": int(c), "first_row": int(rows[has][f])}
+                 for lab, f, c in zip(labels, first, count)}
+    return {"counts": {str(a): int(b) for a, b in zip(names, counts)}, "paths": paths}
+
+
+def explain_paths(spec: SweepSpec, first_rows: dict[str, int]) -> dict[str, list[str]]:
+    """Why each kernel path ran: the routing reasons of its first row."""
+    from vimpact.engine.routing import choose_path
+    out = {}
+    for name, row in first_rows.items():
+        chunk = row // spec.chunk_size
+        scene = spec.scene(spec.chunk_parameters(chunk), row - chunk * spec.chunk_size)
+        out[name] = list(choose_path(scene, spec.numerics).reasons)
+    return out
+
+
+def run_chunk(spec: SweepSpec, chunk: int, parts: str) -> dict:
+    """Compute ``chunk``, write its part file atomically, return its summary (a task)."""
+    table = compute_chunk(spec, chunk)
+    summary = chunk_summary(table)
+    store.write_part(spec, table, Path(parts), chunk, summary)
+    start, stop = spec.chunk_rows(chunk)
+    return {"chunk": chunk, "rows": stop - start, **summary}
+
+
+def _dask_task(spec: SweepSpec, chunk: int, parts: str) -> dict:
+    """:func:`run_chunk` on a Dask worker; reports the worker's numba threads."""
+    import numba
+    try:
+        from distributed import get_worker
+        per_worker = max(1, numba.config.NUMBA_NUM_THREADS // max(1, get_worker().state.nthreads))
+    except Exception:  # noqa: BLE001 - not on a worker (tests call it directly)
+        per_worker = numba.get_num_threads()
+    if numba.get_num_threads() > per_worker:  # a cluster we did not start: no oversubscription
+        numba.set_num_threads(per_worker)
+    out = run_chunk(spec, chunk, parts)
+    out["numba_threads"] = numba.get_num_threads()
+    out["pid"] = os.getpid()
+    return out
+
+
+# ---- the sweep ---------------------------------------------------------------------
+
+def run_sweep(spec_path, out=None, resume: bool = False,
+              progress: Callable[[int, int], None] | None | bool = None, *,
+              workers: int | None = None, scheduler: str | None = None,
+              shard: tuple[int, int] | None = None, combine: bool = False,
+              chunk_order=None) -> Path:
+    """Run the sweep of a TOML specification and write its Parquet table.
+
+    Parameters
+    ----------
+    spec_path : the specification (format: :mod:`vimpact.sweep.spec`)
+    out : output path (relative to the current directory); default the spec's
+        ``output`` (relative to the spec's directory). Must end in ``.parquet``.
+    resume : continue an interrupted run: compute only the chunks missing in the
+        parts. Without it, existing parts are an error.
+    progress : ``None`` (default) a bar on a terminal, a line every ~10 s otherwise
+        (:mod:`vimpact.sweep.progress`); a callable is called as
+        ``progress(rows_done, rows_total)`` after every chunk; ``False`` nothing.
+    workers : run the chunks as tasks on a new Dask ``LocalCluster`` of this many
+        single-threaded worker processes
+    scheduler : address of a running Dask scheduler to run the chunks on
+    shard : ``(I, N)``: compute only the chunks ``c % N == I`` and leave the parts
+    combine : only combine the parts into the table (every chunk must be there)
+    chunk_order : in-process only: the order to compute the chunks in (default
+        ascending); the table does not depend on it
+
+    Returns
+    -------
+    The path of the table (for ``shard``: of the parts directory).
+
+    Raises
+    ------
+    ValueError
+        for a bad spec or output, parts of another run, parts without ``resume``,
+        missing chunks at ``combine``, a second sweep into the same output.
+    SweepInterrupted
+        (a ``KeyboardInterrupt``) on Ctrl-C: finished chunks stay; the message
+        says how to resume.
+    """
+    spec = load_spec(spec_path)
+    out = Path(out) if out is not None else spec.output
+    layout = spec.table_layout
+    if workers is not None and scheduler is not None:
+        raise ValueError("give --workers or --scheduler, not both")
+    if workers is not None and workers < 1:
+        raise ValueError(f"--workers = {workers} is not allowed: must be an integer >= 1")
+    if shard is not None:
+        index, count = shard
+        if not (isinstance(index, int) and isinstance(count, int) and 0 <= index < count):
+            raise ValueError(f"--shard = {index}/{count} is not allowed: must be I/N with "
+                             "0 <= I < N")
+        if combine:
+            raise ValueError("give --shard or --combine, not both")
+    store.check_output(out, layout)
+    parts = store.parts_dir(out, layout)
+    if shard is not None:  # shards run side by side (SLURM array): no output lock
+        return _run(spec, spec_path, out, parts, True, progress, workers, scheduler, shard,
+                    False, chunk_order)
+    with store.OutputLock(out):
+        return _run(spec, spec_path, out, parts, resume, progress, workers, scheduler, None,
+                    combine, chunk_order)
+
+
+def _run(spec, spec_path, out, parts, resume, progress, workers, scheduler, shard, combine,
+         chunk_order) -> Path:
+    layout = spec.table_layout
+    store.remove_temporaries(out.parent, out.name)  # a final write cut short
+    if store.is_complete(spec, out) and (resume or combine or shard is not None):
+        return out
+    done: dict[int, Path] = {}
+    if parts.exists():
+        if not parts.is_dir():
+            raise ValueError(f"{parts} is in the way: it should be the directory of the "
+                             "finished chunks; remove it")
+        done = store.existing_parts(spec, parts)
+        if done and not (resume or combine):
+            raise ValueError(
+                f"{parts} holds {len(done)} finished chunk(s) of an earlier run: use --resume "
+                f"(resume=True) to continue it, or remove {parts} to start over")
+        if layout == "dataset" and (parts / store.COMMON_METADATA).exists():
+            (parts / store.COMMON_METADATA).unlink()  # stale: rewritten at the end
+    if combine:
+        store.combine(spec, parts, out, lambda first: explain_paths(spec, first))
+        return out
+    parts.mkdir(parents=True, exist_ok=True)
+    todo = [c for c in range(spec.n_chunks) if c not in done]
+    if shard is not None:
+        todo = [c for c in todo if c % shard[1] == shard[0]]
+    if chunk_order is not None:
+        order = [int(c) for c in chunk_order]
+        todo = [c for c in order if c in set(todo)]
+    rows_done = sum(spec.chunk_rows(c)[1] - spec.chunk_rows(c)[0] for c in done)
+    bar = Progress(spec.rows, rows_done, spec.path.stem, progress)
+    finished = False
+    try:
+        if workers is not None or scheduler is not None:
+            _run_dask(spec, todo, parts, bar, done, workers, scheduler)
+        else:
+            for chunk in todo:
+                table = compute_chunk(spec, chunk)
+                store.write_part(spec, table, parts, chunk, chunk_summary(table))
+                done[chunk] = store.part_path(parts, chunk, spec.n_chunks)
+                start, stop = spec.chunk_rows(chunk)
+                bar.update(stop - start)
+        finished = True
+        bar.close()
+        if shard is not None:
+            return parts
+        store.combine(spec, parts, out, lambda first: explain_paths(spec, first))
+    except KeyboardInterrupt:
+        bar.close(finished)
+        hint = f"vimpact sweep {spec_path}" + (f" --out {out}" if out != spec.output else "")
+        raise SweepInterrupted(
+            f"interrupted: {len(done)} of {spec.n_chunks} chunks are saved in {parts}; "
+            f"resume with: {hint} --resume", parts, len(done), spec.n_chunks) from None
+    return out
+
+
+def warm_kernels(spec: SweepSpec, rows_per_chunk: int = 2, chunks: int = 4) -> None:
+    """Compile (or load from numba's cache) the kernels the spec needs, in this process:
+    a few rows of a few chunks spread over the sweep, so that workers find them cached."""
+    from vimpact.engine.simulate import simulate_batch
+    from vimpact.sweep.parameters import engine_columns
+
+    picks = np.unique(np.linspace(0, spec.n_chunks - 1, min(chunks, spec.n_chunks)).astype(int))
+    for chunk in picks:
+        params = spec.chunk_parameters(int(chunk))
+        params = {k: v[:rows_per_chunk] for k, v in params.items()}
+        for _, cols in engine_columns(spec, params)[0]:
+            try:
+                simulate_batch(cols, spec.numerics)
+            except Exception:  # noqa: BLE001 - the task will record it
+                pass
+
+
+def _run_dask(spec, todo, parts, bar, done, workers, scheduler) -> None:
+    """Chunks as tasks on a Dask cluster, at most a few per worker in flight."""
+    try:
+        from distributed import Client, LocalCluster, as_completed
+    except ImportError:
+        raise ValueError("--workers / --scheduler need Dask: pip install 'vimpact[dask]'") \
+            from None
+    warm_kernels(spec)
+    cluster = None
+    if workers is not None:
+        cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
+                               env={"NUMBA_NUM_THREADS": "1"}, dashboard_address=None)
+        client = Client(cluster)
+    else:
+        client = Client(scheduler)
+    try:
+        slots = 4 * max(1, sum(client.nthreads().values()))
+        pending = iter(todo)
+        futures = as_completed()
+        for chunk in pending:
+            futures.add(client.submit(_dask_task, spec, chunk, str(parts), pure=False))
+            if futures.count() >= slots:
+                break
+        for future in futures:
+            result = future.result()
+            done[result["chunk"]] = store.part_path(parts, result["chunk"], spec.n_chunks)
+            bar.update(result["rows"])
+            nxt = next(pending, None)
+            if nxt is not None:
+                futures.add(client.submit(_dask_task, spec, nxt, str(parts), pure=False))
+    finally:
+        client.close()
+        if cluster is not None:
+            cluster.close()
+
+
+__all__ = ["SweepInterrupted", "chunk_summary", "compute_chunk", "explain_paths", "guard_nan",
+           "run_chunk", "run_sweep", "warm_kernels"]
