@@ -1,0 +1,41 @@
+"""Shared by the linear spring-dashpot codes (Yade, MFiX): contact-point mass
+factor, Hertz-equivalent contact time and the tangential restitution of a
+linear contact in stick."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from vimpact.dem import laws
+from vimpact.dem.problem import Contact
+
+
+def mass_factor(contact: Contact) -> float:
+    """``F = 1 + m_eff (R1^2/Theta1 + R2^2/Theta2)`` at the nominal sizes: the
+    contact point moves ``F`` times faster than the centres under a tangential
+    force (3.5 for solid spheres), dimensionless."""
+    b1, b2 = contact.levels()[len(contact.levels()) // 2]
+    _, m = contact.nominal()
+    spin = b1.spin_compliance + (0.0 if contact.is_wall else b2.spin_compliance)
+    return 1.0 + m * spin
+
+
+def hertz_time(contact: Contact, speeds) -> float:
+    """Elastic Hertz contact time of the pair at the nominal sizes and the
+    geometric mean speed, s: the linear codes' (speed-independent) contact time."""
+    R, m = contact.nominal()
+    v = float(np.exp(np.mean(np.log(speeds))))
+    return float(laws.hertz_contact_time(contact.E_star, R, m, v))
+
+
+def tangential_beta(en: float, w_t: float, zeta_t: float) -> float:
+    """``beta`` of a linear contact that ends at zero overlap (normal restitution
+    ``en``) with a tangential oscillator ``w_t / omega0``, damping ratio ``zeta_t``."""
+    return laws.linear_spring_dashpot(laws.zeta_of_restitution(en), "overlap",
+                                      (w_t, zeta_t))[1]
+
+
+def ln2(e: float) -> float:
+    return math.log(e)**2 if e > 0 else math.inf

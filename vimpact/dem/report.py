@@ -1,0 +1,106 @@
+"""Report of a DEM export: vimpact's curves beside what the code will produce.
+
+A Markdown file (constants, residuals, what is not represented) and one PNG
+with a panel per contact: ``e_z(v)`` (and ``beta_x(v)`` where the code has a
+tangential restitution), vimpact as lines, the code's law with the exported
+constants as markers.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+
+from vimpact.dem.fit import ContactFit, Targets
+from vimpact.dem.problem import DemProblem
+
+
+def figure(code: str, problem: DemProblem, targets: dict[str, Targets],
+           fits: list[ContactFit], out: Path) -> Path:
+    """Write the comparison figure to ``out`` (PNG)."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    n = len(fits)
+    rows = 2 if any(f.beta_x is not None for f in fits) else 1
+    fig = Figure(figsize=(3.2 * n, 2.9 * rows), layout="constrained")
+    FigureCanvasAgg(fig)
+    axes = fig.subplots(rows, n, squeeze=False)
+    for k, f in enumerate(fits):
+        t = targets[f.contact.key]
+        ax = axes[0, k]
+        for lvl in np.unique(t.level):
+            sel = t.level == lvl
+            style = "-" if lvl == (int(t.level.max()) + 1) // 2 else "--"
+            ax.plot(t.v[sel], t.e_z[sel], style, color="C0",
+                    label="vimpact" if lvl == 0 else None)
+            ax.plot(t.v[sel], f.e_z[sel], "o", ms=3, mfc="none", color="C3",
+                    label=code if lvl == 0 else None)
+        ax.set_xscale("log")
+        ax.set_title(f"{f.contact.key}\nRMS {f.res_e_z.rms:.1e}", fontsize=8)
+        ax.set_xlabel("v_z0 [m/s]")
+        if k == 0:
+            ax.set_ylabel("e_z")
+            ax.legend(fontsize=7)
+        if rows == 2:
+            ax = axes[1, k]
+            if f.beta_x is not None and t.beta_x is not None:
+                ax.plot(t.v, t.beta_x, ".", color="C0", ms=3)
+                ax.plot(t.v, f.beta_x, "o", ms=3, mfc="none", color="C3")
+                ax.set_title(f"beta_x RMS {f.res_beta_x.rms:.1e}", fontsize=8)
+            else:
+                ax.text(0.5, 0.5, "beta_x not\nrepresented", ha="center", va="center",
+                        transform=ax.transAxes)
+            ax.set_xscale("log")
+            ax.set_xlabel("v_z0 [m/s]")
+            if k == 0:
+                ax.set_ylabel("beta_x")
+    fig.suptitle(f"vimpact vs {code} with the exported constants "
+                 "(dashed: ends of a size range)", fontsize=9)
+    fig.savefig(out, dpi=110)
+    return out
+
+
+def _fmt(x) -> str:
+    if isinstance(x, float):
+        return f"{x:.6g}" if math.isfinite(x) else str(x)
+    if isinstance(x, list):
+        return f"[{len(x)} values]"
+    return str(x)
+
+
+def markdown(code: str, problem: DemProblem, targets: dict[str, Targets],
+             fits: list[ContactFit], files: list[str], png: str) -> str:
+    """The report text."""
+    lines = [f"# vimpact dem: {code}", "",
+             f"Input: `{problem.source}`; normal impact speeds {problem.speeds.min():g} to "
+             f"{problem.speeds.max():g} m/s ({problem.speeds.size} points, log-spaced)"
+             + (f"; size levels min/nominal/max where a radius range is given" if any(
+                 len(t.radii) > 1 for t in problem.types) else "") + ".",
+             f"Written: {', '.join(f'`{x}`' for x in files)}.", "",
+             "Residual = code minus vimpact over all points (max |.|, RMS).", "",
+             "| contact | pair material | exported constants | e_z residual | beta_x residual |",
+             "|---|---|---|---|---|"]
+    for f in fits:
+        c = f.contact
+        mat = c.material
+        params = ", ".join(f"{k} = {_fmt(v)}" for k, v in f.params.items())
+        rb = str(f.res_beta_x) if f.res_beta_x is not None else "not represented"
+        lines.append(f"| {c.key} | {mat.model}, G_inf {mat.G_inf:.4g} Pa, nu {mat.nu:.3g} | "
+                     f"{params} | {f.res_e_z} | {rb} |")
+    lines += ["", "## Notes", ""]
+    for f in fits:
+        for note in f.notes:
+            lines.append(f"- {f.contact.key}: {note}")
+    half = {k: int(np.sum(t.status == "half_space")) for k, t in targets.items()}
+    for k, nbad in half.items():
+        if nbad:
+            lines.append(f"- {k}: {nbad} point(s) have a contact wider than 0.2 R "
+                         "(half-space model stretched; status half_space)")
+    if problem.angles_deg:
+        lines.append("- angles: under full stick beta_x does not depend on the impact angle; "
+                     "the DEM code's Coulomb limit (exported mu) takes over at grazing angles")
+    lines += ["", f"![vimpact vs {code}]({png})", ""]
+    return "\n".join(lines)
