@@ -32,6 +32,7 @@ extensions = [
     "sphinx.ext.autodoc",
     "sphinx.ext.napoleon",
     "cli_reference",
+    "optional_pages",
 ]
 
 source_suffix = {".md": "markdown"}

@@ -59,10 +59,18 @@ def _help(action: argparse.Action) -> str:
     return _escape(text) if text else "(no help text)"
 
 
+def _text(parser: argparse.ArgumentParser, text: str) -> list[str]:
+    """A description or epilog: a paragraph, or a literal block where the
+    parser keeps its own line breaks (``RawDescriptionHelpFormatter``)."""
+    if issubclass(parser.formatter_class, argparse.RawDescriptionHelpFormatter):
+        return ["```text", text.strip("\n"), "```", ""]
+    return [_escape(text), ""]
+
+
 def _section(parser: argparse.ArgumentParser, title: str, level: int) -> list[str]:
     out = [f"{'#' * level} `{title}`", "", "```text", _usage(parser), "```", ""]
     if parser.description:
-        out += [_escape(parser.description), ""]
+        out += _text(parser, parser.description)
     for group in parser._action_groups:
         actions = [a for a in group._group_actions
                    if a.help is not argparse.SUPPRESS
@@ -77,7 +85,7 @@ def _section(parser: argparse.ArgumentParser, title: str, level: int) -> list[st
         out += ["**subcommands**", ""]
         out += [f"- `{parser.prog} {name}`: {_escape(help_)}" for name, help_, _ in subs] + [""]
     if parser.epilog:
-        out += [_escape(parser.epilog), ""]
+        out += _text(parser, parser.epilog)
     for name, _, sub in subs:
         out += _section(sub, f"{parser.prog} {name}", min(level + 1, 4))
     return out
@@ -95,6 +103,12 @@ def _append_reference(app, docname: str, source: list[str]) -> None:
         source[0] = source[0].rstrip("\n") + "\n\n" + cli_markdown()
 
 
+def _always_reread(app, env, added, changed, removed) -> list[str]:
+    """The parsers change without the page changing: re-read it on every build."""
+    return [DOCNAME] if DOCNAME in env.found_docs else []
+
+
 def setup(app):
     app.connect("source-read", _append_reference)
+    app.connect("env-get-outdated", _always_reread)
     return {"version": "1", "parallel_read_safe": True, "parallel_write_safe": True}

@@ -5,8 +5,10 @@ Two kinds of example are executable, everything else in the Markdown is prose:
 * **shell examples**: a fenced block tagged ``text`` or ``console`` whose first
   line starts with ``$ ``. Every ``$ `` line must be a ``vimpact`` command (a
   trailing backslash continues it on the next line); the lines up to the next
-  ``$ `` line are its expected output (stdout and stderr, as a terminal shows
-  them). A block that shows a command without running it uses ``sh``.
+  ``$ `` line are its expected output (stdout, and stderr as well when the
+  command fails; a command that succeeds shows its stdout only, as
+  progress reports on stderr depend on the machine). A block that shows a
+  command without running it uses ``sh``.
 * **Python examples**: a fenced block tagged ``pycon`` with doctest-style
   ``>>>`` / ``...`` lines followed by the expected output. The ``pycon`` blocks
   of one file share one namespace and run in the order they appear.
@@ -273,16 +275,18 @@ def commands(block: Block) -> list[Command]:
 
 
 def run_command(argv: list[str]) -> str:
-    """Run ``vimpact ARGV`` in this process; stdout and stderr as one text."""
+    """Run ``vimpact ARGV`` in this process: its stdout, followed by its stderr
+    if it failed (exit code not 0). Progress reports on stderr of a command that
+    succeeds are not part of the example (they depend on the machine's speed)."""
     from vimpact.cli.main import main
 
-    buffer = io.StringIO()
-    with contextlib.redirect_stdout(buffer), contextlib.redirect_stderr(buffer):
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
         try:
-            main(argv)
-        except SystemExit:  # argparse: --help, --version, usage errors
-            pass
-    return buffer.getvalue()
+            code = main(argv)
+        except SystemExit as exc:  # argparse: --help, --version, usage errors
+            code = exc.code
+    return out.getvalue() + (err.getvalue() if code not in (0, None) else "")
 
 
 def run_shell_block(block: Block) -> list[tuple[Command, str]]:

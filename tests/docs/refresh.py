@@ -44,6 +44,10 @@ def _refresh_pycon(blocks: list[ex.Block]) -> dict[int, list[str]]:
                 lines = ex._lines(want)
             else:
                 lines = ex.refreshed(want, got)
+                if got.startswith("Traceback") and not want.startswith("Traceback"):
+                    print(f"warning: {block.path.relative_to(ex.ROOT)}:"
+                          f"{block.line + example.lineno}: the example now raises; "
+                          f"{ex._lines(got)[-1]}", file=sys.stderr)
             out += [(" " * example.indent) + line if line else line for line in lines]
             pos = example.lineno + n_src + len(ex._lines(want))
         new[block.start] = out + body[pos:]

@@ -1,0 +1,71 @@
+"""The examples in README.md and docs/ print what the code prints.
+
+Every shell example (``$ vimpact ...`` in a ``text``/``console`` block) and
+every doctest-style ``pycon`` block is run and its output compared with the
+block, numbers to their printed digits (rules: :mod:`tests.docs.examples`).
+After an intended change of numbers, ``python -m tests.docs.refresh`` rewrites
+the outputs; review the diff like any other change.
+"""
+
+from __future__ import annotations
+
+import pytest
+
+from tests.docs import examples as ex
+
+SHELL, PYCON = ex.executable_blocks()
+PYCON_FILES = sorted({b.path for b in PYCON})
+
+
+def test_the_documentation_has_examples():
+    """The README tour and the tutorial are executable (a renamed language tag would silently skip them)."""
+    where = {b.path.relative_to(ex.ROOT).as_posix() for b in SHELL + PYCON}
+    assert "README.md" in where
+    assert "docs/tutorial.md" in where
+
+
+@pytest.mark.parametrize("block", SHELL, ids=[b.where for b in SHELL])
+def test_shell_example(block):
+    failures = ex.shell_failures(block)
+    assert not failures, ("the output differs from the documentation (python -m "
+                          "tests.docs.refresh rewrites it):\n" + "\n".join(failures))
+
+
+@pytest.mark.parametrize("path", PYCON_FILES, ids=[p.relative_to(ex.ROOT).as_posix() for p in PYCON_FILES])
+def test_python_examples(path):
+    failures = ex.pycon_failures([b for b in PYCON if b.path == path])
+    assert not failures, ("the output differs from the documentation (python -m "
+                          "tests.docs.refresh rewrites it):\n" + "\n\n".join(failures))
+
+
+# --------------------------------------------------------------------------
+# the comparison itself
+# --------------------------------------------------------------------------
+
+@pytest.mark.parametrize("expected, got, same", [
+    ("  e_x                0.15243", "  e_x               0.152556 ", False),  # the old README
+    ("  e_x               0.152556", "  e_x               0.152557", True),   # last digit +-1
+    ("  e_x               0.152556", "  e_x               0.152558", False),
+    ("  t_contact   2.91101e-04 s", "  t_contact   2.91102e-04 s", True),
+    ("  t_contact   2.91101e-04 s", "  t_contact   2.91101e-04 m", False),    # text exactly
+    ("path continuum (44 steps)", "path continuum (45 steps)", False),      # integers exactly
+    ("vimpact 0.1.0: kelvin_voigt", "vimpact 0.1.1: kelvin_voigt", False),  # versions are text
+    ("wrote 306 rows in ... s", "wrote 306 rows in 1.2 s", True),
+    ("wrote 306 rows in ... s", "wrote 307 rows in 1.2 s", False),
+])
+def test_comparison_rules(expected, got, same):
+    assert ex.same_output(expected, got) is same
+
+
+def test_a_changed_number_in_the_code_fails_the_example(monkeypatch):
+    """Demonstration: the README's first example, run with the Hertz contact time
+    factor rounded the way the thesis rounds it (2.94 instead of 2.9432...),
+    no longer matches its block; unpatched it does (test_shell_example)."""
+    import vimpact.model.hertz as hertz
+
+    readme = [b for b in SHELL if b.path.name == "README.md"]
+    tour = next(b for b in readme if any("t_hertz" in line for line in b.body))
+    assert not ex.shell_failures(tour)
+    monkeypatch.setattr(hertz, "HERTZ_TIME_FACTOR", 2.94)
+    failures = ex.shell_failures(tour)
+    assert len(failures) == 1 and "t_hertz" in failures[0], failures
