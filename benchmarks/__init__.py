@@ -1,1 +1,3 @@
-"""Benchmarks: scripts that measure and write JSON and plots to benchmarks/results/."""
+"""Benchmarks of the repository: full-size runs of :mod:`vimpact.bench` (the
+same code as ``vimpact bench``) and other scripts; they write JSON and charts
+to ``benchmarks/results/``."""

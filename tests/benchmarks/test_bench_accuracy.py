@@ -7,7 +7,7 @@ import math
 import pytest
 
 import vimpact as v
-from benchmarks import accuracy
+from vimpact.bench import accuracy
 
 
 @pytest.fixture(scope="module")

@@ -8,8 +8,8 @@ import math
 import pytest
 
 import vimpact as v
-from benchmarks import scaling, throughput
-from benchmarks.pure_python import pure_python_impact
+from vimpact.bench import scaling, throughput
+from vimpact.bench.pure_python import pure_python_impact
 from vimpact.reference.numpy_elements import naive_impact
 
 SCENES = {
@@ -51,7 +51,10 @@ def _finite_positive(x):
 
 
 def test_throughput_quick(tmp_path):
-    throughput.main(["--quick", "--out", str(tmp_path)])
+    """Through the repository script (the same code as ``vimpact bench throughput``)."""
+    from benchmarks import throughput as script
+
+    script.main(["--quick", "--out", str(tmp_path)])
     assert (tmp_path / "throughput_quick.png").stat().st_size > 0
     data = json.loads((tmp_path / "throughput_quick.json").read_text())
     cfg, impls = data["config"], data["implementations"]
@@ -84,9 +87,11 @@ def test_throughput_quick(tmp_path):
 
 
 def test_scaling_quick(tmp_path):
-    scaling.main(["--quick", "--out", str(tmp_path)])
-    assert (tmp_path / "scaling_quick.png").stat().st_size > 0
-    data = json.loads((tmp_path / "scaling_quick.json").read_text())
+    from vimpact.bench.machine import run_and_write
+
+    run_and_write("scaling", scaling, True, tmp_path)
+    assert (tmp_path / "scaling.png").stat().st_size > 0
+    data = json.loads((tmp_path / "scaling.json").read_text())
     assert set(data["sweeps"]) == {"scenes", "elements", "steps"}
     for name, sweep in data["sweeps"].items():
         assert sweep["x"] == data["config"][name]

@@ -18,7 +18,7 @@ def test_paths_quick(tmp_path):
     """Each path runs; the specialized kernels give the general kernel's normal
     results exactly (same arithmetic, branches folded); the continuum path is
     the more accurate one at its setting."""
-    from benchmarks import paths
+    from vimpact.bench import paths
 
     data = paths.run(quick=True)
     paths.plot(data, tmp_path / "paths.png")

@@ -1,0 +1,87 @@
+"""The ``overhead`` and ``imports`` benchmarks and the ``vimpact bench NAME``
+command run end to end on a small configuration: files written, JSON keys
+(no time is asserted)."""
+
+import json
+import math
+
+import pytest
+
+from vimpact.bench import BENCHMARKS, imports, load, overhead
+from vimpact.cli.main import main
+
+FIGURE_KEYS = {"value", "unit", "better", "kind", "spread", "repeats"}
+
+
+def _check_common(data: dict, name: str) -> None:
+    assert data["benchmark"] == name and data["schema"] == 1 and data["quick"] is True
+    for key in ("cpu", "cores", "numba_threads", "python", "numpy", "numba", "vimpact"):
+        assert key in data["machine"]
+    assert data["figures"]
+    for f in data["figures"].values():
+        assert FIGURE_KEYS <= set(f) and f["kind"] in ("time", "accuracy")
+
+
+def test_registry_loads_every_benchmark():
+    for name in BENCHMARKS:
+        m = load(name)
+        assert callable(m.run) and callable(m.plot) and callable(m.figures) and m.TITLE
+
+
+def test_overhead_through_the_command(tmp_path, monkeypatch, capsys):
+    monkeypatch.setitem(overhead.CONFIGS, "quick", dict(kv_rows=2000, kv_repeats=2,
+                                                        element_rows=40, element_repeats=2))
+    assert main(["bench", "overhead", "--quick", "--out", str(tmp_path)]) == 0
+    out = capsys.readouterr().out
+    assert out.startswith("machine: ") and "continuum_overhead_us_per_row" in out
+    assert (tmp_path / "overhead.png").stat().st_size > 0
+    data = json.loads((tmp_path / "overhead.json").read_text())
+    _check_common(data, "overhead")
+    for key, rows, status in (("continuum", 2000, "normal_only"), ("elements", 40, "ok")):
+        d = data[key]
+        assert d["rows"] == rows and len(d["total_s"]) == len(d["kernel_s"]) == 2
+        assert all(t >= k > 0.0 for t, k in zip(d["total_s"], d["kernel_s"]))
+        assert d["statuses"] == {status: rows}
+    assert list(data["continuum"]["paths"]) == ["continuum[kelvin_voigt,normal]"]
+    assert all(p.startswith("elements[") and "tangential" in p for p in data["elements"]["paths"])
+    assert {"continuum_overhead_met", "element_overhead_met",
+            "kv_rows_per_second_met"} <= set(data["targets"])
+
+
+def test_overhead_columns_are_valid_kelvin_voigt_rows():
+    """The random rows are what the module says: ``a_H / R`` and ``Q1`` in
+    their ranges (checked through the package's own Hertz scales)."""
+    import numpy as np
+
+    from vimpact.model.hertz import Q1_PER_TAU, hertz_scales
+
+    c = overhead.scene_columns(500, seed=3)
+    hz = hertz_scales(c["G_inf_Pa"], c["nu"], c["R_m"], c["m_kg"], c["v_z0_m_s"])
+    a_over_R = hz.a_H / c["R_m"]
+    assert np.all((a_over_R > 0.003 * (1 - 1e-9)) & (a_over_R < 0.03 * (1 + 1e-9)))
+    Q1 = c["eta0_Pa_s"] / c["G_inf_Pa"] / hz.T * Q1_PER_TAU
+    assert np.all((Q1 >= 1e-3 * (1 - 1e-9)) & (Q1 <= 1.0 * (1 + 1e-9)))
+
+
+def test_imports(tmp_path, monkeypatch):
+    monkeypatch.setitem(imports.CONFIGS, "quick", dict(repeats=1))
+    monkeypatch.setattr(imports, "TARGETS", {"python": "pass", "vimpact": "import vimpact",
+                                             "vimpact.kernels.continuum_kv":
+                                             "import vimpact.kernels.continuum_kv"})
+    from vimpact.bench.machine import run_and_write
+
+    data, js, png = run_and_write("imports", imports, True, tmp_path)
+    assert png.stat().st_size > 0 and json.loads(js.read_text()) == data
+    _check_common(data, "imports")
+    t = data["targets"]
+    assert t["python"]["heavy"] == []
+    assert "numba" in t["vimpact.kernels.continuum_kv"]["heavy"]
+    for rec in t.values():
+        assert len(rec["wall_s"]) == 1 and math.isfinite(rec["median_wall_s"])
+    assert set(data["figures"]) == {"import_vimpact_s", "import_vimpact.kernels.continuum_kv_s",
+                                    "python_c_import_vimpact_wall_s"}
+
+
+def test_imports_probe_reports_a_failed_import():
+    with pytest.raises(RuntimeError, match="no_such_module"):
+        imports.probe("import no_such_module")

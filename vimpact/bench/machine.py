@@ -1,0 +1,229 @@
+"""What every benchmark shares: the machine it ran on, the median timer, the
+figures ``vimpact bench compare`` reads, JSON + figure output and progress.
+
+Every result file is a JSON object with
+
+- ``benchmark`` (its registry name), ``schema`` (:data:`SCHEMA`), ``quick``;
+- ``machine`` (:func:`machine_info`) and ``load_average`` where measured;
+- the benchmark's own data;
+- ``figures``: the headline numbers, name -> :func:`figure` record (value,
+  unit, which direction is better, ``time`` or ``accuracy``, the relative
+  spread over the repeats and their number). ``vimpact bench compare``
+  judges a change against that spread.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import platform
+import sys
+import time
+from collections.abc import Callable, Sequence
+from pathlib import Path
+
+import numpy as np
+
+#: version of the result-file layout (``benchmark``, ``figures``, ...)
+SCHEMA = 1
+
+
+# ------------------------------------------------------------------ machine
+def machine_info() -> dict:
+    """CPU model, cores, numba threads and the versions of Python, NumPy, numba
+    and vimpact (and the platform string)."""
+    import numba
+
+    import vimpact
+
+    cpu = platform.processor() or ""
+    try:
+        with open("/proc/cpuinfo") as f:
+            for line in f:
+                if line.startswith("model name"):
+                    cpu = line.split(":", 1)[1].strip()
+                    break
+    except OSError:
+        pass
+    return {
+        "cpu": cpu,
+        "cores": os.cpu_count(),
+        "numba_threads": numba.config.NUMBA_NUM_THREADS,
+        "python": platform.python_version(),
+        "numpy": np.__version__,
+        "numba": numba.__version__,
+        "vimpact": vimpact.__version__,
+        "platform": platform.platform(),
+    }
+
+
+def machine_line(info: dict) -> str:
+    """One line naming the machine of a result (:func:`machine_info`)."""
+    return (f"machine: {info.get('cpu') or 'unknown CPU'}, {info.get('cores')} cores, "
+            f"{info.get('numba_threads')} numba threads; python {info.get('python')}, "
+            f"numpy {info.get('numpy')}, numba {info.get('numba')}, "
+            f"vimpact {info.get('vimpact')}")
+
+
+def load_average() -> list[float]:
+    """1, 5 and 15 minute load averages (runnable processes): stored with the
+    times, since the machine may be shared."""
+    try:
+        return [round(x, 2) for x in os.getloadavg()]
+    except (AttributeError, OSError):  # not on every platform
+        return []
+
+
+# ------------------------------------------------------------------ timing
+def time_samples(fn: Callable[[], object], repeats: int) -> list[float]:
+    """Wall times of ``repeats`` calls of ``fn()``, s."""
+    times = []
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - t0)
+    return times
+
+
+def median_time(fn: Callable[[], object], repeats: int) -> float:
+    """Median wall time of ``fn()`` over ``repeats`` calls, s."""
+    return float(np.median(time_samples(fn, repeats)))
+
+
+def spread(samples: Sequence[float]) -> float | None:
+    """Relative spread of repeated measurements: half their range over their
+    median (``None`` for fewer than two samples or a zero median)."""
+    x = np.asarray([s for s in samples if s is not None], dtype=float)
+    x = x[np.isfinite(x)]
+    if len(x) < 2:
+        return None
+    med = float(np.median(x))
+    if med == 0.0:
+        return None
+    return float((x.max() - x.min()) / 2.0 / abs(med))
+
+
+def figure(value, unit: str, better: str = "lower", kind: str = "time",
+           samples: Sequence[float] | None = None, rel_spread: float | None = None,
+           note: str | None = None) -> dict:
+    """A headline number of a benchmark, as ``vimpact bench compare`` reads it.
+
+    Parameters
+    ----------
+    value : the median over the repeats (``None`` if not measured)
+    unit : its unit, e.g. ``"s"``, ``"us/row"``, ``"1/s"``, ``"-"``
+    better : ``"lower"`` or ``"higher"``
+    kind : ``"time"`` (speed: noisy, judged against the spread) or
+        ``"accuracy"`` (an error: deterministic up to rounding)
+    samples : the repeats the value is the median of (their spread is stored)
+    rel_spread : the relative spread, if known otherwise (overrides ``samples``)
+    """
+    if better not in ("lower", "higher") or kind not in ("time", "accuracy"):
+        raise ValueError(f"figure: better={better!r}, kind={kind!r} not allowed")
+    v = None if value is None else float(value)
+    if v is not None and not math.isfinite(v):
+        v = None
+    s = rel_spread if rel_spread is not None else (spread(samples) if samples else None)
+    rec = {"value": v, "unit": unit, "better": better, "kind": kind,
+           "spread": s, "repeats": len(samples) if samples else None}
+    if note:
+        rec["note"] = note
+    return rec
+
+
+def ratio_spread(*spreads: float | None) -> float | None:
+    """Relative spread of a product or ratio of measured numbers (in quadrature)."""
+    known = [s for s in spreads if s is not None]
+    return math.sqrt(sum(s * s for s in known)) if known else None
+
+
+# ------------------------------------------------------------------ output
+def progress(msg: str, start: float | None = None) -> None:
+    """A progress line on stderr (silenced by ``VIMPACT_BENCH_QUIET``), with
+    the seconds since ``start`` (a ``time.perf_counter()`` value) if given."""
+    if os.environ.get("VIMPACT_BENCH_QUIET") is not None:
+        return
+    if start is not None:
+        msg = f"[{time.perf_counter() - start:6.1f} s] {msg}"
+    print(msg, file=sys.stderr, flush=True)
+
+
+def save_figure(fig, path) -> None:
+    """Write ``fig`` to ``path`` (120 dpi) and close it."""
+    import matplotlib.pyplot as plt
+
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+def use_agg() -> None:
+    """Draw without a display (call before importing ``matplotlib.pyplot``)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+
+
+def _json_safe(x):
+    """``x`` with non-finite floats as ``None`` (strict JSON) and NumPy scalars as Python ones."""
+    if isinstance(x, dict):
+        return {str(k): _json_safe(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [_json_safe(v) for v in x]
+    if isinstance(x, np.ndarray):
+        return _json_safe(x.tolist())
+    if isinstance(x, (np.floating, float)):
+        x = float(x)
+        return x if math.isfinite(x) else None
+    if isinstance(x, np.integer):
+        return int(x)
+    if isinstance(x, np.bool_):
+        return bool(x)
+    return x
+
+
+def annotate(name: str, module, data: dict, quick: bool) -> dict:
+    """``data`` with ``benchmark``, ``schema``, ``quick`` and ``figures`` (from
+    ``module.figures(data)``) added, strict-JSON safe."""
+    figs = module.figures(data) if hasattr(module, "figures") else {}
+    head = {"benchmark": name, "schema": SCHEMA, "quick": bool(quick)}
+    body = {k: x for k, x in data.items() if k not in ("benchmark", "schema", "quick", "figures")}
+    return _json_safe({**head, **body, "figures": figs})
+
+
+def figures_table(figs: dict) -> str:
+    """The figures of a result as a short text table."""
+    if not figs:
+        return "(no figures)"
+    w = max(len(k) for k in figs)
+    lines = [f"{'figure':<{w}}  {'value':>11}  {'unit':<8} {'spread':>7}  better"]
+    for k, f in figs.items():
+        val = "n/a" if f["value"] is None else f"{f['value']:.4g}"
+        sp = "" if f.get("spread") is None else f"{100 * f['spread']:.1f}%"
+        lines.append(f"{k:<{w}}  {val:>11}  {f['unit']:<8} {sp:>7}  {f['better']}")
+    return "\n".join(lines)
+
+
+def run_and_write(name: str, module, quick: bool, out: Path, json_name: str | None = None,
+                  png_name: str | None = None, details: bool = False) -> tuple[dict, Path, Path]:
+    """Run benchmark ``module`` (``run(quick)``, ``plot(data, path)``,
+    ``figures(data)``), write ``out/json_name`` and ``out/png_name`` (default
+    ``NAME.json`` and ``NAME.png``), print the machine line and the figures
+    table (and ``module.report(data)`` with ``details``); returns the data and
+    both paths."""
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    start = time.perf_counter()
+    progress(f"{name}: {'quick' if quick else 'full'} run", start)
+    data = annotate(name, module, module.run(quick), quick)
+    json_path = out / (json_name or f"{name}.json")
+    png_path = out / (png_name or f"{name}.png")
+    json_path.write_text(json.dumps(data, indent=1, allow_nan=False))
+    module.plot(data, png_path)
+    print(machine_line(data.get("machine", {})))
+    if details and hasattr(module, "report"):
+        print(module.report(data))
+    print(figures_table(data["figures"]))
+    print(f"wrote {json_path} and {png_path} ({time.perf_counter() - start:.0f} s)")
+    return data, json_path, png_path
