@@ -126,3 +126,22 @@ def _to_stress(target, s0, p0, prow, g, E, omE, phi, tau0_dt):
     for i in range(g.shape[0]):
         prow[i] = E[i] * p0[i] + omE[i] * s0 + phi[i] * (s1 - s0)
     return s1
+
+
+@jit(inline="always")
+def _follow_value(w0, w1, qrow, g, E, omE, phi):
+    """``sum g_i (w1 - q_i)`` after the path ``w0 -> w1``, without changing the arms
+    (the trial force of an element that leaves contact within the step)."""
+    acc = 0.0
+    for i in range(g.shape[0]):
+        acc += g[i] * (w1 - (E[i] * qrow[i] + omE[i] * w0 + phi[i] * (w1 - w0)))
+    return acc
+
+
+@jit(inline="always")
+def _arm_stress(w, qrow, g):
+    """``sum g_i (w - q_i)``: the arms' part of the spring stress at ``w``."""
+    acc = 0.0
+    for i in range(g.shape[0]):
+        acc += g[i] * (w - qrow[i])
+    return acc

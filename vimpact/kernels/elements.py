@@ -53,8 +53,8 @@ from typing import NamedTuple
 import numpy as np
 from numba import prange
 
-from vimpact.kernels.arms import (_arm_coefficient, _follow, _follow_over, _free_rate, _relax,
-                                  _to_stress, arm_coefficients)
+from vimpact.kernels.arms import (_arm_coefficient, _arm_stress, _follow, _follow_over,
+                                  _follow_value, _free_rate, _relax, _to_stress, arm_coefficients)
 from vimpact.kernels.jit import jit
 from vimpact.kernels.layout import (  # noqa: F401 - re-exported: the kernels' common layout
     ELEMENT_STIFFNESS, EULER, N_OUT, N_REC, OUT_B_MAX, OUT_N_REC, OUT_STATUS, OUT_STEPS,
@@ -128,6 +128,8 @@ def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT, FRICTION,
     phi_e = np.empty(n_af)
     Cs = 0.0  # slipping elements: tangential force per unit normal velocity (mu f_n's dashpot)
     t_gross = 0.0
+    PARTIAL = INTEGRATOR == VERLET  # weigh partial contact within a step (see below)
+    ft = np.zeros(n_t if PARTIAL else 0)  # last tangential stress of each element in contact
     w_fric = 0.0
     slip_now = 0.0
 
@@ -187,12 +189,23 @@ def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT, FRICTION,
         n_slip = 0
         sum_slip_r = 0.0  # sum of sign * (normal spring part) over slipping elements
         sum_slip_sign = 0.0
+        # Verlet's step impulse is the trapezoid h/2 (F_start + F_end). An element in
+        # contact for only part of the step (leaving after a fraction alpha, or
+        # entering for the last fraction theta) instead contributes the integral
+        # of its force path over that part (linear in time); corr_n, corr_t are
+        # the end forces (/ k_el, / (k_el kappa)) that make the trapezoid equal
+        # it, added to the second half-kick only.
+        corr_n = 0.0
+        corr_t = 0.0
         j_outer = -1
         for j in range(active):
             w0 = w[j]
             w1 = u1 - xi2[j]
             was_in = contact[j]
             theta = 1.0
+            f_entry = 0.0
+            ft_entry = 0.0
+            fol = 0.0
             if was_in:
                 r = w1
                 if ARMS:
@@ -214,6 +227,10 @@ def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT, FRICTION,
                 # fraction 1 - theta of the step; the element follows it from
                 # there (the arms see a ramp wf -> w1 over theta h, not a jump)
                 theta = (w1 - wf) / (w1 - wf + w0 + xi2[j] - u)
+                if PARTIAL:  # normal force at the moment of entry
+                    f_entry = wf + c0 * v_test
+                    if ARMS:
+                        f_entry += _arm_stress(wf, q[j], g)
                 r = w1
                 if ARMS:
                     r += _follow_over(wf, w1, q[j], g, tau, theta * h)
@@ -221,9 +238,27 @@ def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT, FRICTION,
             fj = r + c0 * v_test
             if fj <= 0.0:  # force would pull: element leaves
                 if was_in:  # interpolate its force to zero within the step
-                    t_leave = max(t_leave, (step + f[j] / (f[j] - fj)) * h)
+                    alpha = f[j] / (f[j] - fj)
+                    t_leave = max(t_leave, (step + alpha) * h)
+                    if PARTIAL:
+                        # in contact for alpha h with a force going linearly to 0:
+                        # integral alpha h f0 / 2 = h/2 (f0 + alpha fj)
+                        corr_n += alpha * fj
+                        if TANGENTIAL:  # tangential stress f0_t -> trial ft1 over the step
+                            s0 = s[j]
+                            s1 = uc1 if MEMORY == 1 else s0 + duc
+                            ft1 = s1 + c0 * vc_test
+                            if ARMS:
+                                ft1 += _follow_value(s0, s1, p[j], g, E, omE, phi)
+                            if FRIC:  # the cone shrinks to 0 with the normal force
+                                if mu_k < math.inf:
+                                    ft1 = math.copysign(mu_k / kappa, ft1) * fj  # fj < 0
+                            corr_t += alpha * alpha * ft1 - (1.0 - alpha) ** 2 * ft[j]
                 contact[j] = False
                 continue
+            if PARTIAL and not was_in:
+                # in contact for theta h, force linear from f_entry to fj
+                corr_n += theta * (f_entry + fj) - fj
             contact[j] = True
             f[j] = fj
             n_c += 1
@@ -238,19 +273,41 @@ def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT, FRICTION,
                 else:  # incremental, entering: relaxed state plus the part of
                     # the step after the surface was reached
                     s1 = s0 + duc * theta
+                if PARTIAL and not was_in:  # stress at entry: the relaxed state,
+                    # dashpot at v_c (seed: the element jumps to the total displacement)
+                    ft_entry = s0 + c0 * vc_test
+                    if ARMS:
+                        ft_entry += _arm_stress(s0, p[j], g)
                 sum_rt += s1
                 if ARMS:
                     if was_in:
-                        sum_rt += _follow(s0, s1, p[j], g, E, omE, phi)
+                        fol = _follow(s0, s1, p[j], g, E, omE, phi)
                     else:
-                        sum_rt += _follow_over(s0, s1, p[j], g, tau, theta * h)
+                        fol = _follow_over(s0, s1, p[j], g, tau, theta * h)
+                    sum_rt += fol
                 s[j] = s1
+                if PARTIAL:
+                    ft1 = s1 + c0 * vc_test
+                    if ARMS:
+                        ft1 += fol
+                    ft[j] = ft1
+                    if not was_in:
+                        if MEMORY == 1:
+                            ft_entry = ft1
+                        corr_t += theta * (ft_entry + ft1) - ft1
             if FRIC:  # stick trial, then return to the cone |f_t| <= mu f_n
                 s0 = s[j]
                 s1 = s0 + duc if was_in else s0 + duc * theta
                 for i in range(n_af):
                     p_save[i] = p[j, i]
-                fol = 0.0
+                if PARTIAL:
+                    if not was_in:  # stress at entry (relaxed state, dashpot), inside the cone
+                        ft_entry = s0 + c0 * vc_test
+                        if ARMS:
+                            ft_entry += _arm_stress(s0, p[j], g)
+                        if mu_k < math.inf:
+                            cone_e = mu_k * max(f_entry, 0.0) / kappa
+                            ft_entry = min(max(ft_entry, -cone_e), cone_e)
                 if ARMS:
                     if was_in:
                         fol = _follow(s0, s1, p[j], g, E, omE, phi)
@@ -265,6 +322,9 @@ def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT, FRICTION,
                     sum_rt += fol
                     n_stick += 1
                     s[j] = s1
+                    ft1 = s1 + c0 * vc_test
+                    if ARMS:
+                        ft1 += fol
                 else:  # slip: the element's own path s0 -> s_slip puts it on the cone
                     target = math.copysign(cone, trial)
                     dt = h if was_in else max(theta, 1e-12) * h
@@ -284,6 +344,13 @@ def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT, FRICTION,
                     sum_slip_r += sgn * r
                     sum_slip_sign += sgn
                     n_slip += 1
+                    ft1 = target
+                    if PARTIAL and not was_in:  # it entered slipping: on the cone then too
+                        ft_entry = math.copysign(mu_k / kappa, trial) * max(f_entry, 0.0)
+                if PARTIAL:
+                    ft[j] = ft1
+                    if not was_in:
+                        corr_t += theta * (ft_entry + ft1) - ft1
         if n_c == 0 and t_leave > 0.0:
             t_exit = t_leave  # the last elements left within this step
         F_el1 = k_el * sum_r
@@ -301,11 +368,12 @@ def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT, FRICTION,
             slip_now = n_slip * dxi
         # ---- sphere: second half ----
         if INTEGRATOR == VERLET:
-            v = v_test - 0.5 * h * (F_el1 + C1 * v_test)
+            v = v_test - 0.5 * h * (F_el1 + C1 * v_test + k_el * corr_n)
             if FRIC and DASHPOT:
-                vc = vc_test - 0.5 * h * mu_t * (Ft_el1 + Ct1 * vc_test + Cs1 * v_test)
+                vc = vc_test - 0.5 * h * mu_t * (Ft_el1 + Ct1 * vc_test + Cs1 * v_test
+                                                 + k_el * kappa * corr_t)
             elif TANGENTIAL:
-                vc = vc_test - 0.5 * h * mu_t * (Ft_el1 + Ct1 * vc_test)
+                vc = vc_test - 0.5 * h * mu_t * (Ft_el1 + Ct1 * vc_test + k_el * kappa * corr_t)
         else:
             v = v_test
             vc = vc_test

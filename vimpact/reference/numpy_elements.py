@@ -17,7 +17,20 @@ nondimensionalize anything: it only takes the discretization (``t_H`` and
 
 The time stepping is the same algorithm as the kernel's ``VERLET``
 integrator, so for the same discretization both agree to rounding (about
-1e-9 relative or better). It is vectorized over elements with NumPy and loops
+1e-9 relative or better): the trapezoidal step impulse, with an element in
+contact for only part of a step weighed by that part (its force taken
+linear in time over it: from its last force to zero at the leave fraction
+``alpha``, from its force at the moment of entry over the entering fraction
+``theta``).
+
+Coulomb friction (PHYSICS.md section 12), written here independently of the
+kernel: every element in contact first takes the stick trial; if its
+tangential force exceeds ``mu`` times its normal force it slips, its
+displacement (and arms) solved so that the force sits on the cone (the
+force is affine in the end displacement: two evaluations give the line).
+A slipping element pushes with ``mu`` times its normal force, whose dashpot
+part moves with the normal velocity of each half-kick. ``check_cone``
+asserts ``|f_t| <= mu f_n (1 + 1e-12)`` for every element at every step. It is vectorized over elements with NumPy and loops
 over time steps in Python: slow on purpose, keep the sizes small.
 
 Sign convention: ``v_z > 0`` into the half-space, indentation ``u > 0``
@@ -124,7 +137,8 @@ class Rheology:
 
 # ------------------------------------------------------------------ impact
 
-def naive_impact(scene, steps, elements, row_width=1.05, max_time=100.0):
+def naive_impact(scene, steps, elements, row_width=1.05, max_time=100.0, mu=None,
+                 check_cone=True):
     """Simulate ``scene`` (a :class:`vimpact.Scene`) in SI units with the
     Stormer-Verlet scheme of the kernel.
 
@@ -135,6 +149,10 @@ def naive_impact(scene, steps, elements, row_width=1.05, max_time=100.0):
     elements : elements per Hertz radius ``a_H`` on the half row
     row_width : half-row length in units of ``a_H``
     max_time : time limit in units of ``t_H + 10 eta0 / G_inf``
+    mu : Coulomb friction coefficient (default ``scene.mu`` if the scene has
+        one, else ``inf``: full stick); needs incremental memory
+    check_cone : raise ``AssertionError`` if an element in contact ends a
+        step with ``|f_t| > mu f_n (1 + 1e-12)``
 
     Returns
     -------
@@ -142,7 +160,9 @@ def naive_impact(scene, steps, elements, row_width=1.05, max_time=100.0):
     ``v_z_end, v_x_end`` (m/s), ``omega_end`` (rad/s), ``t_contact`` (s),
     ``u_max``, ``a_max`` (m), ``energy_ratio`` (1), ``status``
     (``ok``, ``vc0_zero``, ``half_space``, ``time_limit``, ``row_exceeded``,
-    ``non_finite``) and ``steps`` (time steps taken).
+    ``non_finite``), ``steps`` (time steps taken), ``t_gross_slip`` (s with
+    every element in contact slipping), ``w_friction`` (J dissipated by slip)
+    and ``slip_width_max`` (m, widest slip zone on the half row).
     """
     mat = scene.material
     rheo = Rheology(mat)
@@ -184,6 +204,15 @@ def naive_impact(scene, steps, elements, row_width=1.05, max_time=100.0):
     Fx_spring, Cx = 0.0, 0.0
 
     memory = scene.tangential_memory
+    if mu is None:
+        mu = float(getattr(scene, "mu", math.inf))
+    friction = mu < math.inf
+    if friction and memory != "incremental":
+        raise ValueError(f"friction (mu = {mu}) needs incremental tangential memory, "
+                         f"not {memory!r}")
+    ft_last = np.zeros(n)  # last tangential force of each element in contact, N
+    Fx_slip, Cx_slip = 0.0, 0.0  # slipping elements: mu F_n, spring part (N), per v_z (N s/m)
+    t_gross, w_friction, slip_width_max = 0.0, 0.0, 0.0
     t_contact = 0.0
     u_max = 0.0
     j_outer_max = -1
@@ -197,7 +226,8 @@ def naive_impact(scene, steps, elements, row_width=1.05, max_time=100.0):
         # F_x = Fx_spring + Cx (v_x+ + R omega+): a 2x2 linear system
         k = 0.5 * h * Cx
         A = np.array([[m + k, k * R], [k * R, Theta + k * R * R]])
-        b = np.array([m * v_x - 0.5 * h * Fx_spring, Theta * omega - 0.5 * h * R * Fx_spring])
+        Fx_known = Fx_spring + Fx_slip + Cx_slip * v_z_half
+        b = np.array([m * v_x - 0.5 * h * Fx_known, Theta * omega - 0.5 * h * R * Fx_known])
         v_x_half, omega_half = np.linalg.solve(A, b)
         v_c_half = v_x_half + R * omega_half
 
@@ -233,6 +263,10 @@ def naive_impact(scene, steps, elements, row_width=1.05, max_time=100.0):
         theta[entering] = gain[entering] / (gain[entering] + (w0 - w_sphere_old)[entering])
         # entering elements ramp from the relaxed surface to the sphere over theta h
         arms_theta = arm_update_coefficients(rheo.tau[None, :], (theta[entering] * h)[:, None])
+        # normal force at the moment of entry (relaxed surface, dashpot at v_z)
+        f_entry = np.zeros(n)
+        f_entry[entering] = c_n * weight * (rheo.spring_stress(w_relaxed[entering], q[entering])
+                                            + rheo.eta0 * v_z_half)
         q[entering] = advance_arms(q[entering], w_relaxed[entering], w_sphere[entering], arms_theta)
 
         touching = was_in | entering
@@ -244,37 +278,106 @@ def naive_impact(scene, steps, elements, row_width=1.05, max_time=100.0):
         leaving = touching & (force <= 0.0)
         now_in = touching & ~leaving
         left = leaving & was_in
+        alpha = np.zeros(n)
         if left.any():
             # the time the last of them left: interpolate its force to zero
-            fraction = f_last[left] / (f_last[left] - force[left])
-            t_leave = ((step + fraction) * h).max()
+            alpha[left] = f_last[left] / (f_last[left] - force[left])
+            t_leave = ((step + alpha[left]) * h).max()
         contact = now_in
         f_last[now_in] = force[now_in]
 
+        # Partial contact within the step: the kick's trapezoid h/2 (F_start + F_end)
+        # gets, per such element, the end force that makes it the integral of the
+        # element's force taken linear in time over the part of the step in contact.
+        # Leaving after alpha h: normal force f0 -> 0, tangential f0_t -> trial ft1.
+        corr_z = float((alpha[left] * force[left]).sum())
+        corr_x = 0.0
+        if left.any():
+            s_l = np.full(int(left.sum()), u_c_new) if memory == "seed" else s[left] + du_c
+            p_l = advance_arms(p[left], s[left], s_l, arms_h)  # trial only, not kept
+            ft1 = c_t * weight * (rheo.spring_stress(s_l, p_l) + rheo.eta0 * v_c_half)
+            if friction:  # the cone shrinks to zero with the normal force
+                ft1 = np.copysign(mu, ft1) * force[left]  # force < 0
+            a_l = alpha[left]
+            corr_x += float((a_l**2 * ft1 - (1.0 - a_l) ** 2 * ft_last[left]).sum())
+        new = now_in & entering
+        # Entering for the last theta h: from the force at entry to the end force.
+        corr_z += float((theta[new] * (f_entry[new] + force[new]) - force[new]).sum())
+
         # tangential state of the elements in contact (PHYSICS.md section 6)
+        s_start, p_start = s.copy(), p.copy()  # relaxed state for the entering ones
         if memory == "seed":  # thesis eq. 4.16: total contact-point displacement
             s_new = np.full(n, u_c_new)
         else:  # incremental: only the displacement since entering loads an element
             s_new = s + du_c * theta  # theta = 1 for elements that were in contact
         stay = now_in & was_in
-        new = now_in & entering
-        p[stay] = advance_arms(p[stay], s0[stay], s_new[stay], arms_h)
-        p[new] = advance_arms(p[new], s[new], s_new[new], arm_update_coefficients(
-            rheo.tau[None, :], (theta[new] * h)[:, None]))
+        arms_new = arm_update_coefficients(rheo.tau[None, :], (theta[new] * h)[:, None])
+        p[stay] = advance_arms(p_start[stay], s_start[stay], s_new[stay], arms_h)
+        p[new] = advance_arms(p_start[new], s_start[new], s_new[new], arms_new)
         s[now_in] = s_new[now_in]
+        f_t = np.zeros(n)  # end-of-step tangential force of each element in contact, N
+        f_t[now_in] = c_t * weight * (rheo.spring_stress(s[now_in], p[now_in])
+                                      + rheo.eta0 * v_c_half)
+        ft_entry = np.zeros(n)
+        ft_entry[new] = c_t * weight * (rheo.spring_stress(s_start[new], p_start[new])
+                                        + rheo.eta0 * v_c_half)
+        if memory == "seed":  # the element jumps to the total displacement at entry
+            ft_entry[new] = f_t[new]
+        slip = np.zeros(n, dtype=bool)
+        if friction:
+            slip = now_in & (np.abs(f_t) > mu * force)
+            ft_entry[new] = np.clip(ft_entry[new], -mu * np.maximum(f_entry[new], 0.0),
+                                    mu * np.maximum(f_entry[new], 0.0))
+        if slip.any():
+            # the element's own path s_start -> s1 over dt (h, or theta h when
+            # entering) with its force on the cone: the force is affine in s1
+            idx = np.flatnonzero(slip)
+            dt = np.where(was_in[idx], h, np.maximum(theta[idx], 1e-12) * h)
+            coeff = arm_update_coefficients(rheo.tau[None, :], dt[:, None])
+            s_a = s_start[idx]
+
+            def path_force(s1):
+                q1 = advance_arms(p_start[idx], s_a, s1, coeff)
+                return c_t * weight * (rheo.spring_stress(s1, q1) + rheo.eta0 * (s1 - s_a) / dt), q1
+
+            f_a, _ = path_force(s_a)
+            s_b = np.where(s_new[idx] != s_a, s_new[idx], s_a + dx)
+            f_b, _ = path_force(s_b)
+            target = np.copysign(mu * force[idx], f_t[idx])
+            s_slip = s_a + (target - f_a) * (s_b - s_a) / (f_b - f_a)
+            _, p[idx] = path_force(s_slip)
+            w_friction += float((target * (s_new[idx] - s_slip)).sum())
+            s[idx] = s_slip
+            f_t[idx] = target
+            # an element that entered slipping was on the cone at entry too
+            entered = idx[~was_in[idx]]
+            ft_entry[entered] = np.copysign(mu, f_t[entered]) * np.maximum(f_entry[entered], 0.0)
+            slip_width_max = max(slip_width_max, idx.size * dx)
+        ft_last[now_in] = f_t[now_in]
+        corr_x += float((theta[new] * (ft_entry[new] + f_t[new]) - f_t[new]).sum())
+        if check_cone and friction and now_in.any():
+            excess = np.abs(f_t[now_in]) - mu * force[now_in] * (1.0 + 1e-12)
+            if excess.max() > 0.0:
+                raise AssertionError(f"step {step}: |f_t| > mu f_n by {excess.max():.3e} N")
 
         # forces of the new state
         n_c = int(now_in.sum())
+        stick = now_in & ~slip
         Fz_spring = c_n * weight * spring[now_in].sum()
         Cz = c_n * weight * rheo.eta0 * n_c
-        Fx_spring = c_t * weight * rheo.spring_stress(s[now_in], p[now_in]).sum()
-        Cx = c_t * weight * rheo.eta0 * n_c
+        Fx_spring = c_t * weight * rheo.spring_stress(s[stick], p[stick]).sum()
+        Cx = c_t * weight * rheo.eta0 * int(stick.sum())
+        sign = np.sign(f_t[slip])
+        Fx_slip = float((sign * mu * c_n * weight * spring[slip]).sum()) if slip.any() else 0.0
+        Cx_slip = float((sign * mu * c_n * weight * rheo.eta0).sum()) if slip.any() else 0.0
+        if n_c > 0 and int(slip.sum()) == n_c:
+            t_gross += h
         if n_c == 0 and left.any():
             t_contact = t_leave
 
         # ---- second half kick (dashpot with the half-step velocities) ----
-        F_z = Fz_spring + Cz * v_z_half
-        F_x = Fx_spring + Cx * v_c_half
+        F_z = Fz_spring + Cz * v_z_half + corr_z
+        F_x = Fx_spring + Cx * v_c_half + Fx_slip + Cx_slip * v_z_half + corr_x
         v_z = v_z_half - 0.5 * h * F_z / m
         v_x = v_x_half - 0.5 * h * F_x / m
         omega = omega_half - 0.5 * h * R * F_x / Theta
@@ -315,4 +418,5 @@ def naive_impact(scene, steps, elements, row_width=1.05, max_time=100.0):
         v_z_end=v_z, v_x_end=v_x, omega_end=omega,
         t_contact=t_contact, u_max=u_max, a_max=a_max,
         energy_ratio=energy1 / energy0, status=status, steps=step,
+        t_gross_slip=t_gross, w_friction=w_friction, slip_width_max=slip_width_max,
     )
