@@ -33,6 +33,7 @@ extensions = [
     "sphinx.ext.napoleon",
     "cli_reference",
     "optional_pages",
+    "numpydoc_prose",
 ]
 
 source_suffix = {".md": "markdown"}
