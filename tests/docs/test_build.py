@@ -178,3 +178,46 @@ def test_docs_build_without_warnings(tmp_path):
     from vimpact.cli.main import SUBCOMMANDS
     for name in SUBCOMMANDS:  # the generated reference has every subcommand
         assert f"vimpact {name}" in cli, name
+
+
+# --------------------------------------------------------------------------
+# the two Sphinx extensions of docs/_ext (plain functions, no Sphinx needed)
+# --------------------------------------------------------------------------
+
+def _ext(name: str):
+    sys.path.insert(0, str(ROOT / "docs" / "_ext"))
+    try:
+        return importlib.import_module(name)
+    finally:
+        sys.path.pop(0)
+
+
+def _all_parsers(parser):
+    yield parser
+    for action in parser._actions:
+        if hasattr(action, "choices") and isinstance(action.choices, dict):
+            for sub in action.choices.values():
+                yield from _all_parsers(sub)
+
+
+def test_cli_reference_lists_every_command_and_option():
+    from vimpact.cli.main import build_parser
+
+    text = _ext("cli_reference").cli_markdown()
+    missing = [f"{p.prog} {opt}" for p in _all_parsers(build_parser())
+               for a in p._actions for opt in a.option_strings if opt not in text]
+    missing += [p.prog for p in _all_parsers(build_parser()) if f"`{p.prog}`" not in text]
+    assert not missing, missing
+
+
+def test_prose_after_the_colon_becomes_the_description():
+    prose = _ext("numpydoc_prose")
+    lines = ["Summary.", "", "Parameters", "----------",
+             "nu : Poisson ratio, dimensionless, in [0, 0.5]",
+             "R : float", "    sphere radius, m",
+             "mu : float | None, optional", "v_z0 : normal speed, m/s"]
+    assert prose.prose_to_description(lines) == [
+        "Summary.", "", "Parameters", "----------",
+        "nu", "    Poisson ratio, dimensionless, in [0, 0.5]",
+        "R : float", "    sphere radius, m",
+        "mu : float | None, optional", "v_z0", "    normal speed, m/s"]
