@@ -337,18 +337,26 @@ def warm_kernels(spec: SweepSpec, rows_per_chunk: int = 2, chunks: int = 4) -> N
                 pass
 
 
+def local_cluster(workers: int):
+    """A ``dask.distributed.LocalCluster`` of ``workers`` processes with one thread each
+    and ``NUMBA_NUM_THREADS=1`` in their environment (set by the nanny before the worker
+    process imports anything, so numba starts with one thread)."""
+    from distributed import LocalCluster
+    return LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
+                        env={"NUMBA_NUM_THREADS": "1"}, dashboard_address=None)
+
+
 def _run_dask(spec, todo, parts, bar, done, workers, scheduler) -> None:
     """Chunks as tasks on a Dask cluster, at most a few per worker in flight."""
     try:
-        from distributed import Client, LocalCluster, as_completed
+        from distributed import Client, as_completed
     except ImportError:
         raise ValueError("--workers / --scheduler need Dask: pip install 'vimpact[dask]'") \
             from None
     warm_kernels(spec)
     cluster = None
     if workers is not None:
-        cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                               env={"NUMBA_NUM_THREADS": "1"}, dashboard_address=None)
+        cluster = local_cluster(workers)
         client = Client(cluster)
     else:
         client = Client(scheduler)
@@ -374,4 +382,4 @@ def _run_dask(spec, todo, parts, bar, done, workers, scheduler) -> None:
 
 
 __all__ = ["SweepInterrupted", "chunk_summary", "compute_chunk", "explain_paths", "guard_nan",
-           "run_chunk", "run_sweep", "warm_kernels"]
+           "local_cluster", "run_chunk", "run_sweep", "warm_kernels"]
