@@ -88,8 +88,11 @@ def test_explain_normal_only_takes_the_continuum_path(capsys):
 def test_explain_standard_solid_names_its_effects(capsys):
     assert main(["simulate", "--Q1", "0.3", "--Q2", "1", "--nu", "0.5", "--explain"]) == 0
     text = capsys.readouterr().out
-    assert "path: elements[verlet,tangential:incremental,arms]" in text
+    assert "path: continuum[stick]" in text
     assert "Maxwell arms" in text and "no dashpot term" in text
+    assert main(["simulate", "--Q1", "0.3", "--Q2", "1", "--nu", "0.5", "--explain",
+                 "--no-continuum"]) == 0
+    assert "path: elements[verlet,tangential:incremental,arms]" in capsys.readouterr().out
 
 
 def test_scene_file_and_tolerance(capsys):

@@ -256,7 +256,8 @@ class SceneColumns:
             pair = arms.get(i, {})
             if set(pair) != {"G", "tau"}:
                 raise InputError(f"arm {i} needs both G_arm{i}_Pa and tau_arm{i}_s")
-            G_arm[:, i - 1] = check_column(f"G_arm{i}_Pa", pair["G"], "positive", reasons)
+            # 0 = no such arm in this row (rows of one batch may have fewer arms)
+            G_arm[:, i - 1] = check_column(f"G_arm{i}_Pa", pair["G"], "non_negative", reasons)
             tau_arm[:, i - 1] = check_column(f"tau_arm{i}_s", pair["tau"], "positive", reasons)
         codes = {}
         for name, (choices, default) in CHOICES.items():
@@ -376,7 +377,7 @@ def _model(values, G_arm: np.ndarray, eta0: np.ndarray, n: int, reasons) -> np.n
     if values is None:
         return inferred.astype(np.int8)
     codes = _codes("model", values, MODELS, "prony", n, reasons)
-    fits = {MODEL_ELASTIC: (n_arms == 0) & (eta0 == 0.0, "no arms and eta0 = 0"),
+    fits = {MODEL_ELASTIC: ((n_arms == 0) & (eta0 == 0.0), "no arms and eta0 = 0"),
             MODEL_KELVIN_VOIGT: (n_arms == 0, "no Maxwell arms"),
             MODEL_STANDARD_SOLID: ((n_arms <= 1) & (eta0 == 0.0),
                                    "at most one Maxwell arm and eta0 = 0"),

@@ -11,14 +11,33 @@ import numpy as np
 
 from vimpact.engine import discretization
 from vimpact.engine.columns import SceneColumns
-from vimpact.engine.routing import Path
-from vimpact.kernels import continuum_kv
+from vimpact.engine.routing import CONTINUUM_STICK, Path
+from vimpact.kernels import continuum_kv, continuum_maxwell
 from vimpact.kernels import layout
 from vimpact.kernels.elements import KernelSpec, element_kernel
 from vimpact.model.numerics import Numerics
 
 #: Accepted steps of the adaptive continuum path at most (it needs tens to hundreds).
 CONTINUUM_MAX_STEPS = 1_000_000
+#: Accepted steps of the full-stick continuum kernel at most (tens to thousands;
+#: beyond, the element path takes the row).
+CONTINUUM_STICK_MAX_STEPS = 200_000
+
+
+def arm_arrays(cols: SceneColumns, keep: bool = True) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``g = G_i / G_inf``, ``tau = tau_i / T`` as ``(n, max_arms)`` with the real arms of
+    a row first, and their count ``n_arms`` (``keep=False``: no arms at all)."""
+    n = len(cols)
+    real = cols.G_arm > 0.0
+    n_arms = real.sum(axis=1).astype(np.int64)
+    width = int(n_arms.max(initial=0)) if keep else 0
+    if not width:
+        return np.zeros((n, 0)), np.zeros((n, 0)), np.zeros(n, dtype=np.int64)
+    order = np.argsort(~real, axis=1, kind="stable")[:, :width]  # real arms first
+    g = np.take_along_axis(cols.G_arm, order, axis=1) / cols.G_inf[:, None]
+    tau = np.take_along_axis(cols.tau_arm, order, axis=1) / cols.T[:, None]
+    tau = np.where(np.take_along_axis(real, order, axis=1), tau, 1.0)
+    return np.ascontiguousarray(g), np.ascontiguousarray(tau), n_arms
 
 
 def element_arrays(cols: SceneColumns, numerics: Numerics, spec: KernelSpec) -> dict[str, np.ndarray]:
@@ -31,23 +50,14 @@ def element_arrays(cols: SceneColumns, numerics: Numerics, spec: KernelSpec) -> 
     """
     n = len(cols)
     tangential = np.full(n, bool(spec.tangential))
-    real = cols.G_arm > 0.0
-    n_arms = real.sum(axis=1).astype(np.int64)
-    width = int(n_arms.max(initial=0)) if spec.arms else 0
-    g = np.zeros((n, width))
-    tau = np.zeros((n, width))
-    if width:
-        order = np.argsort(~real, axis=1, kind="stable")[:, :width]  # real arms first
-        g = np.take_along_axis(cols.G_arm, order, axis=1) / cols.G_inf[:, None]
-        tau = np.take_along_axis(cols.tau_arm, order, axis=1) / cols.T[:, None]
-        tau = np.where(np.take_along_axis(real, order, axis=1), tau, 1.0)
+    g, tau, n_arms = arm_arrays(cols, spec.arms)
     with np.errstate(divide="ignore"):
         mu = np.where(np.isfinite(cols.mu), cols.mu * cols.v_z0 / np.abs(cols.v_c0), np.inf)
     a = {
         "tau0": cols.dashpot_time / cols.T,
-        "g": np.ascontiguousarray(g),
-        "tau": np.ascontiguousarray(tau),
-        "n_arms": n_arms if spec.arms else np.zeros(n, dtype=np.int64),
+        "g": g,
+        "tau": tau,
+        "n_arms": n_arms,
         "kappa": cols.kappa,
         "mu_t": cols.contact_mass_factor,
         "mu": mu,
@@ -61,6 +71,20 @@ def run_path(path: Path, cols: SceneColumns, numerics: Numerics, rec: np.ndarray
     """Run the rows ``cols`` on ``path``, results into ``out`` (``(n, N_OUT)``) and
     the trajectory buffer ``rec`` (``(n, n_rec, N_REC)``; ``n_rec`` may be 0).
     ``arrays``: the element-kernel inputs if already made (:func:`element_arrays`)."""
+    if path.kind == CONTINUUM_STICK:
+        g, tau, n_arms = arm_arrays(cols)
+        args = (cols.dashpot_time / cols.T, g, tau, n_arms, cols.kappa, cols.contact_mass_factor,
+                cols.computes_tangential)
+        if rec.shape[1] == 0:
+            continuum_maxwell.maxwell_stick_batch(*args, numerics.rtol, CONTINUUM_STICK_MAX_STEPS,
+                                                  out)
+            return
+        for i in range(len(cols)):
+            k = n_arms[i]
+            out[i, layout.OUT_N_REC] = continuum_maxwell.maxwell_stick_impact(
+                args[0][i], g[i, :k], tau[i, :k], args[4][i], args[5][i], args[6][i],
+                numerics.rtol, CONTINUUM_STICK_MAX_STEPS, rec[i], rec_every, out[i])
+        return
     if path.spec is None:
         tau0 = cols.dashpot_time / cols.T
         if rec.shape[1] == 0:

@@ -56,6 +56,8 @@ STATUSES = {
     "too_costly": "the element path would need more steps or elements than its cost bounds "
                   "(numerics.MAX_STEPS_PER_T_H, MAX_ELEMENTS_IN_ROW) for this scene; outputs NaN "
                   "(reason in the error column)",
+    "tolerance_unreachable": "the numerics' tolerance is below what the element path this scene "
+                             "needs can reach (floor in the error column); outputs NaN",
     "invalid": "the row's inputs are not a valid scene (reason in the error column); outputs NaN",
 }
 

@@ -23,11 +23,18 @@ import numpy as np
 from vimpact.engine import discretization
 from vimpact.engine.columns import SceneColumns
 from vimpact.kernels.elements import KernelSpec
+from vimpact.kernels.layout import STATUS_ASSUMPTION
 from vimpact.model.numerics import INTEGRATORS, Numerics
 from vimpact.model.scene import TANGENTIAL_MEMORY, Scene
 
 CONTINUUM = "continuum"
+CONTINUUM_STICK = "continuum_stick"
 ELEMENTS = "elements"
+
+#: The full-stick continuum kernel integrates the arms explicitly: an arm faster
+#: than this fraction of the time unit T would cost ~T/tau_i steps, and the
+#: element path (exact arm update) takes the scene instead.
+STIFF_ARM_TIME = 1e-3
 
 
 @dataclass(frozen=True)
@@ -36,7 +43,8 @@ class Path:
 
     Attributes
     ----------
-    kind : ``"continuum"`` or ``"elements"``
+    kind : ``"continuum"`` (Kelvin-Voigt/elastic normal impact), ``"continuum_stick"``
+        (full stick, every rheology) or ``"elements"``
     spec : compile-time effects of the element kernel (``None`` for the continuum path)
     reasons : why, one sentence each
     """
@@ -48,6 +56,8 @@ class Path:
     @property
     def name(self) -> str:
         """Short label, e.g. ``elements[verlet,tangential:incremental,dashpot]``."""
+        if self.kind == CONTINUUM_STICK:
+            return "continuum[stick]"
         if self.spec is None:
             return "continuum[kelvin_voigt,normal]"
         sp = self.spec
@@ -74,6 +84,8 @@ _INTEGRATOR_NAMES = {code: name for name, code in INTEGRATORS.items()}
 
 #: path of the Kelvin-Voigt/elastic normal-only continuum kernel
 CONTINUUM_KV = Path(CONTINUUM, None, ())
+#: path of the full-stick continuum kernel (every rheology, PHYSICS section 11)
+CONTINUUM_FULL_STICK = Path(CONTINUUM_STICK, None, ())
 
 
 @dataclass(frozen=True)
@@ -99,15 +111,20 @@ def route(cols: SceneColumns, numerics: Numerics) -> Routes:
     friction = tangential & np.isfinite(cols.mu)
     memory = np.where(tangential, cols.memory, 0)
     continuum = ~arms & ~tangential & numerics.continuum
-    key = (continuum.astype(np.int64) << 5 | tangential << 4 | memory << 3 | arms << 2
+    stick = continuum_stick(cols, numerics) & ~continuum
+    kind = np.where(continuum, 1, np.where(stick, 2, 0))
+    key = (kind.astype(np.int64) << 5 | tangential << 4 | memory << 3 | arms << 2
            | dashpot << 1 | friction)
+    key = np.where(kind > 0, kind << 5, key)  # one continuum group per kernel
     key = np.where(valid, key, -1)
     paths: list[Path] = []
     group = np.full(len(cols), -1, dtype=np.int64)
     for k in np.unique(key[key >= 0]):
         rows = key == k
-        if k >> 5:
+        if k >> 5 == 1:
             path = CONTINUUM_KV
+        elif k >> 5 == 2:
+            path = CONTINUUM_FULL_STICK
         else:
             path = Path(ELEMENTS, KernelSpec(numerics.integrator_code, bool(k >> 4 & 1),
                                              int(k >> 3 & 1), bool(k >> 2 & 1), bool(k >> 1 & 1),
@@ -115,6 +132,27 @@ def route(cols: SceneColumns, numerics: Numerics) -> Routes:
         group[rows] = len(paths)
         paths.append(path)
     return Routes(group, tuple(paths))
+
+
+def continuum_stick(cols: SceneColumns, numerics: Numerics) -> np.ndarray:
+    """Rows the full-stick continuum kernel can take: continuum allowed, no
+    friction, incremental memory (or no tangential problem), no arm faster than
+    :data:`STIFF_ARM_TIME` T. Its run-time assumptions (one contact interval, no
+    re-entry) are checked by the kernel, which hands a row back otherwise."""
+    tangential = cols.computes_tangential
+    friction = tangential & np.isfinite(cols.mu)
+    incremental = cols.memory == TANGENTIAL_MEMORY.index("incremental")
+    real = cols.G_arm > 0.0
+    fast_arm = (real & (cols.tau_arm < STIFF_ARM_TIME * cols.T[:, None])).any(axis=1)
+    return (numerics.continuum & cols.valid & ~friction & (incremental | ~tangential)
+            & ~fast_arm)
+
+
+def handover_reason(status: int) -> str:
+    """Why a row left the full-stick continuum kernel for the element path."""
+    return ("the continuum kernel found its assumptions broken (the contact split or an "
+            "element re-entered)" if status == STATUS_ASSUMPTION else
+            "the continuum kernel reached its step limit")
 
 
 def choose_path(scene: Scene, numerics: Numerics) -> Path:
@@ -140,12 +178,27 @@ def choose_path(scene: Scene, numerics: Numerics) -> Path:
     what = [("Maxwell arms" if arms else "no arm variables"),
             ("a parallel dashpot" if dashpot else "no dashpot term")]
     reasons.append(f"material {mat.model}: {what[0]}, {what[1]}")
-    if path.spec is None:
+    if path.kind == CONTINUUM:
         reasons.append("Kelvin-Voigt/elastic normal impact: closed-form continuum force, 1-DOF "
                        "ODE, adaptive Dormand-Prince 5(4) with event location, "
                        f"rtol = {numerics.rtol:g}")
         return Path(CONTINUUM, None, tuple(reasons))
-    if not arms and not tangential:
+    if path.kind == CONTINUUM_STICK:
+        reasons.append("full stick with incremental memory: the exact continuum limit of the "
+                       "element row (docs/physics.md, continuum limit for every rheology), "
+                       "adaptive Dormand-Prince 5(4) with event location, "
+                       f"rtol = {numerics.rtol:g}; should the contact split or an element "
+                       "re-enter, the element kernel takes over")
+        return Path(CONTINUUM_STICK, None, tuple(reasons))
+    if numerics.continuum and (arms or tangential):
+        if tangential and np.isfinite(scene.mu):
+            reasons.append("Coulomb friction (slip) needs the element row")
+        elif tangential and scene.tangential_memory != "incremental":
+            reasons.append("seed tangential memory needs the element row")
+        else:
+            reasons.append(f"an arm faster than {STIFF_ARM_TIME:g} T would make the continuum "
+                           "kernel stiff; the element row updates arms exactly")
+    if not numerics.continuum:
         reasons.append("continuum path switched off (Numerics.continuum = False)")
     else:
         need = [n for n, on in (("the tangential problem", tangential), ("Maxwell arms", arms)) if on]

@@ -18,11 +18,12 @@ import pandas as pd
 from vimpact.engine.columns import SceneColumns, scene_columns
 from vimpact.engine.pack import element_arrays, interleave, run_path
 from vimpact.engine.result import RESULT_FIELDS, ImpactResult
-from vimpact.engine.routing import choose_path, route
+from vimpact.engine.routing import CONTINUUM_STICK, choose_path, route
 from vimpact.engine.unpack import unpack
 from vimpact.kernels import layout
 from vimpact.model.hertz import HERTZ_TIME_FACTOR
-from vimpact.model.numerics import MAX_ELEMENTS_IN_ROW, MAX_STEPS_PER_T_H, Numerics
+from vimpact.model.numerics import (ELEMENT_TOLERANCE_FLOOR, MAX_ELEMENTS_IN_ROW,
+                                    MAX_STEPS_PER_T_H, Numerics)
 from vimpact.model.scene import HALF_SPACE_LIMIT, Scene
 from vimpact.model.validation import InputError, message, require
 
@@ -50,7 +51,11 @@ def run_columns(cols: SceneColumns, numerics: Numerics, n_rec: int = 0, rec_ever
                 timings: dict | None = None
                 ) -> tuple[dict[str, np.ndarray], np.ndarray, np.ndarray]:
     """Route, pack, run and unpack a batch: the result columns, the trajectory
-    buffer ``(n, n_rec, N_REC)`` (kernel units) and the rows written in it."""
+    buffer ``(n, n_rec, N_REC)`` (kernel units) and the rows written in it.
+
+    Rows the full-stick continuum kernel hands back (its assumptions broke, or
+    its step limit) run again on the element kernel their effects call for.
+    """
     import numba
 
     n = len(cols)
@@ -60,27 +65,33 @@ def run_columns(cols: SceneColumns, numerics: Numerics, n_rec: int = 0, rec_ever
     path_names = np.full(n, None, dtype=object)
     explicit_euler = np.zeros(n, dtype=bool)
     steps_per_T = np.zeros(n)
+    refused = np.full(n, None, dtype=object)
     kernel_s = 0.0
     threads = max(1, numba.get_num_threads())
-    refused = np.full(n, None, dtype=object)
-    for k, path in enumerate(routes.paths):
-        idx = np.flatnonzero(routes.group == k)
+    queue = [(path, np.flatnonzero(routes.group == k)) for k, path in enumerate(routes.paths)]
+    while queue:
+        path, idx = queue.pop(0)
         arrays = None
         if path.spec is not None:
-            sub = cols.take(idx)
-            arrays = element_arrays(sub, numerics, path.spec)
+            arrays = element_arrays(cols.take(idx), numerics, path.spec)
             per_t_H = HERTZ_TIME_FACTOR / arrays["h"]
             costly = (per_t_H > MAX_STEPS_PER_T_H) | (arrays["n_elem"] > MAX_ELEMENTS_IN_ROW)
             for j in np.flatnonzero(costly):
-                refused[idx[j]] = (
+                refused[idx[j]] = ("too_costly",
                     f"this scene needs {per_t_H[j]:.3g} steps per Hertz time and "
                     f"{arrays['n_elem'][j]} elements (refined for its stiffest mode): more than "
                     f"the limits {MAX_STEPS_PER_T_H:.0e} and {MAX_ELEMENTS_IN_ROW:.0e}")
-            keep = ~costly
+            if not numerics.element_tolerance_reachable:
+                for j in np.flatnonzero(~costly):
+                    refused[idx[j]] = ("tolerance_unreachable",
+                        f"tolerance = {numerics.tolerance:g} is not reachable on the element "
+                        f"path this scene needs ({path.name}): the smallest it reaches is "
+                        f"{ELEMENT_TOLERANCE_FLOOR:.2g}")
+                costly[:] = True
             explicit_euler[idx] = path.spec.integrator == layout.EULER
             steps_per_T[idx] = 1.0 / arrays["h"]
-            idx = idx[keep]
-            arrays = {key: value[keep] for key, value in arrays.items()}
+            idx = idx[~costly]
+            arrays = {key: value[~costly] for key, value in arrays.items()}
             if len(idx) == 0:
                 continue
         if n_rec == 0 and len(idx) > threads:
@@ -98,6 +109,13 @@ def run_columns(cols: SceneColumns, numerics: Numerics, n_rec: int = 0, rec_ever
         if n_rec:
             rec[idx] = sub_rec
         path_names[idx] = path.name
+        if path.kind == CONTINUUM_STICK:
+            status = sub_out[:, layout.OUT_STATUS]
+            back = (status == layout.STATUS_ASSUMPTION) | (status == layout.STATUS_TIME_LIMIT)
+            if back.any():
+                rows = idx[back]
+                again = route(cols.take(rows), numerics.with_(continuum=False))
+                queue.extend((p, rows[again.group == k]) for k, p in enumerate(again.paths))
     if timings is not None:
         timings["kernel_s"] = timings.get("kernel_s", 0.0) + kernel_s
     written = out[:, layout.OUT_N_REC].astype(np.int64)
@@ -159,7 +177,9 @@ def simulate(scene: Scene, numerics: Numerics | str | None = None, *,
     Raises
     ------
     InputError
-        if ``scene`` is not a :class:`Scene` or ``numerics`` is not valid.
+        if ``scene`` is not a :class:`Scene`, ``numerics`` is not valid, or its
+        ``tolerance`` is below what the path this scene needs can reach (the
+        message names the smallest it reaches).
     HalfSpaceError
         if the contact half-width exceeds ``0.2 R`` and the scene does not
         allow it (``Scene.allow_large_contact``).
@@ -172,7 +192,7 @@ def simulate(scene: Scene, numerics: Numerics | str | None = None, *,
     if trajectory:
         path = choose_path(scene, numerics)
         if path.spec is None:
-            n_rec = 100_000  # one row per accepted ODE step
+            n_rec = 100_000  # one row per accepted ODE step (a hand-over records on elements)
         else:
             a = element_arrays(cols, numerics, path.spec)
             per_t_H = HERTZ_TIME_FACTOR / a["h"][0]
@@ -185,6 +205,8 @@ def simulate(scene: Scene, numerics: Numerics | str | None = None, *,
     if trajectory:
         traj = _trajectory(scene, rec[0, :written[0]])
     res = ImpactResult(trajectory=traj, **row)
+    if res.status == "tolerance_unreachable":
+        raise InputError(res.error)
     if res.status == "half_space" and not scene.allow_large_contact:
         raise HalfSpaceError(
             f"a_max = {res.a_max:.4g} m is not allowed: must be <= 0.2 R = "

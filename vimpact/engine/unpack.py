@@ -43,7 +43,8 @@ def unpack(cols: SceneColumns, out: np.ndarray, path_names: np.ndarray, explicit
     explicit_euler : rows integrated by explicit Euler (energy gain expected)
     steps_per_T : time steps per time unit ``T`` of each element-path row (0 on
         continuum rows): with the contact time, how well the contact was resolved
-    refused : object array, why a valid row was not run (cost bounds), else ``None``
+    refused : object array, ``(status, reason)`` of a valid row that was not run
+        (cost bounds, an unreachable tolerance), else ``None``
     """
     n = len(cols)
     valid = cols.valid
@@ -52,7 +53,8 @@ def unpack(cols: SceneColumns, out: np.ndarray, path_names: np.ndarray, explicit
     ran = valid & np.equal(refused, None)
     for code, name in KERNEL_STATUSES.items():
         status[ran & (kstatus == code)] = name
-    status[valid & ~ran] = "too_costly"
+    for i in np.flatnonzero(valid & ~ran):
+        status[i] = refused[i][0]
     ok = status == "ok"
     tangential = cols.computes_tangential
     v_z0, v_c0, mu_t = cols.v_z0, cols.v_c0, cols.contact_mass_factor
@@ -96,7 +98,10 @@ def unpack(cols: SceneColumns, out: np.ndarray, path_names: np.ndarray, explicit
     ok = status == "ok"
     status[ok & (v_c0 == 0.0)] = "vc0_zero"
     guard(values, status, tangential)
-    error = np.where(valid, refused, cols.reasons)
+    why = np.full(n, None, dtype=object)
+    for i in np.flatnonzero(valid & ~ran):  # refused rows only
+        why[i] = refused[i][1]
+    error = np.where(valid, why, cols.reasons)
     error = np.where(status == "non_finite", _nan_message(values, status, error), error)
     with np.errstate(all="ignore"):
         result = {

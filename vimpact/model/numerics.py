@@ -34,7 +34,11 @@ class Numerics:
         an impact still running then ends with status ``time_limit``
     continuum : take the continuum 1-DOF path for Kelvin-Voigt and elastic
         normal-only scenes (default ``True``; ``False`` forces elements)
-    rtol : relative tolerance of the adaptive continuum path
+    rtol : relative tolerance of the adaptive continuum paths
+    tolerance : the accuracy on e_z and beta_x these numerics were chosen for
+        (:meth:`for_tolerance`), or ``None``; a scene on the element path whose
+        tolerance is below what that path reaches (:data:`ELEMENT_TOLERANCE_FLOOR`)
+        is refused (status ``tolerance_unreachable``), never reported as ``ok``
     """
 
     integrator: str = "verlet"
@@ -44,35 +48,45 @@ class Numerics:
     max_time: float = 100.0
     continuum: bool = True
     rtol: float = 1e-8
+    tolerance: float | None = None
 
     def __post_init__(self):
         one_of("integrator", self.integrator, tuple(INTEGRATORS))
         for name in ("steps", "elements"):
             value = getattr(self, name)
-            require(name, value, isinstance(value, int) and value >= 4, "an integer >= 4")
+            require(name, value, isinstance(value, int) and not isinstance(value, bool)
+                    and 4 <= value <= MAX_SETTING[name],
+                    f"an integer from 4 to {MAX_SETTING[name]:.0e}")
         require("row_width", self.row_width, positive("row_width", self.row_width) >= 1.0, ">= 1")
         positive("max_time", self.max_time)
         require("continuum", self.continuum, isinstance(self.continuum, bool), "True or False")
         require("rtol", self.rtol, 1e-14 <= positive("rtol", self.rtol) <= 1e-2,
                 "between 1e-14 and 1e-2")
+        if self.tolerance is not None:
+            require("tolerance", self.tolerance,
+                    1e-12 <= positive("tolerance", self.tolerance) <= 1e-2,
+                    "between 1e-12 and 1e-2")
 
     @classmethod
     def for_tolerance(cls, tolerance: float, integrator: str = "verlet") -> "Numerics":
-        """Steps and elements chosen to reach ``tolerance`` on e_z and e_x.
+        """Numerics that reach ``tolerance`` on e_z and beta_x on the path that runs.
 
-        Uses the error model measured by ``python -m benchmarks.accuracy``
-        (:data:`ERROR_MODEL`: ``error ~ a / steps^p + b / elements^q``, the
-        worst case over Q1 in [1e-3, 10], Q2 and nu), half the tolerance to
-        each knob; the continuum path gets ``rtol = min(tolerance / 10, 1e-8)``
-        (its error is 0.1 to 6 times rtol; it costs microseconds, and below
-        1e-6 its elastic e_z cannot pass 1 by more than the passivity slack). The element path is capped at
-        :data:`MAX_STEPS` and :data:`MAX_ELEMENTS`: below about 1e-6 it
-        cannot follow (its e_x converges only about first order in the steps)
-        and delivers what the cap reaches; the continuum path reaches 1e-12.
+        The continuum paths (every full-stick scene with incremental memory;
+        the Kelvin-Voigt normal impact) get ``rtol = tolerance / 10`` (their
+        error is a small multiple of rtol, measured by
+        ``python -m benchmarks.continuum_maxwell``). The element path (friction,
+        seed memory, stiff arms, hand-overs) gets steps and elements from the
+        error model measured by ``python -m benchmarks.accuracy``
+        (:data:`ERROR_MODEL`: an envelope ``a / steps^p + b / elements^q``),
+        half the tolerance to each knob, capped at :data:`MAX_STEPS` and
+        :data:`MAX_ELEMENTS`; a tolerance below what the capped element path
+        reaches (:data:`ELEMENT_TOLERANCE_FLOOR`) is kept in ``tolerance`` and
+        refused for the scenes that need elements (status
+        ``tolerance_unreachable``, with the floor in the error column).
 
         Parameters
         ----------
-        tolerance : target absolute error on e_z and e_x, in [1e-12, 1e-2]
+        tolerance : target absolute error on e_z and beta_x, in [1e-12, 1e-2]
         integrator : ``"verlet"`` (the model is measured for it)
         """
         tol = positive("tolerance", tolerance)
@@ -83,7 +97,12 @@ class Numerics:
         elements = math.ceil((2.0 * m["b"] / tol) ** (1.0 / m["q"]))
         return cls(integrator=integrator, steps=int(min(max(steps, 100), MAX_STEPS)),
                    elements=int(min(max(elements, 20), MAX_ELEMENTS)),
-                   rtol=min(max(tol / 10.0, 1e-13), 1e-8))
+                   rtol=min(max(tol / 10.0, 1e-13), 1e-8), tolerance=tol)
+
+    @property
+    def element_tolerance_reachable(self) -> bool:
+        """The element path reaches ``tolerance`` (always, without one)."""
+        return self.tolerance is None or self.tolerance >= ELEMENT_TOLERANCE_FLOOR
 
     @classmethod
     def preset(cls, name: str) -> "Numerics":
@@ -119,6 +138,11 @@ MIN_CONTACT_STEPS = 20
 MAX_STEPS_PER_T_H = 1e7
 MAX_ELEMENTS_IN_ROW = 1e6
 MAX_ELEMENTS = 3200
+#: The smallest tolerance the element path verifiably reaches: the error model at the caps.
+ELEMENT_TOLERANCE_FLOOR = (ERROR_MODEL["a"] / MAX_STEPS ** ERROR_MODEL["p"]
+                           + ERROR_MODEL["b"] / MAX_ELEMENTS ** ERROR_MODEL["q"])
+#: Largest accepted ``steps`` and ``elements`` settings (cost bounds).
+MAX_SETTING = {"steps": 10_000_000, "elements": 1_000_000}
 
 PRESETS = {
     # chosen from the accuracy-versus-time front (benchmarks/results/accuracy.json)

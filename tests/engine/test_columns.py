@@ -1,0 +1,154 @@
+"""The columnar batch path: scene columns in, result columns out; bad rows get a status.
+
+References are the one-scene API (Scene objects through the same kernels), the
+closed-form gross-slip law, and the linearity of the tangential problem in v_c0.
+"""
+
+import math
+
+import numpy as np
+import pandas as pd
+import pytest
+
+import vimpact as v
+from vimpact.engine import pack
+from vimpact.model.numerics import ELEMENT_TOLERANCE_FLOOR
+
+FAST = v.Numerics.preset("fast")
+
+
+def _columns(n=4):
+    """Physical scenes of several rheologies as columns (SI units in the names)."""
+    return pd.DataFrame({
+        "nu": np.linspace(0.2, 0.5, n),
+        "G_inf_Pa": np.full(n, 1e6),
+        "eta0_Pa_s": [0.0, 30.0, 0.0, 10.0][:n],
+        "G_arm1_Pa": [0.0, 0.0, 2e6, 5e5][:n],
+        "tau_arm1_s": [1.0, 1.0, 1e-4, 3e-4][:n],
+        "R_m": np.full(n, 0.01),
+        "m_kg": np.full(n, 0.004),
+        "v_z0_m_s": np.full(n, 0.3),
+        "v_x0_m_s": [0.0, 0.2, 0.3, -0.1][:n],
+        "omega0_rad_s": [0.0, 0.0, 5.0, 0.0][:n],
+    })
+
+
+def _scenes(df):
+    out = []
+    for _, r in df.iterrows():
+        arms = [(r.G_arm1_Pa, r.tau_arm1_s)] if r.G_arm1_Pa > 0 else []
+        mat = v.Material.prony(nu=r.nu, G_inf=r.G_inf_Pa, arms=arms, eta0=r.eta0_Pa_s)
+        out.append(v.Scene(mat, R=r.R_m, m=r.m_kg, v_z0=r.v_z0_m_s, v_x0=r.v_x0_m_s,
+                           omega0=r.omega0_rad_s, allow_large_contact=True))
+    return out
+
+
+def test_columns_equal_scene_objects_bit_for_bit():
+    df = _columns()
+    by_columns = v.simulate_batch(df.assign(model="prony"), FAST)
+    by_scenes = v.simulate_batch(_scenes(df), FAST)
+    assert list(by_columns.columns) == list(by_scenes.columns)
+    for name in ("e_z", "beta_x", "t_contact", "energy_ratio", "status", "path"):
+        assert by_columns[name].equals(by_scenes[name]), name
+
+
+def test_bad_rows_get_invalid_and_leave_the_others_bit_identical():
+    clean = _columns()
+    bad = pd.concat([clean, clean.iloc[:4]], ignore_index=True).astype(object)
+    bad.loc[4, "m_kg"] = -1.0
+    bad.loc[5, "nu"] = 0.7
+    bad.loc[6, "R_m"] = float("nan")
+    bad.loc[7, "G_inf_Pa"] = "stiff"
+    res_clean = v.simulate_batch(clean, FAST)
+    res = v.simulate_batch(bad, FAST)
+    assert list(res.status[4:]) == ["invalid"] * 4
+    for row, name in zip(range(4, 8), ("m_kg", "nu", "R_m", "G_inf_Pa")):
+        assert res.error[row].startswith(f"{name} = ") and "not allowed" in res.error[row]
+        assert math.isnan(res.e_z[row])
+    for name in ("e_z", "beta_x", "t_contact", "status"):
+        assert res[name][:4].equals(res_clean[name]), name
+    assert res.error[:4].isna().all()
+
+
+def test_a_none_in_a_scene_list_is_one_bad_row():
+    scenes = [v.Scene.from_dimensionless(0.1, 0.5), None]
+    res = v.simulate_batch(scenes, FAST)
+    assert list(res.status) == ["ok", "invalid"]
+    assert "scenes[1]" in res.error[1]
+
+
+def test_a_malformed_batch_is_an_input_error():
+    with pytest.raises(v.InputError, match="required"):
+        v.simulate_batch({"nu": [0.5]})
+    with pytest.raises(v.InputError, match="unknown scene column"):
+        v.simulate_batch(_columns().assign(speed=1.0))
+
+
+def test_timings_are_reported():
+    t = {}
+    v.simulate_batch(_columns(), FAST, timings=t)
+    assert 0.0 < t["kernel_s"] <= t["total_s"]
+
+
+def test_held_spin_is_not_an_energy_gain():
+    """Without rotation (Theta -> inf) only v_c0 = v_x0 + R omega0 matters
+    (the tangential problem is linear in it); a large held spin pumps energy into
+    v_x, which is physical, not an instability."""
+    mat = v.Material.elastic(nu=0.5, G=1e6)
+    plain = v.Scene(mat, R=0.01, m=0.004, v_z0=0.3, v_x0=0.2, rotation=False)
+    spun = v.Scene(mat, R=0.01, m=0.004, v_z0=0.3, v_x0=0.2 + 0.01 * 1000.0, omega0=-1000.0,
+                   rotation=False)
+    a, b = v.simulate(plain), v.simulate(spun)
+    assert a.status == b.status == "ok"
+    assert b.e_z == pytest.approx(a.e_z, abs=1e-12)
+    assert b.beta_x == pytest.approx(a.beta_x, abs=1e-9)
+    assert b.omega_end == -1000.0
+
+
+def test_gross_slip_through_the_batch_path():
+    """Large incidence: F_x = mu F_z throughout, so
+    v_c,end = v_c0 - mu (1 + m R^2/Theta)(1 + e_z) v_z0 (PHYSICS: Coulomb friction)."""
+    mu = 0.1
+    res = v.simulate(v.Scene.from_dimensionless(0.2, 0.5, mu=mu), FAST)  # v_c0 = v_z0 = 1
+    assert res.path.endswith("friction]") and res.status == "ok"
+    expected = 1.0 - mu * (1.0 + 1.0 / 0.4) * (1.0 + res.e_z)
+    assert -res.beta_x == pytest.approx(expected, abs=1e-9)
+    assert res.mu_eff == pytest.approx(mu, abs=1e-9)
+
+
+def test_unreachable_tolerance_is_refused_on_the_element_path_only():
+    numerics = v.Numerics.for_tolerance(1e-8)
+    assert numerics.tolerance == 1e-8 < ELEMENT_TOLERANCE_FLOOR
+    stick = v.simulate(v.Scene.from_dimensionless(0.1, 0.5), numerics)
+    assert stick.status == "ok" and stick.path.startswith("continuum")
+    with pytest.raises(v.InputError, match="smallest it reaches"):
+        v.simulate(v.Scene.from_dimensionless(0.1, 0.5, mu=0.3), numerics)
+    df = v.simulate_batch([v.Scene.from_dimensionless(0.1, 0.5, mu=0.3)], numerics)
+    assert df.status[0] == "tolerance_unreachable" and math.isnan(df.e_z[0])
+
+
+def test_cost_bounds_give_a_status():
+    mat = v.Material.kelvin_voigt(nu=0.5, E=1e6, eta=10.0)
+    scene = v.Scene(mat, R=0.01, m=0.004, v_z0=1.0, v_x0=1.0, Theta=1e-300, mu=0.5,
+                    allow_large_contact=True)
+    res = v.simulate(scene, FAST)
+    assert res.status == "too_costly" and "steps per Hertz time" in res.error
+
+
+def test_scales_outside_the_float_range_are_refused():
+    mat = v.Material.kelvin_voigt(nu=0.5, E=1e6, eta=10.0)
+    with pytest.raises(v.InputError, match="floating-point range"):
+        v.Scene(mat, R=0.01, m=0.004, v_z0=1e200)
+    df = _columns(2).assign(v_z0_m_s=[0.3, 1e200])
+    res = v.simulate_batch(df, FAST)
+    assert res.status[1] == "invalid" and "floating-point range" in res.error[1]
+    assert res.status[0] != "invalid"
+
+
+def test_a_continuum_row_that_hits_its_step_limit_is_handed_to_the_elements(monkeypatch):
+    scene = v.Scene.from_dimensionless(0.1, 0.3, Q2=1.0)
+    elements = v.simulate(scene, FAST.with_(continuum=False))
+    monkeypatch.setattr(pack, "CONTINUUM_STICK_MAX_STEPS", 3)
+    handed = v.simulate(scene, FAST)
+    assert handed.status == "ok" and handed.path == elements.path
+    assert handed.beta_x == elements.beta_x and handed.e_z == elements.e_z
