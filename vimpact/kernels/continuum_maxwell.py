@@ -109,9 +109,9 @@ from vimpact.kernels.continuum_kv import (
     _SAFETY, RTOL_MAX, RTOL_MIN)
 from vimpact.kernels.jit import jit
 from vimpact.kernels.layout import (
-    ELEMENT_STIFFNESS, N_OUT, N_REC, OUT_B_MAX, OUT_N_REC, OUT_STATUS, OUT_STEPS, OUT_T_CONTACT,
-    OUT_U_MAX, OUT_VC_END, OUT_VZ_END, STATUS_ASSUMPTION, STATUS_NON_FINITE, STATUS_OK,
-    STATUS_TIME_LIMIT, _record)
+    ELEMENT_STIFFNESS, N_REC, OUT_B_MAX, OUT_N_REC, OUT_STATUS, OUT_STEPS, OUT_T_CONTACT,
+    OUT_T_GROSS_SLIP, OUT_U_MAX, OUT_VC_END, OUT_VZ_END, OUT_W_FRICTION, STATUS_ASSUMPTION,
+    STATUS_NON_FINITE, STATUS_OK, STATUS_TIME_LIMIT, _record)
 
 __all__ = ["maxwell_stick_impact", "maxwell_stick_batch", "GN"]
 
@@ -442,6 +442,8 @@ def maxwell_stick_impact(tau0, g, tau, kappa, mu_t, tangential, rtol, max_steps,
     """
     n_rec = rec.shape[0]
     i_rec = 0
+    out[OUT_T_GROSS_SLIP] = 0.0  # no friction on this path
+    out[OUT_W_FRICTION] = 0.0
     nin = g.shape[0]
     ok_in = (tau0 >= 0.0 and math.isfinite(tau0) and kappa > 0.0 and math.isfinite(kappa)
              and mu_t > 0.0 and math.isfinite(mu_t) and tau.shape[0] == nin)
