@@ -112,3 +112,10 @@ def test_scene_and_numerics_errors(args, names, capsys):
     assert main(["simulate"] + args) == 2
     err = capsys.readouterr().err
     assert names in err and len(err.strip().splitlines()) == 1
+
+
+def test_a_negative_value_is_read_as_a_value_and_refused_by_name(capsys):
+    code = main(["simulate", "--E", "-1e9", "--nu", "0.5", "--R", "0.01", "--m", "0.004",
+                 "--vz0", "1"])
+    err = capsys.readouterr().err
+    assert code == 2 and err.count("\n") == 1 and err.startswith("vimpact simulate: error: --E = ")

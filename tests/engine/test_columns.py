@@ -152,3 +152,18 @@ def test_a_continuum_row_that_hits_its_step_limit_is_handed_to_the_elements(monk
     handed = v.simulate(scene, FAST)
     assert handed.status == "ok" and handed.path == elements.path
     assert handed.beta_x == elements.beta_x and handed.e_z == elements.e_z
+
+
+def test_prony_arm_with_a_third_field_is_refused():
+    with pytest.raises(v.InputError, match="arm 1"):
+        v.Material.prony(nu=0.5, G_inf=1e6, arms=[(1e6, 1e-3, 5.0)])
+
+
+def test_a_tiny_radius_is_blamed_on_the_radius():
+    with pytest.raises(v.InputError, match="^R = "):
+        v.Scene(v.Material.elastic(nu=0.5, G=1e6), R=1e-200, m=0.004, v_z0=1.0)
+
+
+def test_string_inputs_are_refused_at_the_boundary():
+    with pytest.raises(v.InputError, match="v_z0 = '1'"):
+        v.Scene(v.Material.elastic(nu=0.5, G=1e6), R=0.01, m=0.004, v_z0="1")

@@ -84,8 +84,13 @@ class Material:
         """Prony series: relaxed modulus ``G_inf`` (Pa), arms ``[(G_i [Pa], tau_i [s]), ...]``,
         optional parallel dashpot ``eta0`` (Pa s)."""
         nu = poisson_ratio("nu", nu)
-        arms = tuple((float(a[0]), float(a[1])) for a in arms)
-        return cls("prony", nu, positive("G_inf", G_inf), arms, non_negative("eta0", eta0))
+        checked = []
+        for i, arm in enumerate(arms, start=1):
+            require(f"arm {i}", arm, isinstance(arm, (tuple, list)) and len(arm) == 2,
+                    "a pair (G_i [Pa], tau_i [s])")
+            checked.append((positive(f"G_{i} (arm {i} modulus, Pa)", arm[0]),
+                            positive(f"tau_{i} (arm {i} relaxation time, s)", arm[1])))
+        return cls("prony", nu, positive("G_inf", G_inf), tuple(checked), non_negative("eta0", eta0))
 
     # ---- derived ------------------------------------------------------
     @property

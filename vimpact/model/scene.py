@@ -75,7 +75,11 @@ class Scene:
         object.__setattr__(self, "v_x0", finite("v_x0", self.v_x0))
         object.__setattr__(self, "omega0", finite("omega0", self.omega0))
         if self.Theta is None:
-            object.__setattr__(self, "Theta", DEFAULT_THETA_RATIO * self.m * self.R**2)
+            theta = DEFAULT_THETA_RATIO * self.m * self.R**2 if self.R < 1e150 else math.inf
+            require("R", self.R, 0.0 < theta < math.inf,
+                    f"large enough for the default Theta = 0.4 m R^2 to be a finite number > 0 "
+                    f"(with m = {self.m:g} kg; give Theta)")
+            object.__setattr__(self, "Theta", theta)
         object.__setattr__(self, "Theta", positive("Theta", self.Theta))
         one_of("tangential_memory", self.tangential_memory, TANGENTIAL_MEMORY)
         one_of("tangential", self.tangential, TANGENTIAL_EFFECTS)
