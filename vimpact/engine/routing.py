@@ -175,6 +175,9 @@ def choose_path(scene: Scene, numerics: Numerics) -> Path:
         contact = ("full stick" if path.spec is None or not path.spec.friction
                    else f"Coulomb friction mu = {scene.mu:g}")
         reasons.append(f"tangential {contact}, {scene.tangential_memory} memory, {rot}")
+        if mat.nu != 0.5:
+            reasons.append(f"nu = {mat.nu:g}: the tangential MDR mapping is exact only at "
+                           "nu = 0.5 for a rigid sphere; beta_x here is the thesis's approximation")
     what = [("Maxwell arms" if arms else "no arm variables"),
             ("a parallel dashpot" if dashpot else "no dashpot term")]
     reasons.append(f"material {mat.model}: {what[0]}, {what[1]}")
