@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import os
 import sys
 
 from vimpact import __version__
@@ -64,6 +65,9 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(_negative_values(sys.argv[1:] if argv is None else list(argv)))
     try:
         return args.func(args)
+    except BrokenPipeError:  # the reader went away (``| head``): stop quietly
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 0
     except (ValueError, OSError) as exc:
         text = " ".join(str(exc).split()) or type(exc).__name__
         print(f"vimpact {args.command}: error: {text}", file=sys.stderr)
