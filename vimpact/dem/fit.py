@@ -127,9 +127,9 @@ def fit_constant(target: np.ndarray, lo: float = 0.0, hi: float = 1.0) -> tuple[
     return c, Residual.of(np.full_like(target, c), target)
 
 
-def fit_viscoelastic_hertz(t: Targets, E_star: float, mass_factor: np.ndarray | None = None,
-                           clipped: bool = True) -> tuple[float, np.ndarray]:
-    """Dissipation time ``A`` (s) of the viscoelastic Hertz law closest to ``t.e_z`` in RMS.
+def fit_viscoelastic_hertz(t: Targets, E_star: float, mass_factor: np.ndarray | None = None
+                           ) -> tuple[float, np.ndarray]:
+    """Dissipation time ``A`` (s) of the clipped viscoelastic Hertz law closest to ``t.e_z`` in RMS.
 
     Parameters
     ----------
@@ -147,7 +147,7 @@ def fit_viscoelastic_hertz(t: Targets, E_star: float, mass_factor: np.ndarray | 
     unit = f * t.v / d  # alpha per unit A, 1/s
 
     def predict(A: float) -> np.ndarray:
-        return laws.viscoelastic_hertz_curve(np.minimum(A * unit, 1e3), clipped)
+        return laws.viscoelastic_hertz_curve(np.minimum(A * unit, 1e3))
 
     # first-order guess from the small-damping slope, then a bounded search in log A
     guess = float(np.median(np.maximum(1.0 - t.e_z, 1e-9) / laws.SMALL_DAMPING_SLOPE / unit))

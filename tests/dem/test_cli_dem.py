@@ -1,0 +1,81 @@
+"""`vimpact dem`: files for every code, bad input in one line with exit 2."""
+
+import pytest
+
+from vimpact.cli.main import main
+from vimpact.dem.export import CODES
+
+TOML = """
+[speeds]
+min = 0.1
+max = 1.0
+n = 4
+[types.a]
+density = 1200.0
+radius = 0.005
+[types.a.material]
+model = "kelvin_voigt"
+nu = 0.45
+G = 3e7
+eta = 600.0
+[types.b]
+density = 1300.0
+radius = 0.004
+[types.b.material]
+model = "elastic"
+nu = 0.45
+G = 9e7
+[walls.floor]
+material = "rigid"
+[friction]
+default = 0.5
+"""
+
+FILES = {"lammps": ["lammps.in"], "liggghts": ["liggghts.in"],
+         "mercurydpm": ["mercurydpm_species.cpp"], "yade": ["yade_materials.py"],
+         "mfix": ["mfix.dat"], "rebound": ["vimpact_restitution.py"]}
+
+
+@pytest.mark.parametrize("code", CODES)
+def test_writes_input_and_report_for_every_code(code, tmp_path, capsys):
+    src = tmp_path / "setup.toml"
+    src.write_text(TOML)
+    out = tmp_path / code
+    assert main(["dem", str(src), "--for", code, "--out", str(out)]) == 0
+    for name in FILES[code] + [f"report_{code}.md", f"report_{code}.png"]:
+        assert (out / name).stat().st_size > 0, name
+    report = (out / f"report_{code}.md").read_text()
+    assert "a-b" in report and "a-floor" in report and "b-floor" in report
+    if code not in ("yade", "mfix"):
+        assert "not represented" in report
+    text = capsys.readouterr().out
+    assert "e_z residual" in text
+
+
+def test_lammps_lines_name_every_pair_and_one_wall_fix_per_type(tmp_path):
+    src = tmp_path / "setup.toml"
+    src.write_text(TOML)
+    main(["dem", str(src), "--for", "lammps", "--out", str(tmp_path)])
+    text = (tmp_path / "lammps.in").read_text()
+    assert [ln.split()[1:3] for ln in text.splitlines() if ln.startswith("pair_coeff")] == \
+        [["1", "1"], ["1", "2"], ["2", "2"]]
+    assert sum(ln.startswith("fix wall_floor_") for ln in text.splitlines()) == 2
+
+
+@pytest.mark.parametrize("edit, words", [
+    (("G = 9e7", "G = -9e7"), "G"),
+    (('model = "elastic"', 'model = "kelvin_voigt"\neta = 100.0'), "not allowed"),
+    (("min = 0.1", "min = 2.0"), "speeds"),
+    (("density = 1200.0", 'density = "heavy"'), "density"),
+])
+def test_bad_input_is_one_line_and_exit_2(edit, words, tmp_path, capsys):
+    src = tmp_path / "bad.toml"
+    src.write_text(TOML.replace(*edit, 1))
+    assert main(["dem", str(src), "--for", "lammps", "--out", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and words in err
+
+
+def test_missing_file_is_exit_2(tmp_path, capsys):
+    assert main(["dem", str(tmp_path / "nope.toml"), "--for", "mfix"]) == 2
+    assert capsys.readouterr().err.count("\n") == 1

@@ -1,0 +1,80 @@
+"""The DEM codes' one-contact laws against closed forms (vimpact.dem.laws)."""
+
+import math
+
+import numpy as np
+import pytest
+
+from vimpact.dem import laws, linear
+from vimpact.dem.mfix import _beta as mfix_beta
+from vimpact.dem.yade import _beta as yade_beta
+from vimpact.reference.closed_forms import linear_model_zeta
+
+
+@pytest.mark.parametrize("zeta", [0.0, 0.05, 0.3, 0.7, 0.999, 1.0, 1.5, 4.0])
+def test_linear_law_ending_at_zero_force_is_the_closed_form(zeta):
+    e, _, t = laws.linear_spring_dashpot(zeta, "force")
+    ref = linear_model_zeta(zeta)
+    assert e == pytest.approx(float(ref.e), rel=1e-8, abs=1e-12)
+    assert t == pytest.approx(float(ref.t_star), rel=1e-8)
+
+
+@pytest.mark.parametrize("e_in", [0.1, 0.5, 0.9, 0.999])
+def test_linear_law_ending_at_zero_overlap_restitutes_its_input(e_in):
+    """The DEM formula zeta = |ln e| / sqrt(pi^2 + ln^2 e) with the contact ending at zero
+    overlap gives e = exp(-zeta pi / sqrt(1 - zeta^2)) = e_in after t = pi / omega_d."""
+    zeta = laws.zeta_of_restitution(e_in)
+    e, _, t = laws.linear_spring_dashpot(zeta, "overlap")
+    assert e == pytest.approx(e_in, rel=1e-9)
+    assert t == pytest.approx(math.pi / math.sqrt(1 - zeta**2), rel=1e-9)
+
+
+def test_elastic_hertz_law_is_hertz():
+    e, t = laws.viscoelastic_hertz_e(0.0)
+    assert e == pytest.approx(1.0, abs=1e-9)
+    assert t == pytest.approx(2.9432751843, rel=1e-8)
+
+
+def test_viscoelastic_hertz_small_damping_slope():
+    """1 - e = 1.8917 alpha to first order (PHYSICS.md section 5), with the second-order
+    term visible as a linear trend of the slope in alpha."""
+    alphas = np.array([1e-5, 2e-5, 4e-5])
+    slopes = np.array([(1 - laws.viscoelastic_hertz_e(a)[0]) / a for a in alphas])
+    intercept = np.polyfit(alphas, slopes, 1)[1]
+    assert intercept == pytest.approx(1.8917, abs=2e-4)
+    assert laws.SMALL_DAMPING_SLOPE == pytest.approx(1.8917, abs=1e-4)
+
+
+def test_clipping_only_raises_restitution():
+    for a in (0.01, 0.3, 3.0):
+        assert laws.viscoelastic_hertz_e(a, True)[0] > laws.viscoelastic_hertz_e(a, False)[0]
+
+
+def test_tabulated_master_curve_equals_direct_solves():
+    alphas = np.geomspace(2e-7, 500.0, 23)
+    direct = [laws.viscoelastic_hertz_e(a)[0] for a in alphas]
+    np.testing.assert_allclose(laws.viscoelastic_hertz_curve(alphas), direct, atol=2e-7)
+
+
+@pytest.mark.parametrize("en, et", [(0.7, 0.4), (0.3, 0.9), (0.95, 0.05)])
+def test_yade_tangential_restitution_is_et_for_solid_spheres(en, et):
+    """Yade's ks, cs use the contact-point mass 2/7 m of solid spheres (mass factor 3.5):
+    the tangential oscillator then completes half a damped period in tc, so beta = et."""
+    assert yade_beta(en, et, 3.5) == pytest.approx(et, rel=1e-8)
+
+
+def test_linear_tangential_undamped_closed_form():
+    """Undamped tangential oscillator w_t over a normal contact of pi / omega_d: beta = -cos(w_t t)."""
+    en = 0.6
+    zeta = laws.zeta_of_restitution(en)
+    t = math.pi / math.sqrt(1 - zeta**2)
+    for w_t in (0.5, 1.0, 1.7):
+        assert linear.tangential_beta(en, w_t, 0.0) == pytest.approx(-math.cos(w_t * t), abs=1e-8)
+
+
+def test_mfix_beta_is_monotonic_in_the_damping_factor():
+    b = [mfix_beta(0.7, f, 3.5) for f in (0.0, 0.2, 0.5, 1.0)]
+    assert b[0] == pytest.approx(-math.cos(math.sqrt(2 / 7 * 3.5) * math.pi /
+                                           math.sqrt(1 - laws.zeta_of_restitution(0.7)**2)),
+                                 abs=1e-8)
+    assert all(x > y for x, y in zip(b, b[1:]))
