@@ -88,7 +88,7 @@ def add_parser(sub) -> argparse.ArgumentParser:
     g.add_argument("--allow-large-contact", action="store_true",
                    help="accept a contact half-width above 0.2 R (outside the half-space model)")
     g.add_argument("--trajectory", metavar="FILE",
-                   help="write the time series (t, u_z, v_z, v_x, omega, F_z, F_x, a) to "
+                   help="write the time series (t, u_z, v_z, v_x, omega, F_z, F_x, a, slip width) to "
                         "FILE, CSV or Parquet by extension (.csv, .parquet)")
     g.add_argument("--json", action="store_true", help="print one JSON object")
     sim.set_defaults(func=run)
@@ -246,7 +246,7 @@ def _summary(scene: Scene, res) -> str:
              f"tangential memory {scene.tangential_memory}"]
     for key in ("e_z", "beta_x", "e_x", "mu_eff", "energy_ratio", "Q1", "Q2", "t_contact",
                 "t_hertz", "u_max", "d_hertz", "a_max", "a_hertz", "v_z_end", "v_x_end",
-                "omega_end", "rebound_angle"):
+                "omega_end", "rebound_angle", "gross_slip_fraction", "friction_energy"):
         value = getattr(res, key)
         unit = UNITS[key] if UNITS[key] != "1" else ""
         text = "undefined" if math.isnan(value) else f"{value:.6g}"

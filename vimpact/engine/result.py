@@ -27,6 +27,8 @@ UNITS = {
     "omega_end": "rad/s",
     "mu_eff": "1",
     "rebound_angle": "deg",
+    "gross_slip_fraction": "1",
+    "friction_energy": "J",
     "status": "",
     "n_steps": "1",
     "path": "",
@@ -87,6 +89,9 @@ class ImpactResult:
     mu_eff : impulse ratio ``|int F_x dt| / int F_z dt`` (NaN without tangential problem)
     rebound_angle : angle of the centre's rebound velocity to the normal,
         ``atan2(v_x_end, -v_z_end)``, degrees
+    gross_slip_fraction : fraction of the contact time in which every element in
+        contact slips (Coulomb friction; 0 in full stick, NaN without tangential problem)
+    friction_energy : energy dissipated by slip, J (0 in full stick)
     n_steps : time steps taken (element path) or accepted ODE steps (continuum path)
     path : the kernel that ran (:mod:`vimpact.engine.routing`), e.g. ``elements[verlet,dashpot]``
     trajectory : time series of the impact if asked for (``None`` otherwise)
@@ -113,6 +118,8 @@ class ImpactResult:
     path: str = ""
     mu_eff: float = math.nan
     rebound_angle: float = math.nan
+    gross_slip_fraction: float = math.nan
+    friction_energy: float = math.nan
     error: str | None = None
     trajectory: pd.DataFrame | None = field(default=None, repr=False, compare=False)
 

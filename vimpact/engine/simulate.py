@@ -171,7 +171,7 @@ def simulate(scene: Scene, numerics: Numerics | str | None = None, *,
         or a preset name (``"fast"``, ``"default"``, ``"precise"``, ``"thesis"``)
     trajectory : also record the time series (``ImpactResult.trajectory``, a
         DataFrame with columns ``t_s, u_z_m, v_z_m_s, v_x_m_s, omega_rad_s,
-        F_z_N, F_x_N, a_m``; about 500 rows per Hertz time on the element
+        F_z_N, F_x_N, a_m, slip_width_m``; about 500 rows per Hertz time on the element
         path, one row per accepted step on the continuum path)
 
     Raises
@@ -236,4 +236,5 @@ def _trajectory(s: Scene, rec: np.ndarray) -> pd.DataFrame:
         "F_z_N": rec[:, layout.REC_FZ] * force_n,
         "F_x_N": rec[:, layout.REC_FX] * force_t,
         "a_m": rec[:, layout.REC_B] * hz.a_H,
+        "slip_width_m": rec[:, layout.REC_SLIP] * hz.a_H,
     })

@@ -26,9 +26,10 @@ PASSIVITY_SLACK = 1e-6
 
 #: Outputs that are numbers only with a status in ``FINISHED``.
 OUTPUTS = ("e_z", "e_x", "beta_x", "t_contact", "u_max", "a_max", "energy_ratio", "v_z_end",
-           "v_x_end", "omega_end", "mu_eff", "rebound_angle")
+           "v_x_end", "omega_end", "mu_eff", "rebound_angle", "gross_slip_fraction",
+           "friction_energy")
 #: Outputs that are NaN (by definition) without a tangential problem.
-TANGENTIAL_OUTPUTS = ("e_x", "beta_x", "mu_eff")
+TANGENTIAL_OUTPUTS = ("e_x", "beta_x", "mu_eff", "gross_slip_fraction")
 
 
 def unpack(cols: SceneColumns, out: np.ndarray, path_names: np.ndarray, explicit_euler: np.ndarray,
@@ -84,6 +85,10 @@ def unpack(cols: SceneColumns, out: np.ndarray, path_names: np.ndarray, explicit
             "v_z_end": v_z_end, "v_x_end": v_x_end, "omega_end": omega_end,
             "mu_eff": np.where(tangential, np.abs(impulse) / (v_z0 - v_z_end), np.nan),
             "rebound_angle": np.degrees(np.arctan2(v_x_end, -v_z_end)),
+            "gross_slip_fraction": np.where(
+                tangential, out[:, layout.OUT_T_GROSS_SLIP] / out[:, layout.OUT_T_CONTACT], np.nan),
+            "friction_energy": np.where(
+                tangential, out[:, layout.OUT_W_FRICTION] * cols.m * v_c0**2, 0.0),
         }
         gain = contact1 > contact0 * (1.0 + PASSIVITY_SLACK)
         unresolved = out[:, layout.OUT_T_CONTACT] * steps_per_T < MIN_CONTACT_STEPS
