@@ -134,6 +134,8 @@ _LS, _LV, _LT = 0, 1, 2
 _US, _UV, _UT, _UU = 0, 1, 2, 3
 
 _N_CHECK = 200  # steps of the post-separation surface check
+#: first unloading step as a fraction of the step the loading phase proposed
+UNLOAD_FIRST_STEP = 1e-3
 
 
 @jit()
@@ -644,7 +646,10 @@ def maxwell_stick_impact(tau0, g, tau, kappa, mu_t, tangential, rtol, max_steps,
                 atol[0] = rtol * min(s_max, (v_scale / (1.25 * tau0)) ** (1.0 / 3.0))
             Fz, Fx = _rhs(phase, y, K[0], tau0, ga, itau, n, kappa, mu_t, tang, rc, hs, nh,
                           e_val)
-            h = h_next
+            # restart small: the right-hand side is not smooth in the edge state
+            # at the turning point, and there the error estimate of a long step
+            # misses most of its error (measured: 10-20x the error otherwise)
+            h = h_next * UNLOAD_FIRST_STEP
             err_old = 1e-4
             if n_rec > 0 and steps % rec_every == 0:
                 i_rec = _rec_state(rec, i_rec, phase, y, K, tau0, ga, itau, n, kappa, mu_t,
