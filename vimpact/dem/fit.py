@@ -44,6 +44,12 @@ class Targets:
     t_contact: np.ndarray
     status: np.ndarray
 
+    def subset(self, mask: np.ndarray) -> "Targets":
+        """The points selected by ``mask``."""
+        pick = lambda a: None if a is None else a[mask]  # noqa: E731
+        return Targets(self.contact, self.v[mask], self.level[mask], self.R[mask], self.m[mask],
+                       self.e_z[mask], pick(self.beta_x), self.t_contact[mask], self.status[mask])
+
     @property
     def nominal(self) -> np.ndarray:
         """Mask of the points at the nominal size level."""
@@ -161,6 +167,15 @@ def fit_viscoelastic_hertz(t: Targets, E_star: float, mass_factor: np.ndarray | 
                            options={"xatol": 1e-9, "maxiter": 500})
     A = 10.0**best.x
     return A, predict(A)
+
+
+def viscoelastic_hertz_prediction(t: Targets, E_star: float, A: float,
+                                  mass_factor: np.ndarray | None = None) -> np.ndarray:
+    """The viscoelastic Hertz law's restitution at the points of ``t`` with constant ``A``
+    (times ``mass_factor`` per point, as in :func:`fit_viscoelastic_hertz`)."""
+    f = np.ones_like(t.v) if mass_factor is None else np.asarray(mass_factor, dtype=float)
+    return laws.viscoelastic_hertz_curve(np.minimum(A * f * t.v / laws.hertz_overlap(
+        E_star, t.R, t.m, t.v), 1e3))
 
 
 def linear_tangential_beta(en: float, et_like: tuple[float, float]) -> float:

@@ -32,7 +32,8 @@ import tempfile
 
 import numpy as np
 
-from vimpact.dem.fit import ContactFit, Residual, Targets, fit_viscoelastic_hertz
+from vimpact.dem.fit import (ContactFit, Residual, Targets, fit_viscoelastic_hertz,
+                             viscoelastic_hertz_prediction)
 from vimpact.dem.problem import Contact, DemProblem
 
 CODE = "lammps"
@@ -57,17 +58,20 @@ def contact_constants(contact: Contact, A: float) -> dict:
 
 
 def fit(problem: DemProblem, targets: dict[str, Targets]) -> list[ContactFit]:
-    """Fit ``A`` per contact; the prediction includes LAMMPS' mass scaling over a size range."""
+    """Fit ``A`` per contact at the nominal sizes; the prediction at the other size levels
+    includes LAMMPS' mass scaling of the damping."""
     fits = []
     for c in problem.contacts:
         t = targets[c.key]
         _, m_nom = c.nominal()
-        A, e = fit_viscoelastic_hertz(t, c.E_star, mass_factor=t.m / m_nom)
+        A, _ = fit_viscoelastic_hertz(t.subset(t.nominal), c.E_star)
+        e = viscoelastic_hertz_prediction(t, c.E_star, A, mass_factor=t.m / m_nom)
         notes = ["beta_x: not represented (LAMMPS has no tangential restitution input; "
                  "tangential mindlin with the relaxed stiffness is exported, not fitted)"]
         if len(set(t.level.tolist())) > 1:
-            notes.append("size range: eta_n0 is exact at the nominal size only (LAMMPS "
-                         "multiplies it by m_eff); the residual includes the other sizes")
+            notes.append("size range: A is fitted at the nominal size; LAMMPS multiplies "
+                         "eta_n0 by m_eff, so at the other sizes the damping is off by "
+                         "m_eff / m_eff,nominal (included in the residual)")
         if not math.isfinite(c.mu):
             notes.append(f"no friction given: mu_s = {STICK_MU:g} (stick)")
         fits.append(ContactFit(c, contact_constants(c, A), e, None, Residual.of(e, t.e_z), None,
@@ -226,3 +230,32 @@ def predicted_restitution(fit: ContactFit, v) -> np.ndarray:
 
     R, m = fit.contact.nominal()
     return viscoelastic_hertz_restitution(fit.params["A_s"], fit.params["E_star_Pa"], R, m, v)
+
+
+def round_trip(problem: DemProblem, speeds=(0.1, 1.0), steps_per_contact: int = 4000,
+               numerics=None) -> list[tuple[str, float, float, float]]:
+    """Run LAMMPS on every contact of ``problem`` (nominal sizes) with the exported lines:
+    ``(contact, v, predicted e, LAMMPS e)`` per contact and speed."""
+    from vimpact.dem.export import export
+    from vimpact.dem.laws import hertz_contact_time
+
+    rows = []
+    for f in export(problem, CODE, numerics=numerics).fits:
+        R, m = f.contact.nominal()
+        for v in speeds:
+            t_c = float(hertz_contact_time(f.params["E_star_Pa"], R, m, v))
+            rows.append((f.contact.key, v, float(predicted_restitution(f, v)),
+                         lammps_restitution(f, v, t_c, steps_per_contact)))
+    return rows
+
+
+if __name__ == "__main__":  # python -m vimpact.dem.lammps SETUP.toml [STEPS_PER_CONTACT]
+    from vimpact.dem.problem import load_problem
+
+    why = lammps_available()
+    if why:
+        sys.exit(f"cannot run LAMMPS: {why}")
+    steps = int(sys.argv[2]) if len(sys.argv) > 2 else 4000
+    print(f"{'contact':12s} {'v [m/s]':>8s} {'predicted e':>12s} {'LAMMPS e':>12s} {'diff':>10s}")
+    for key, v, e_pred, e_lmp in round_trip(load_problem(sys.argv[1]), (0.05, 0.2, 1.0), steps):
+        print(f"{key:12s} {v:8.3g} {e_pred:12.8f} {e_lmp:12.8f} {e_lmp - e_pred:10.2e}")
