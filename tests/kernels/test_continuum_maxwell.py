@@ -71,13 +71,17 @@ def test_elastic_is_hertz(nu):
 
 # ---- the independent scipy reference --------------------------------------------------
 
-# Accuracy: the edge makes the unloading right-hand side weakly singular just
-# after the turning point (with a dashpot and arms, the edge itself has a
-# (t - t_turn)^(3/2) term), which costs the Runge-Kutta steps their order
-# there: at rtol 1e-13 the error is below 1e-10 except t_contact and beta_x
-# with a dashpot and arms (~2e-10), hence the common bound 1e-9.
-TOL_REF = 1e-9
-RTOL_REF = 1e-13
+# Accuracy at rtol 1e-12: 1e-10 on e_z, beta_x, t_contact and u_max. With a
+# dashpot *and* arms the edge has a (t - t_turn)^(3/2) term just after the
+# turning point, which both the kernel and the reference (in t) integrate
+# through at reduced order: 1e-9 there (measured up to 3.4e-10 in t_contact;
+# all other scenes within 3e-11).
+RTOL_REF = 1e-12
+
+
+def _tol_ref(tau0, g):
+    return 1e-9 if (tau0 > 0.0 and len(g) > 0) else 1e-10
+
 
 SCENES = [  # (tau0, g, tau, nu, mu_t)
     (0.2, [], [], 0.5, 3.5),  # Kelvin-Voigt
@@ -92,8 +96,9 @@ def _compare_with_reference(tau0, g, tau, nu, mu_t):
     assert out[OUT_STATUS] == STATUS_OK
     got = outputs(out)
     want = np.array([ref.e_z, ref.beta_x, ref.t_contact])
-    assert np.all(np.abs(got - want) < TOL_REF), (got - want)
-    assert abs(out[OUT_U_MAX] - ref.u_max) < TOL_REF
+    tol = _tol_ref(tau0, g)
+    assert np.all(np.abs(got - want) < tol), (got - want)
+    assert abs(out[OUT_U_MAX] - ref.u_max) < tol
 
 
 @pytest.mark.parametrize("scene", SCENES)
