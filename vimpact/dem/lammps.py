@@ -4,8 +4,12 @@ The normal law is the viscoelastic Hertz law with the force clipped at zero
 (``limit_damping``). LAMMPS' ``hertz`` model takes the stiffness ``k_n`` per
 contact directly (``F = k_n a delta``, ``a = sqrt(R_eff delta)``), so
 ``k_n = 4/3 E*`` of the pair; this avoids the modulus mixing of
-``hertz/material`` (which builds ``E*`` from per-type ``E``, ``nu`` with its
-own wall rule). ``damping viscoelastic`` writes the damping as
+``hertz/material``, which builds ``E* = 1/((1-nu1^2)/E1 + (1-nu2^2)/E2)`` from
+the ``E``, ``nu`` it is given and, for ``fix wall/gran``, treats the wall as
+a body of the *same* ``E`` and ``nu`` as the particle: ``E* = E / (2 (1 -
+nu^2))``, not the rigid-wall ``E / (1 - nu^2)`` (measured with the installed
+LAMMPS 2025.7.22: the elastic contact time against a wall is the Hertz time of
+``E/(2(1-nu^2))`` to 6e-6, and 1.32 = 2^0.4 times the rigid-wall one). ``damping viscoelastic`` writes the damping as
 ``eta_n = eta_n0 a m_eff``, i.e. ``eta_n0 = 2 E* A / m_eff``: the
 dissipation time ``A`` is a material constant, but LAMMPS' coefficient
 carries the effective mass, so one ``eta_n0`` per type pair is exact only at
