@@ -170,9 +170,9 @@ def test_interpolation_is_linear_in_log_q1_and_nu(kv):
     rows = kv.ok
     at = lambda q1, nu: rows[np.isclose(rows.Q1, q1, rtol=1e-9) & np.isclose(rows.nu, nu)].iloc[0]
     a, b = Q1_GRID[2], Q1_GRID[3]
-    mid = kv.lookup(np.sqrt(a * b), 0.5)  # halfway in log Q1
+    mid = kv.lookup(np.sqrt(a * b), 0.5, method="linear")  # halfway in log Q1
     assert mid["e_z"] == pytest.approx(0.5 * (at(a, 0.5).e_z + at(b, 0.5).e_z), abs=1e-12)
-    mid = kv.lookup(a, 0.125)  # halfway in nu
+    mid = kv.lookup(a, 0.125, method="linear")  # halfway in nu
     assert mid["beta_x"] == pytest.approx(0.5 * (at(a, 0.0).beta_x + at(a, 0.25).beta_x),
                                           abs=1e-12)
     assert mid["e_x"] == pytest.approx(abs(mid["beta_x"]), abs=1e-15)
@@ -212,8 +212,12 @@ def test_extrapolate_continues_the_edge_cell(kv):
     rows = kv.ok[np.isclose(kv.ok.nu, 0.5)].sort_values("Q1")
     e0, e1 = rows.e_z.iloc[0], rows.e_z.iloc[1]
     q = Q1_GRID[0] * (Q1_GRID[1] / Q1_GRID[0]) ** -0.2  # a fifth of a cell below the table
-    res = kv.lookup(q, 0.5, extrapolate=True)
+    res = kv.lookup(q, 0.5, extrapolate=True, method="linear")
     assert res["e_z"] == pytest.approx(e0 + 0.2 * (e0 - e1), abs=1e-12) and res["e_z"] < 1
+    # cubic: linear beyond the end node with its slope, which lies between the end
+    # secant's value and 0 for this monotone data
+    cubic = kv.lookup(q, 0.5, extrapolate=True)["e_z"]
+    assert e0 <= cubic <= e0 + 3 * 0.2 * (e0 - e1)
     far = kv.lookup([1e-6, 1e3], 0.5, extrapolate=True)  # clipped to the physical bounds
     assert np.all((far["e_z"] >= 0) & (far["e_z"] <= 1) & (far["e_x"] >= 0) & (far["e_x"] <= 1))
     with pytest.raises(ValueError, match="Q1 = 0 cannot be extrapolated"):
@@ -235,7 +239,7 @@ def test_standard_solid_interpolates_in_log_q2(ss_path):
     rows = ss.ok
     sel = lambda q2: rows[np.isclose(rows.Q2, q2) & np.isclose(rows.Q1, 0.1)
                           & np.isclose(rows.nu, 0.0)].iloc[0]
-    mid = ss.lookup(0.1, 0.0, Q2=np.sqrt(0.1 * 1.0))
+    mid = ss.lookup(0.1, 0.0, Q2=np.sqrt(0.1 * 1.0), method="linear")
     assert mid["e_z"] == pytest.approx(0.5 * (sel(0.1).e_z + sel(1.0).e_z), abs=1e-12)
 
 

@@ -1,4 +1,4 @@
-"""The ``vimpact table`` subcommand: info, lookup and e(v) export of restitution tables.
+"""The ``vimpact table`` subcommand: info, lookup, verify and e(v) export of restitution tables.
 
 ``add_parser(subparsers)`` registers it on the subparsers object of :func:`vimpact.cli.main.build_parser`; each sets
 ``func`` to its handler, which returns the exit code and raises
@@ -43,13 +43,14 @@ def _json_value(x):
 # --------------------------------------------------------------------------
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
-    """Register ``vimpact table {info,lookup,export}`` on ``subparsers``."""
+    """Register ``vimpact table {info,lookup,verify,export}`` on ``subparsers``."""
     table = subparsers.add_parser(
         "table", help="inspect, interpolate and export restitution tables",
         description=(
             "Read a restitution table (Parquet, written by `vimpact sweep`): summarize it, "
-            "interpolate e_z, e_x, beta_x at given Q1 [Q2] nu (linear in log Q1, log Q2 and "
-            "in nu on the table's grid), or export e_z(v), e_x(v) for one material and sphere."))
+            "interpolate e_z, e_x, beta_x at given Q1 [Q2] nu (cubic Hermite in log Q1, log Q2 "
+            "and nu on the table's grid, or linear), measure the interpolation error against "
+            "direct simulation, or export e_z(v), e_x(v) for one material and sphere."))
     sub = table.add_subparsers(dest="table_command", required=True, metavar="ACTION")
 
     info = sub.add_parser("info", help="model, rows, statuses, covered ranges, grid, numerics",
@@ -62,8 +63,10 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     look = sub.add_parser(
         "lookup", help="interpolate e_z, e_x, beta_x at Q1 [Q2] nu",
         description=(
-            "Interpolate e_z, e_x, beta_x (dimensionless) on a grid table: linear in log Q1 "
-            "(and log Q2), linear in nu. Each of --Q1, --Q2, --nu takes one value or a "
+            "Interpolate e_z, e_x, beta_x (dimensionless) on a grid table: cubic Hermite in "
+            "log Q1 (and log Q2) and nu, shape-preserving where the data is monotone (or "
+            "--method linear). The measured interpolation error of the table (`vimpact table "
+            "verify --write`) is printed with the values. Each of --Q1, --Q2, --nu takes one value or a "
             "comma-separated list; lists are paired element by element (a single value is "
             "used for every element). Values outside the table's range are an error unless "
             "--extrapolate is given."),
@@ -80,8 +83,32 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     look.add_argument("--extrapolate", action="store_true",
                       help="extrapolate linearly outside the covered range (clipped to "
                            "0 <= e <= 1) instead of failing")
+    look.add_argument("--method", choices=("cubic", "linear"), default="cubic",
+                      help="interpolation: cubic Hermite (default) or multilinear")
     look.add_argument("--json", action="store_true", help="print one JSON object")
     look.set_defaults(func=_cmd_lookup)
+
+    ver = sub.add_parser(
+        "verify", help="measure the interpolation error against direct simulation",
+        description=(
+            "Simulate held-out points between the table's nodes (the mid-point of every cell "
+            "edge along each axis, every cell centre, and --n random interior points) with "
+            "the table's own numerics, compare with the lookup, and print the max and RMS "
+            "error of e_z, beta_x, e_x (dimensionless). --write stores it in the table as "
+            "the metadata entry vimpact.interpolation_error, which lookup and info report."),
+        epilog="Example: vimpact table verify kv.parquet --n 500 --write")
+    ver.add_argument("table", metavar="TABLE", help="restitution table (.parquet)")
+    ver.add_argument("--n", type=int, default=200, metavar="N",
+                     help="random interior points besides the mid-points (default 200)")
+    ver.add_argument("--seed", type=int, default=0, help="seed of the random points (default 0)")
+    ver.add_argument("--method", choices=("cubic", "linear"), default="cubic",
+                     help="interpolation measured (default cubic)")
+    ver.add_argument("--theta-ratio", type=float, metavar="RATIO",
+                     help="Theta / (m R^2), only for tables that hold several")
+    ver.add_argument("--write", action="store_true",
+                     help="store the result in the table (rewrites the file)")
+    ver.add_argument("--json", action="store_true", help="print one JSON object")
+    ver.set_defaults(func=_cmd_verify)
 
     exp = sub.add_parser(
         "export", help="write e_z(v), e_x(v) for one material and sphere to CSV",
@@ -143,19 +170,57 @@ def _cmd_lookup(a) -> int:
         raise ValueError(", ".join(f"{k} has {len(v)} values" for k, v in given.items())
                          + ": lists must have one length (or be a single value)")
     res = table.lookup(np.array(a.Q1), np.array(a.nu), None if a.Q2 is None else np.array(a.Q2),
-                       extrapolate=a.extrapolate, theta_ratio=a.theta_ratio)
+                       extrapolate=a.extrapolate, theta_ratio=a.theta_ratio, method=a.method)
+    bound = res.pop("error_bound")
     names = list(res)
     rows = [{k: _json_value(float(res[k][i])) for k in names} for i in range(len(res["Q1"]))]
     if a.json:
         print(json.dumps({"table": a.table, "model": table.model, "extrapolate": a.extrapolate,
-                          "rows": rows}))
+                          "method": a.method, "error_bound": bound, "rows": rows}))
     else:
-        print(f"{table.model} table {a.table}" + (" (extrapolated where outside)"
-                                                   if a.extrapolate else ""))
+        print(f"{table.model} table {a.table}, {a.method}" + (" (extrapolated where outside)"
+                                                              if a.extrapolate else ""))
         print("  ".join(f"{k:>12}" for k in names))
         for row in rows:
             print("  ".join(f"{'nan' if row[k] is None else format(row[k], '.6g'):>12}"
                             for k in names))
+        if bound:
+            print("measured interpolation error (max between nodes): "
+                  + ", ".join(f"{k} {v:.2g}" for k, v in bound.items()))
+        else:
+            print(f"interpolation error not measured for {a.method} "
+                  f"(`vimpact table verify {a.table} --method {a.method} --write`)")
+    return 0
+
+
+def _cmd_verify(a) -> int:
+    from vimpact.lookup.verify import interpolation_error, write_interpolation_error
+
+    if a.n < 0:
+        raise ValueError(f"--n = {a.n} is not allowed: must be an integer >= 0")
+    table = _open(a.table)
+    result = interpolation_error(table, n=a.n, seed=a.seed, theta_ratio=a.theta_ratio,
+                                 method=a.method)
+    if a.write:
+        write_interpolation_error(table, result)
+    if a.json:
+        print(json.dumps(result, default=_json_value))
+        return 0
+    print(f"{table.model} table {a.table}: {a.method} lookup against direct simulation at "
+          f"{result['points']} held-out points ({result['failed']} failed, left out)")
+    for name, v in result["outputs"].items():
+        if v["max"] is None:
+            print(f"  {name:<7} no data")
+            continue
+        at = ", ".join(f"{k} = {x:.4g}" for k, x in v["at"].items())
+        print(f"  {name:<7} max {v['max']:.3g} (at {at}), rms {v['rms']:.3g}")
+    for axis, errs in result["per_axis"].items():
+        print(f"  mid-way along {axis}: " + ", ".join(f"{k} {e:.3g}" for k, e in errs.items()))
+    if result["node_error"]:
+        print("  at the table's nodes (re-simulated sample): "
+              + ", ".join(f"{k} {e:.3g}" for k, e in result["node_error"].items()))
+    if a.write:
+        print(f"stored as vimpact.interpolation_error in {a.table}")
     return 0
 
 
