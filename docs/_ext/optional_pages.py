@@ -23,6 +23,12 @@ def _drop_missing(app, docname: str, source: list[str]) -> None:
     source[0] = "\n".join(keep) + "\n"
 
 
+def _always_reread_root(app, env, added, changed, removed) -> list[str]:
+    """Whether an optional page exists can change between builds: re-read the index."""
+    return [app.config.root_doc]
+
+
 def setup(app):
     app.connect("source-read", _drop_missing)
+    app.connect("env-get-outdated", _always_reread_root)
     return {"version": "1", "parallel_read_safe": True, "parallel_write_safe": True}
