@@ -2,7 +2,6 @@
 report predicted for it (LAMMPS; REBOUND with the exported callback module)."""
 
 import importlib.util
-import sys
 
 import numpy as np
 import pytest

