@@ -74,8 +74,9 @@ def add_parser(sub) -> argparse.ArgumentParser:
                    help="numerics preset: fast (about 1e-3), default (about 1e-4), precise, "
                         "thesis (explicit Euler as in the thesis)")
     g.add_argument("--tolerance", type=float, metavar="TOL",
-                   help="pick steps and elements for this accuracy on e_z and e_x "
-                        "(instead of a preset; between 1e-7 and 1e-2)")
+                   help="numerics for this absolute accuracy on e_z and beta_x on the path "
+                        "that runs (instead of a preset; between 1e-9 and 1e-2); refused where "
+                        "the element path cannot reach it")
     g.add_argument("--integrator", choices=tuple(INTEGRATORS), help="override the integrator")
     g.add_argument("--steps", type=int, help="override: time steps per Hertz contact time")
     g.add_argument("--elements", type=int, help="override: elements per Hertz contact radius")
