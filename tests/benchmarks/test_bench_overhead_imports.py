@@ -43,7 +43,8 @@ def test_overhead_through_the_command(tmp_path, monkeypatch, capsys):
         assert all(t >= k > 0.0 for t, k in zip(d["total_s"], d["kernel_s"]))
         assert d["statuses"] == {status: rows}
     assert list(data["continuum"]["paths"]) == ["continuum[kelvin_voigt,normal]"]
-    assert all(p.startswith("elements[") and "tangential" in p for p in data["elements"]["paths"])
+    assert all(p.startswith("elements[") and "tangential" in p and "friction" in p
+               for p in data["elements"]["paths"])
     assert {"continuum_overhead_met", "element_overhead_met",
             "kv_rows_per_second_met"} <= set(data["targets"])
 
@@ -56,6 +57,9 @@ def test_overhead_columns_are_valid_kelvin_voigt_rows():
     from vimpact.model.hertz import Q1_PER_TAU, hertz_scales
 
     c = overhead.scene_columns(500, seed=3)
+    oblique = overhead.scene_columns(500, seed=3, oblique=True)
+    assert np.all((oblique["mu"] >= 0.1) & (oblique["mu"] <= 0.5))
+    assert np.array_equal(oblique["v_x0_m_s"], oblique["v_z0_m_s"])
     hz = hertz_scales(c["G_inf_Pa"], c["nu"], c["R_m"], c["m_kg"], c["v_z0_m_s"])
     a_over_R = hz.a_H / c["R_m"]
     assert np.all((a_over_R > 0.003 * (1 - 1e-9)) & (a_over_R < 0.03 * (1 + 1e-9)))

@@ -45,6 +45,24 @@ def available(name: str) -> bool:
         return False
 
 
+def title(name: str) -> str:
+    """``TITLE`` of benchmark ``name``, read from its source without importing
+    it (``vimpact bench list`` stays fast); empty if it has none."""
+    import ast
+
+    spec = importlib.util.find_spec(BENCHMARKS[name])
+    if spec is None or not spec.origin or not spec.origin.endswith(".py"):
+        return ""
+    with open(spec.origin, encoding="utf-8") as f:
+        tree = ast.parse(f.read())
+    for node in tree.body:
+        if (isinstance(node, ast.Assign) and any(isinstance(t, ast.Name) and t.id == "TITLE"
+                                                 for t in node.targets)
+                and isinstance(node.value, ast.Constant)):
+            return str(node.value.value)
+    return ""
+
+
 def load(name: str) -> ModuleType:
     """The module of benchmark ``name``.
 

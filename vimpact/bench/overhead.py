@@ -12,8 +12,9 @@ packing, unpacking and the ``DataFrame``. Measured on
 - the continuum path: ``1e5`` random Kelvin-Voigt normal-only rows
   (``tangential = "none"``, default numerics);
 - an element path: random oblique Kelvin-Voigt rows (``v_x0 = v_z0``,
-  tangential full stick with rotation) at the ``fast`` preset, fewer rows
-  (the kernel is about 1e2 times dearer per row);
+  rotation) with Coulomb friction (``mu`` uniform in [0.1, 0.5]; friction
+  needs the element kernel, full stick would take a continuum path) at the
+  ``fast`` preset, fewer rows (the kernel is some ten times dearer per row);
 
 both on 2 numba threads (or 1 where numba has only one), after a warm-up
 call that compiles or loads the kernels; median over the repeats. Also the
@@ -56,7 +57,8 @@ def scene_columns(n: int, seed: int = 0, oblique: bool = False) -> dict[str, np.
     """``n`` random Kelvin-Voigt rows as scene columns (SI units, see the module).
 
     Normal-only (``tangential = "none"``) unless ``oblique``, in which case
-    ``v_x0 = v_z0`` and the tangential problem runs (full stick, rotation).
+    ``v_x0 = v_z0`` and the tangential problem runs with Coulomb friction
+    (``mu`` uniform in [0.1, 0.5]) and rotation.
     """
     from vimpact.model.hertz import Q1_PER_TAU
 
@@ -75,6 +77,7 @@ def scene_columns(n: int, seed: int = 0, oblique: bool = False) -> dict[str, np.
             "v_z0_m_s": v_z0}
     if oblique:
         cols["v_x0_m_s"] = v_z0.copy()
+        cols["mu"] = rng.uniform(0.1, 0.5, n)
     else:
         cols["tangential"] = np.full(n, "none", dtype=object)
     return cols

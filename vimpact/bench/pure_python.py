@@ -3,7 +3,8 @@
 The same algorithm as ``naive_impact`` of :mod:`vimpact.reference.numpy_elements` (generalized
 Stormer-Verlet with the dashpot implicit in the half-step velocity, a row of
 elements that follow the sphere or relax freely, exact exponential update of
-the Maxwell arm), restricted to what the throughput benchmark needs:
+the Maxwell arm, an element in contact for part of a step weighed by that
+part in the step impulse), restricted to what the throughput benchmark needs:
 Kelvin-Voigt and one-arm standard-solid materials (at most one arm, any
 parallel dashpot) and the default ``incremental`` tangential memory. It
 loops over every element of the row in every step, like ``naive_impact``.
@@ -126,6 +127,7 @@ def pure_python_impact(scene: Scene, steps: int, elements: int, row_width: float
 
     tangential = scene.v_c0 != 0.0
     w, q, s, p = [0.0] * n, [0.0] * n, [0.0] * n, [0.0] * n  # m
+    f_last, ft_last = [0.0] * n, [0.0] * n  # last normal / tangential force in contact, N
     contact = [False] * n
     u, v_z, v_c = 0.0, float(scene.v_z0), float(scene.v_c0)  # m, m/s
     Fz_spring = Cz = Fx_spring = Cx = 0.0  # N, N s/m
@@ -139,6 +141,10 @@ def pure_python_impact(scene: Scene, steps: int, elements: int, row_width: float
         u_new = u + h * v_z_half
         du_c = h * v_c_half
         Fz_spring = Fx_spring = 0.0
+        # partial contact within the step: the trapezoid h/2 (F_start + F_end) gets,
+        # per such element, the end force that makes it the integral of the element's
+        # force taken linear in time over its part of the step
+        corr_z = corr_x = 0.0
         n_c, j_outer = 0, -1
         for j in range(n):
             w0, w1 = w[j], u_new - gap[j]
@@ -156,25 +162,43 @@ def pure_python_impact(scene: Scene, steps: int, elements: int, row_width: float
                 # theta: fraction of the step after the sphere reached the surface
                 theta = (w1 - w_rel) / (w1 - w_rel + w0 - (u - gap[j]))
                 c = _arm_coefficients(tau1, theta * h)
+                f_entry = k_n * weight * (G_inf * w_rel + G1 * (w_rel - q[j]) + eta0 * v_z_half)
                 q[j] = _advance(q[j], w_rel, w1, c)
             w[j] = w1
             spring = G_inf * w1 + G1 * (w1 - q[j])  # Pa
-            if spring + eta0 * v_z_half <= 0.0:  # no adhesion: leaves contact
+            force = k_n * weight * (spring + eta0 * v_z_half)  # N
+            if force <= 0.0:  # no adhesion: leaves contact
                 contact[j] = False
+                if was_in:  # left after the fraction alpha: force f_last -> 0
+                    alpha = f_last[j] / (f_last[j] - force)
+                    corr_z += alpha * force
+                    if tangential:  # trial tangential end force (not kept)
+                        s_l = s[j] + du_c
+                        p_l = _advance(p[j], s[j], s_l, c_h)
+                        ft1 = k_t * weight * (G_inf * s_l + G1 * (s_l - p_l) + eta0 * v_c_half)
+                        corr_x += alpha**2 * ft1 - (1.0 - alpha) ** 2 * ft_last[j]
                 continue
             contact[j] = True
+            f_last[j] = force
             n_c, j_outer = n_c + 1, j
             Fz_spring += k_n * weight * spring
+            if not was_in:  # entered for the last theta h: from the force at entry
+                corr_z += theta * (f_entry + force) - force
             if tangential:  # incremental memory: displacement since entering
                 s0, s1 = s[j], s[j] + du_c * theta
+                ft_entry = k_t * weight * (G_inf * s0 + G1 * (s0 - p[j]) + eta0 * v_c_half)
                 p[j] = _advance(p[j], s0, s1, c)
                 s[j] = s1
-                Fx_spring += k_t * weight * (G_inf * s1 + G1 * (s1 - p[j]))
+                f_spring = k_t * weight * (G_inf * s1 + G1 * (s1 - p[j]))
+                Fx_spring += f_spring
+                ft_last[j] = f_spring + k_t * weight * eta0 * v_c_half
+                if not was_in:
+                    corr_x += theta * (ft_entry + ft_last[j]) - ft_last[j]
         Cz = k_n * weight * eta0 * n_c
         Cx = k_t * weight * eta0 * n_c
         # second half kick
-        v_z = v_z_half - 0.5 * h * (Fz_spring + Cz * v_z_half) / m
-        v_c = v_c_half - 0.5 * h * mu * (Fx_spring + Cx * v_c_half)
+        v_z = v_z_half - 0.5 * h * (Fz_spring + Cz * v_z_half + corr_z) / m
+        v_c = v_c_half - 0.5 * h * mu * (Fx_spring + Cx * v_c_half + corr_x)
         u = u_new
         step += 1
         if not (math.isfinite(u) and math.isfinite(v_z) and math.isfinite(v_c)):

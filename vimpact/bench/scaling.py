@@ -3,7 +3,8 @@
 Run: ``vimpact bench scaling [--quick] [--out DIR]``; the full-size run of
 the repository is ``python -m benchmarks.scaling`` (``benchmarks/results/``).
 
-Wall time of ``vimpact.simulate_batch`` (all numba threads, Python packing
+Wall time of ``vimpact.simulate_batch`` on the element kernel
+(``Numerics(continuum=False)``; all numba threads, Python packing
 and result rows included) on the random Kelvin-Voigt / standard-solid scenes
 of :func:`vimpact.bench.throughput.random_scenes`, against
 
@@ -36,10 +37,12 @@ TITLE = "how the batch wall time scales with batch size, elements and steps (pow
 #: sweep values, scenes per point of the numerics sweeps, base numerics, repeats
 CONFIGS = {
     "full": dict(scenes=[8, 16, 32, 64, 128, 256], elements=[50, 100, 200, 400, 800],
-                 steps=[250, 500, 1000, 2000, 4000], n_scenes=64, numerics=v.Numerics(),
+                 steps=[250, 500, 1000, 2000, 4000], n_scenes=64,
+                 numerics=v.Numerics(continuum=False),
                  repeats=9),
     "quick": dict(scenes=[2, 4, 8], elements=[8, 16, 32], steps=[25, 50, 100], n_scenes=4,
-                  numerics=v.Numerics(steps=50, elements=16), repeats=1),
+                  numerics=v.Numerics(steps=50, elements=16, continuum=False),
+                  repeats=1),
 }
 
 

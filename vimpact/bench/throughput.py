@@ -7,7 +7,8 @@ One element-update is one element of the row advanced by one time step, so
 an impact costs ``steps taken x ceil(row_width * elements)`` of them; the
 rate is comparable across batch sizes and numerics. Measured on the same random
 Kelvin-Voigt and standard-solid scenes (oblique, so the tangential problem
-runs too) at the same ``Numerics``:
+runs too) at the same ``Numerics``, continuum paths off (``continuum=False``:
+the element kernel is what is measured):
 
 - the batch kernel (``vimpact.simulate_batch``, Python packing and result
   rows included) on one and on two numba threads, alternated repeat by
@@ -52,9 +53,9 @@ T = TypeVar("T")
 #: sizes: kernel batch, NumPy and pure-Python subsets, repeats, numerics
 CONFIGS = {
     "full": dict(n_scenes=64, n_numpy=8, n_python=8, repeats=11, baseline_repeats=5,
-                 numerics=v.Numerics()),
+                 numerics=v.Numerics(continuum=False)),
     "quick": dict(n_scenes=8, n_numpy=2, n_python=2, repeats=2, baseline_repeats=1,
-                  numerics=v.Numerics(steps=60, elements=12)),
+                  numerics=v.Numerics(steps=60, elements=12, continuum=False)),
 }
 
 

@@ -67,16 +67,11 @@ def _cmd_bench(a) -> int:
 
 
 def _list() -> int:
-    import importlib
-
-    from vimpact.bench import BENCHMARKS, available
+    from vimpact.bench import BENCHMARKS, available, title
 
     for name, module in BENCHMARKS.items():
-        if available(name):
-            title = getattr(importlib.import_module(module), "TITLE", "")
-        else:
-            title = f"(needs {module}: run from a source checkout)"
-        print(f"{name:<12} {title}")
+        text = title(name) if available(name) else f"(needs {module}: run from a source checkout)"
+        print(f"{name:<12} {text}")
     return 0
 
 
