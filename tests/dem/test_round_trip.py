@@ -89,3 +89,34 @@ def test_rebound_round_trip_with_the_exported_callback(problem, tmp_path):
         assert e == pytest.approx(expected, rel=1e-9)
     # and that is vimpact's e_z at the table speeds
     assert fit.params["e_z"] == pytest.approx(list(ex.targets[fit.contact.key].e_z), rel=1e-12)
+
+
+@pytest.mark.skipif(_NO_LAMMPS is not None, reason=f"LAMMPS: {_NO_LAMMPS}")
+def test_lammps_hertz_material_wall_is_a_body_of_the_particles_material():
+    """What docs/dem.md says about LAMMPS (why the export uses `hertz` with k_n per
+    contact): with `hertz/material E eta nu` a `fix wall/gran` wall behaves as a body of
+    the same E and nu, E* = E / (2 (1 - nu^2)), not as a rigid wall (E / (1 - nu^2)).
+    Measured through the elastic contact time against the Hertz closed form."""
+    import math
+
+    R, rho, v, E, nu = 0.005, 1150.0, 0.5, 1e8, 0.3
+    m = rho * 4.0 / 3.0 * math.pi * R**3
+
+    def t_hertz(E_star):
+        return float(hertz_contact_time(E_star, R, m, v))
+
+    dt = t_hertz(E / (1 - nu**2)) / 4000
+    n = int(3 * t_hertz(E / (1 - nu**2)) / dt)
+    coeff = f"hertz/material {E} 0.0 {nu} damping viscoelastic tangential linear_nohistory 0 0"
+    script = "\n".join([
+        "units si", "atom_style sphere", "atom_modify map array", "boundary f f f",
+        "comm_modify vel yes", "region box block -0.05 0.05 -0.05 0.05 -0.05 0.05",
+        "create_box 1 box", "pair_style granular", f"pair_coeff * * {coeff}",
+        f"create_atoms 1 single 0 0 {R}", f"set atom 1 diameter {2 * R} density {rho}",
+        f"velocity all set 0 0 {-v}", f"fix w all wall/gran granular {coeff} zplane 0.0 NULL",
+        f"variable inside equal z[1]<{R}", "fix nve all nve/sphere", f"timestep {dt}",
+        f"fix a all ave/time 1 {n} {n} v_inside", "variable frac equal f_a", f"run {n}", ""])
+    frac, = lammps.run_lammps(script, ["frac"])
+    t_contact = frac * n * dt
+    assert t_contact == pytest.approx(t_hertz(E / (2 * (1 - nu**2))), rel=1e-3)
+    assert t_contact / t_hertz(E / (1 - nu**2)) == pytest.approx(2**0.4, rel=1e-3)
