@@ -17,7 +17,7 @@ from pathlib import Path
 import numba
 import numpy as np
 
-from vimpact.sweep.spec import load_spec, run_sweep, summary
+from vimpact.sweep import load_spec, run_sweep, summary
 
 from .machine import RESULTS, machine_info
 

@@ -103,7 +103,9 @@ def compute_chunk(spec: SweepSpec, chunk: int, timings: dict | None = None):
         valid = st != "invalid"
         if spec.mode == "random" and spec.model != "prony":
             cols["Q1"][rows] = frame["Q1"].to_numpy(dtype=float)
-            if spec.model == "standard_solid":
+            if spec.model == "standard_solid" and "G_arm1_Pa" not in scene_cols:
+                cols["Q2"][rows] = np.where(valid, np.inf, np.nan)  # no arm (eta = 0): G2 idle
+            elif spec.model == "standard_solid":
                 cols["Q2"][rows] = frame["Q2"].to_numpy(dtype=float)
             else:
                 cols["Q2"][rows] = np.where(valid, 0.0, np.nan)  # the Kelvin-Voigt limit G2 -> inf
@@ -207,7 +209,7 @@ def run_sweep(spec_path, out=None, resume: bool = False,
               progress: Callable[[int, int], None] | None | bool = None, *,
               workers: int | None = None, scheduler: str | None = None,
               shard: tuple[int, int] | None = None, combine: bool = False,
-              chunk_order=None) -> Path:
+              chunk_order=None, timings: dict | None = None) -> Path:
     """Run the sweep of a TOML specification and write its Parquet table.
 
     Parameters
@@ -227,6 +229,8 @@ def run_sweep(spec_path, out=None, resume: bool = False,
     combine : only combine the parts into the table (every chunk must be there)
     chunk_order : in-process only: the order to compute the chunks in (default
         ascending); the table does not depend on it
+    timings : in-process only: a dict that receives ``kernel_s`` and ``total_s`` of
+        :func:`vimpact.simulate_batch` summed over the chunks
 
     Returns
     -------
@@ -259,14 +263,14 @@ def run_sweep(spec_path, out=None, resume: bool = False,
     parts = store.parts_dir(out, layout)
     if shard is not None:  # shards run side by side (SLURM array): no output lock
         return _run(spec, spec_path, out, parts, True, progress, workers, scheduler, shard,
-                    False, chunk_order)
+                    False, chunk_order, timings)
     with store.OutputLock(out):
         return _run(spec, spec_path, out, parts, resume, progress, workers, scheduler, None,
-                    combine, chunk_order)
+                    combine, chunk_order, timings)
 
 
 def _run(spec, spec_path, out, parts, resume, progress, workers, scheduler, shard, combine,
-         chunk_order) -> Path:
+         chunk_order, timings) -> Path:
     layout = spec.table_layout
     store.remove_temporaries(out.parent, out.name)  # a final write cut short
     if store.is_complete(spec, out) and (resume or combine or shard is not None):
@@ -301,7 +305,7 @@ def _run(spec, spec_path, out, parts, resume, progress, workers, scheduler, shar
             _run_dask(spec, todo, parts, bar, done, workers, scheduler)
         else:
             for chunk in todo:
-                table = compute_chunk(spec, chunk)
+                table = compute_chunk(spec, chunk, timings)
                 store.write_part(spec, table, parts, chunk, chunk_summary(table))
                 done[chunk] = store.part_path(parts, chunk, spec.n_chunks)
                 start, stop = spec.chunk_rows(chunk)

@@ -12,6 +12,9 @@ Layouts (``layout`` in the spec; ``"auto"``: a file up to
   ``pyarrow.parquet.read_table(OUT)``, :meth:`vimpact.RestitutionTable.open`
   and ``vimpact table`` read it directly.
 
+Memory is bounded by the chunk size in both layouts: a part is written as it
+is finished, and the file layout is combined one part (one row group) at a time.
+
 Every write is atomic (a temporary file in the same directory, fsync,
 ``os.replace``, fsync of the directory), so a run killed anywhere (kill -9)
 leaves finished parts and no half-written file; a resumed run gives the
@@ -133,9 +136,11 @@ def fsync_dir(path: Path) -> None:
         os.close(fd)
 
 
-def write_atomic(table, path: Path, *, schema_only: bool = False) -> None:
+def write_atomic(table, path: Path, *, schema_only: bool = False, more=()) -> None:
     """Write the ``pyarrow`` ``table`` (or only its schema) to ``path``: a temporary
-    file in the same directory, fsync, ``os.replace``, fsync of the directory."""
+    file in the same directory, fsync, ``os.replace``, fsync of the directory.
+    ``more``: further tables (same schema) appended one row group each, read one
+    at a time, so that memory stays bounded by the largest of them."""
     import pyarrow.parquet as pq
     path = Path(path)
     tmp = path.with_name(f".{path.name}.{socket.gethostname()}.{os.getpid()}.tmp")
@@ -143,6 +148,11 @@ def write_atomic(table, path: Path, *, schema_only: bool = False) -> None:
         with open(tmp, "wb") as f:
             if schema_only:
                 pq.write_metadata(table.schema, f)
+            elif more:
+                with pq.ParquetWriter(f, table.schema) as writer:
+                    writer.write_table(table)
+                    for other in more:
+                        writer.write_table(other.replace_schema_metadata(table.schema.metadata))
             else:
                 pq.write_table(table, f)
             f.flush()
@@ -241,7 +251,6 @@ def combine(spec, parts: Path, out: Path, explain_paths) -> None:
     (dataset)."""
     import shutil
 
-    import pyarrow as pa
     import pyarrow.parquet as pq
 
     found = existing_parts(spec, parts)
@@ -270,14 +279,11 @@ def combine(spec, parts: Path, out: Path, explain_paths) -> None:
         write_atomic(spec.schema().empty_table().replace_schema_metadata(meta),
                      out / COMMON_METADATA, schema_only=True)
         return
-    tables = [pq.read_table(found[c]).replace_schema_metadata(None)
-              for c in range(spec.n_chunks)]
-    table = pa.concat_tables(tables)
-    if table.num_rows != spec.rows:
-        raise ValueError(f"{parts}: the parts do not add up to rows 0..{spec.rows - 1}; "
-                         f"remove {parts} to start over")
+    # one row group per part, read one at a time: memory bounded by the chunk size
+    first = pq.read_table(found[0]).replace_schema_metadata(meta)
+    rest = (pq.read_table(found[c]) for c in range(1, spec.n_chunks))
     out.parent.mkdir(parents=True, exist_ok=True)
-    write_atomic(table.replace_schema_metadata(meta), out)
+    write_atomic(first, out, more=rest)
     shutil.rmtree(parts)
 
 

@@ -1,0 +1,148 @@
+"""Sweep backends side by side, and a 1e6-row sweep: wall time against kernel time.
+
+Run: ``python -m benchmarks.sweep_backends [--part backends|large|both] [--rows N]
+[--quick]``.
+
+- ``backends``: the same random oblique Kelvin-Voigt sweep (``fast`` numerics)
+  in-process on 2 numba threads and on a Dask ``LocalCluster`` of 2 worker
+  processes x 1 thread, one run each, side by side (after a warm-up of both;
+  the cluster's start-up is reported apart). Compare the ratio, not the seconds:
+  the machine is shared and noisy. The two tables must be identical.
+- ``large``: one 1e6-row random oblique sweep (``fast`` numerics, in-process):
+  wall time, kernel time alone (seconds inside the numba kernels, from
+  ``simulate_batch(timings=...)``), their ratio (target <= 1.2), rows/s, Python
+  overhead per row, and the peak resident memory of this process and its
+  children (``resource.getrusage``).
+
+Writes ``benchmarks/results/sweep_backends.json`` (a part not run keeps its
+earlier entry).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import platform
+import resource
+import tempfile
+import time
+from pathlib import Path
+
+RESULTS = Path(__file__).parent / "results"
+
+SPEC = """
+description = "benchmark: random oblique Kelvin-Voigt impacts"
+model = "kelvin_voigt"
+seed = 2026
+chunk_size = {chunk}
+[numerics]
+preset = "fast"
+[random]
+rows = {rows}
+E_Pa = [1e7, 1e10]
+eta_Pa_s = [1e1, 1e5]
+R_m = [0.01, 0.1]
+m_kg = [1e-3, 0.1]
+v_z0_m_s = [0.1, 10]
+v_x0_m_s = [-5, 5]
+omega0_rad_s = [-100, 100]
+nu = [0.0, 0.5]
+"""
+
+
+def machine() -> dict:
+    return {"platform": platform.platform(), "python": platform.python_version(),
+            "cpus": os.cpu_count(), "load_average_1min": os.getloadavg()[0],
+            "date_utc": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime())}
+
+
+def _spec(tmp: Path, name: str, rows: int, chunk: int) -> Path:
+    path = tmp / f"{name}.toml"
+    path.write_text(SPEC.format(rows=rows, chunk=chunk))
+    return path
+
+
+def backends(rows: int, chunk: int) -> dict:
+    import numba
+    from distributed import Client
+
+    from vimpact.sweep import run_sweep
+    from vimpact.sweep.runner import local_cluster
+
+    numba.set_num_threads(min(2, numba.config.NUMBA_NUM_THREADS))
+    with tempfile.TemporaryDirectory() as tmp:
+        tmp = Path(tmp)
+        warm, spec = _spec(tmp, "warm", 8, 2), _spec(tmp, "sweep", rows, chunk)
+        t0 = time.perf_counter()
+        cluster = local_cluster(2)
+        client = Client(cluster)
+        start_s = time.perf_counter() - t0
+        try:
+            address = cluster.scheduler_address
+            run_sweep(warm, out=tmp / "w1.parquet", progress=False)
+            run_sweep(warm, out=tmp / "w2.parquet", progress=False, scheduler=address)
+            t0 = time.perf_counter()
+            a = run_sweep(spec, out=tmp / "inprocess.parquet", progress=False)
+            t_in = time.perf_counter() - t0
+            t0 = time.perf_counter()
+            b = run_sweep(spec, out=tmp / "dask.parquet", progress=False, scheduler=address)
+            t_dask = time.perf_counter() - t0
+            identical = a.read_bytes() == b.read_bytes()
+        finally:
+            client.close()
+            cluster.close()
+    return {"rows": rows, "chunk_size": chunk, "numerics": "fast",
+            "in_process_2_threads_s": t_in, "dask_2_workers_x_1_thread_s": t_dask,
+            "dask_over_in_process": t_dask / t_in, "cluster_start_s": start_s,
+            "rows_per_s": {"in_process": rows / t_in, "dask": rows / t_dask},
+            "tables_identical": identical}
+
+
+def large(rows: int, chunk: int) -> dict:
+    from vimpact.sweep import run_sweep, summary
+
+    with tempfile.TemporaryDirectory() as tmp:
+        tmp = Path(tmp)
+        spec = _spec(tmp, "large", rows, chunk)
+        timings: dict = {}
+        t0 = time.perf_counter()
+        out = run_sweep(spec, out=tmp / "large.parquet", timings=timings)
+        wall = time.perf_counter() - t0
+        counts = summary(out)
+        size = sum(p.stat().st_size for p in ([out] if out.is_file() else out.iterdir()))
+    self_kb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    children_kb = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss
+    kernel = timings.get("kernel_s", float("nan"))
+    return {"rows": rows, "chunk_size": chunk, "numerics": "fast", "wall_s": wall,
+            "kernel_s": kernel, "simulate_batch_s": timings.get("total_s"),
+            "wall_over_kernel": wall / kernel, "rows_per_s": rows / wall,
+            "overhead_us_per_row": 1e6 * (wall - kernel) / rows,
+            "peak_rss_mb": {"self": self_kb / 1024, "children": children_kb / 1024},
+            "table_bytes": size, "statuses": counts}
+
+
+def main(argv=None) -> dict:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--part", choices=("backends", "large", "both"), default="both")
+    parser.add_argument("--rows", type=int, default=1_000_000, help="rows of the large sweep")
+    parser.add_argument("--quick", action="store_true", help="small sizes (a smoke run)")
+    parser.add_argument("--out", type=Path, default=RESULTS)
+    args = parser.parse_args(argv)
+    path = args.out / ("sweep_backends_quick.json" if args.quick else "sweep_backends.json")
+    data = json.loads(path.read_text()) if path.exists() else {}
+    data["machine"] = machine()
+    if args.part in ("backends", "both"):
+        data["backends"] = backends(200 if args.quick else 2000, 20 if args.quick else 100)
+        print(json.dumps(data["backends"], indent=1))
+    if args.part in ("large", "both"):
+        data["large"] = large(2000 if args.quick else args.rows, 500 if args.quick else 10_000)
+        data["large"]["command"] = "python -m benchmarks.sweep_backends --part large"
+        print(json.dumps(data["large"], indent=1))
+    args.out.mkdir(parents=True, exist_ok=True)
+    path.write_text(json.dumps(data, indent=1))
+    return data
+
+
+if __name__ == "__main__":
+    main()
