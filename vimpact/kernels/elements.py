@@ -119,7 +119,8 @@ def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT, FRICTION,
     s = np.zeros(n_t)
     p = np.zeros((n_t, n_arms))
     contact = np.zeros(n_elem, dtype=np.bool_)
-    f = np.zeros(n_elem)  # last normal force of each element in contact / (k_el)
+    # last normal force (Verlet: its spring part) of each element in contact / k_el
+    f = np.zeros(n_elem)
     FRIC = FRICTION and TANGENTIAL
     n_af = n_arms if FRIC else 0
     p_save = np.empty(n_af)  # arms of a slip candidate before the stick trial
@@ -129,7 +130,10 @@ def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT, FRICTION,
     Cs = 0.0  # slipping elements: tangential force per unit normal velocity (mu f_n's dashpot)
     t_gross = 0.0
     PARTIAL = INTEGRATOR == VERLET  # weigh partial contact within a step (see below)
-    ft = np.zeros(n_t if PARTIAL else 0)  # last tangential stress of each element in contact
+    # last step's position part of each element's tangential force (/ k_el kappa)
+    # and, with friction, its slip direction (0: sticking)
+    ftp = np.zeros(n_t if PARTIAL else 0)
+    fsgn = np.zeros(n_t if PARTIAL and FRIC else 0)
     w_fric = 0.0
     slip_now = 0.0
 
@@ -189,14 +193,19 @@ def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT, FRICTION,
         n_slip = 0
         sum_slip_r = 0.0  # sum of sign * (normal spring part) over slipping elements
         sum_slip_sign = 0.0
-        # Verlet's step impulse is the trapezoid h/2 (F_start + F_end). An element in
-        # contact for only part of the step (leaving after a fraction alpha, or
-        # entering for the last fraction theta) instead contributes the integral
-        # of its force path over that part (linear in time); corr_n, corr_t are
-        # the end forces (/ k_el, / (k_el kappa)) that make the trapezoid equal
-        # it, added to the second half-kick only.
+        # Verlet's step impulse is the trapezoid h/2 (F_start + F_end) of the forces
+        # as the half-kicks apply them (dashpots at the half-step velocity). An
+        # element in contact for only part of the step (leaving after a fraction
+        # alpha, or entering for the last fraction theta) contributes instead the
+        # integral of its force over that part, the force taken linear in time
+        # between its values at the step ends (dashpots at the velocities of
+        # those instants: v at the start, 2 v_test - v at the end); corr_n,
+        # corr_t are what the second half-kick adds for them (/ k_el, / (k_el
+        # kappa)). The zero crossing of that normal force gives alpha.
         corr_n = 0.0
         corr_t = 0.0
+        ve = 2.0 * v_test - v
+        vce = 2.0 * vc_test - vc
         j_outer = -1
         for j in range(active):
             w0 = w[j]
@@ -228,7 +237,7 @@ def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT, FRICTION,
                 # there (the arms see a ramp wf -> w1 over theta h, not a jump)
                 theta = (w1 - wf) / (w1 - wf + w0 + xi2[j] - u)
                 if PARTIAL:  # normal force at the moment of entry
-                    f_entry = wf + c0 * v_test
+                    f_entry = wf + c0 * (v + 2.0 * (1.0 - theta) * (v_test - v))
                     if ARMS:
                         f_entry += _arm_stress(wf, q[j], g)
                 r = w1
@@ -236,31 +245,47 @@ def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT, FRICTION,
                     r += _follow_over(wf, w1, q[j], g, tau, theta * h)
             w[j] = w1
             fj = r + c0 * v_test
-            if fj <= 0.0:  # force would pull: element leaves
+            # the element leaves when its force would pull (Verlet: its force at the
+            # step end, the dashpot at the end velocity 2 v_test - v)
+            if (r + c0 * ve <= 0.0) if PARTIAL else (fj <= 0.0):
                 if was_in:  # interpolate its force to zero within the step
-                    alpha = f[j] / (f[j] - fj)
-                    t_leave = max(t_leave, (step + alpha) * h)
                     if PARTIAL:
-                        # in contact for alpha h with a force going linearly to 0:
-                        # integral alpha h f0 / 2 = h/2 (f0 + alpha fj)
-                        corr_n += alpha * fj
-                        if TANGENTIAL:  # tangential stress f0_t -> trial ft1 over the step
+                        T0 = f[j] + c0 * v
+                        T1 = r + c0 * ve
+                        if T0 <= 0.0:
+                            alpha = 0.0
+                        elif T1 >= 0.0:
+                            alpha = 1.0
+                        else:
+                            alpha = T0 / (T0 - T1)
+                        corr_n += alpha * T0 - (f[j] + c0 * v_test)
+                        if TANGENTIAL:  # tangential force T0t -> trial T1t over the step
                             s0 = s[j]
                             s1 = uc1 if MEMORY == 1 else s0 + duc
-                            ft1 = s1 + c0 * vc_test
+                            T1t = s1 + c0 * vce
                             if ARMS:
-                                ft1 += _follow_value(s0, s1, p[j], g, E, omE, phi)
-                            if FRIC:  # the cone shrinks to 0 with the normal force
-                                if mu_k < math.inf:
-                                    ft1 = math.copysign(mu_k / kappa, ft1) * fj  # fj < 0
-                            corr_t += alpha * alpha * ft1 - (1.0 - alpha) ** 2 * ft[j]
+                                T1t += _follow_value(s0, s1, p[j], g, E, omE, phi)
+                            sg = fsgn[j] if FRIC else 0.0
+                            if sg != 0.0:  # slipping: mu times the normal force
+                                T0t = ftp[j] + sg * mu_k / kappa * c0 * v
+                                A_t = ftp[j] + sg * mu_k / kappa * c0 * v_test
+                                T1t = sg * mu_k / kappa * T1
+                            else:
+                                T0t = ftp[j] + c0 * vc
+                                A_t = ftp[j] + c0 * vc_test
+                                if FRIC:  # the cone shrinks to 0 with the normal force
+                                    if mu_k < math.inf:
+                                        T1t = math.copysign(mu_k / kappa, T1t) * T1
+                            corr_t += (2.0 * alpha * T0t + alpha * alpha * (T1t - T0t) - A_t)
+                    else:
+                        alpha = f[j] / (f[j] - fj)
+                    t_leave = max(t_leave, (step + alpha) * h)
                 contact[j] = False
                 continue
-            if PARTIAL and not was_in:
-                # in contact for theta h, force linear from f_entry to fj
-                corr_n += theta * (f_entry + fj) - fj
+            if PARTIAL and not was_in:  # from f_entry to the end force over theta h
+                corr_n += theta * (f_entry + r + c0 * ve) - fj
             contact[j] = True
-            f[j] = fj
+            f[j] = r if PARTIAL else fj
             n_c += 1
             j_outer = j
             sum_r += r
@@ -274,8 +299,8 @@ def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT, FRICTION,
                     # the step after the surface was reached
                     s1 = s0 + duc * theta
                 if PARTIAL and not was_in:  # stress at entry: the relaxed state,
-                    # dashpot at v_c (seed: the element jumps to the total displacement)
-                    ft_entry = s0 + c0 * vc_test
+                    # dashpot at v_c then
+                    ft_entry = s0 + c0 * (vc + 2.0 * (1.0 - theta) * (vc_test - vc))
                     if ARMS:
                         ft_entry += _arm_stress(s0, p[j], g)
                 sum_rt += s1
@@ -287,27 +312,24 @@ def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT, FRICTION,
                     sum_rt += fol
                 s[j] = s1
                 if PARTIAL:
-                    ft1 = s1 + c0 * vc_test
-                    if ARMS:
-                        ft1 += fol
-                    ft[j] = ft1
+                    P1 = s1 + fol
+                    ftp[j] = P1
                     if not was_in:
-                        if MEMORY == 1:
-                            ft_entry = ft1
-                        corr_t += theta * (ft_entry + ft1) - ft1
+                        if MEMORY == 1:  # seed: the element jumps to the total displacement
+                            ft_entry = P1 + c0 * vce
+                        corr_t += theta * (ft_entry + P1 + c0 * vce) - (P1 + c0 * vc_test)
             if FRIC:  # stick trial, then return to the cone |f_t| <= mu f_n
                 s0 = s[j]
                 s1 = s0 + duc if was_in else s0 + duc * theta
                 for i in range(n_af):
                     p_save[i] = p[j, i]
-                if PARTIAL:
-                    if not was_in:  # stress at entry (relaxed state, dashpot), inside the cone
-                        ft_entry = s0 + c0 * vc_test
-                        if ARMS:
-                            ft_entry += _arm_stress(s0, p[j], g)
-                        if mu_k < math.inf:
-                            cone_e = mu_k * max(f_entry, 0.0) / kappa
-                            ft_entry = min(max(ft_entry, -cone_e), cone_e)
+                if PARTIAL and not was_in:  # stress at entry (relaxed state, dashpot)
+                    ft_entry = s0 + c0 * (vc + 2.0 * (1.0 - theta) * (vc_test - vc))
+                    if ARMS:
+                        ft_entry += _arm_stress(s0, p[j], g)
+                    if mu_k < math.inf:  # inside the cone then
+                        cone_e = mu_k * max(f_entry, 0.0) / kappa
+                        ft_entry = min(max(ft_entry, -cone_e), cone_e)
                 if ARMS:
                     if was_in:
                         fol = _follow(s0, s1, p[j], g, E, omE, phi)
@@ -317,16 +339,19 @@ def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT, FRICTION,
                 if DASHPOT:
                     trial += c0 * vc_test
                 cone = mu_k * fj / kappa  # element stress at the cone, tangential units
-                if abs(trial) <= cone:  # stick (always for mu = inf)
+                if mu_k == math.inf or abs(trial) <= cone:  # stick
                     sum_rt += s1
                     sum_rt += fol
                     n_stick += 1
                     s[j] = s1
-                    ft1 = s1 + c0 * vc_test
-                    if ARMS:
-                        ft1 += fol
+                    if PARTIAL:
+                        P1 = s1 + fol
+                        ftp[j] = P1
+                        fsgn[j] = 0.0
+                        if not was_in:
+                            corr_t += theta * (ft_entry + P1 + c0 * vce) - (P1 + c0 * vc_test)
                 else:  # slip: the element's own path s0 -> s_slip puts it on the cone
-                    target = math.copysign(cone, trial)
+                    target = math.copysign(mu_k / kappa, trial) * fj
                     dt = h if was_in else max(theta, 1e-12) * h
                     if ARMS:
                         if was_in:
@@ -344,13 +369,11 @@ def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT, FRICTION,
                     sum_slip_r += sgn * r
                     sum_slip_sign += sgn
                     n_slip += 1
-                    ft1 = target
-                    if PARTIAL and not was_in:  # it entered slipping: on the cone then too
-                        ft_entry = math.copysign(mu_k / kappa, trial) * max(f_entry, 0.0)
-                if PARTIAL:
-                    ft[j] = ft1
-                    if not was_in:
-                        corr_t += theta * (ft_entry + ft1) - ft1
+                    if PARTIAL:  # mu times the normal force, entering or not
+                        ftp[j] = sgn * mu_k / kappa * r
+                        fsgn[j] = sgn
+                        if not was_in:
+                            corr_t += sgn * mu_k / kappa * (theta * (f_entry + r + c0 * ve) - fj)
         if n_c == 0 and t_leave > 0.0:
             t_exit = t_leave  # the last elements left within this step
         F_el1 = k_el * sum_r

@@ -138,7 +138,7 @@ class Rheology:
 # ------------------------------------------------------------------ impact
 
 def naive_impact(scene, steps, elements, row_width=1.05, max_time=100.0, mu=None,
-                 check_cone=True):
+                 check_cone=True, flat_punch=None):
     """Simulate ``scene`` (a :class:`vimpact.Scene`) in SI units with the
     Stormer-Verlet scheme of the kernel.
 
@@ -153,6 +153,9 @@ def naive_impact(scene, steps, elements, row_width=1.05, max_time=100.0, mu=None
         one, else ``inf``: full stick); needs incremental memory
     check_cone : raise ``AssertionError`` if an element in contact ends a
         step with ``|f_t| > mu f_n (1 + 1e-12)``
+    flat_punch : radius ``a0`` (m) of a flat punch instead of the sphere's
+        MDR profile (PHYSICS.md section 9): ``g = 0`` on ``|x| < a0``, no
+        element outside; every element enters at once and leaves together
 
     Returns
     -------
@@ -180,8 +183,11 @@ def naive_impact(scene, steps, elements, row_width=1.05, max_time=100.0, mu=None
     elements = int(math.ceil(elements * element_factor))
     dx = hz.a_H / elements  # m
     n = int(math.ceil(row_width * elements))
+    if flat_punch is not None:  # the same spacing, as many elements as fit in a0
+        n = max(1, round(flat_punch / dx))
+        dx = flat_punch / n
     x = (np.arange(n) + 0.5) * dx  # element positions, m
-    gap = x * x / R  # MDR profile g(x) = x^2 / R, m
+    gap = x * x / R if flat_punch is None else np.zeros(n)  # MDR profile g(x) = x^2 / R, m
     weight = 2.0 * dx  # symmetric row: each element stands for itself and its mirror image
     max_steps = int(math.ceil(max_time * (hz.t_H + 10.0 * rheo.eta0 / rheo.G_inf) / h))
 
@@ -193,7 +199,7 @@ def naive_impact(scene, steps, elements, row_width=1.05, max_time=100.0, mu=None
     s = np.zeros(n)  # tangential surface displacement, m
     p = np.zeros((n, rheo.n_arms))  # tangential arm variables, m
     contact = np.zeros(n, dtype=bool)
-    f_last = np.zeros(n)  # last normal force of each element in contact, N
+    f_last = np.zeros(n)  # last normal spring force of each element in contact, N
 
     # sphere state
     u, v_z = 0.0, float(scene.v_z0)  # indentation (m), normal velocity (m/s)
@@ -210,7 +216,10 @@ def naive_impact(scene, steps, elements, row_width=1.05, max_time=100.0, mu=None
     if friction and memory != "incremental":
         raise ValueError(f"friction (mu = {mu}) needs incremental tangential memory, "
                          f"not {memory!r}")
-    ft_last = np.zeros(n)  # last tangential force of each element in contact, N
+    # last step's tangential force of each element in contact without its
+    # dashpot part (N) and its slip direction (0: sticking)
+    ft_pos = np.zeros(n)
+    slip_sign = np.zeros(n)
     Fx_slip, Cx_slip = 0.0, 0.0  # slipping elements: mu F_n, spring part (N), per v_z (N s/m)
     t_gross, w_friction, slip_width_max = 0.0, 0.0, 0.0
     t_contact = 0.0
@@ -230,6 +239,10 @@ def naive_impact(scene, steps, elements, row_width=1.05, max_time=100.0, mu=None
         b = np.array([m * v_x - 0.5 * h * Fx_known, Theta * omega - 0.5 * h * R * Fx_known])
         v_x_half, omega_half = np.linalg.solve(A, b)
         v_c_half = v_x_half + R * omega_half
+        # velocities at the step ends (the end one extrapolated through the half
+        # step): the dashpots of the force path of an element in partial contact
+        v_z_start, v_c_start = v_z, v_x + R * omega
+        v_z_end, v_c_end_step = 2.0 * v_z_half - v_z_start, 2.0 * v_c_half - v_c_start
 
         # ---- drift ----
         u_new = u + h * v_z_half
@@ -263,46 +276,58 @@ def naive_impact(scene, steps, elements, row_width=1.05, max_time=100.0, mu=None
         theta[entering] = gain[entering] / (gain[entering] + (w0 - w_sphere_old)[entering])
         # entering elements ramp from the relaxed surface to the sphere over theta h
         arms_theta = arm_update_coefficients(rheo.tau[None, :], (theta[entering] * h)[:, None])
-        # normal force at the moment of entry (relaxed surface, dashpot at v_z)
+        # normal force at the moment of entry (relaxed surface, dashpot at v_z then)
         f_entry = np.zeros(n)
+        v_entry = v_z_start + 2.0 * (1.0 - theta) * (v_z_half - v_z_start)
         f_entry[entering] = c_n * weight * (rheo.spring_stress(w_relaxed[entering], q[entering])
-                                            + rheo.eta0 * v_z_half)
+                                            + rheo.eta0 * v_entry[entering])
         q[entering] = advance_arms(q[entering], w_relaxed[entering], w_sphere[entering], arms_theta)
 
         touching = was_in | entering
         w[touching] = w_sphere[touching]
         spring = np.zeros(n)
-        spring[touching] = rheo.spring_stress(w[touching], q[touching])
-        force = c_n * weight * (spring + rheo.eta0 * v_z_half)  # N, element and mirror image
-        # no adhesion: an element whose force would pull leaves contact
-        leaving = touching & (force <= 0.0)
+        spring[touching] = c_n * weight * rheo.spring_stress(w[touching], q[touching])  # N
+        force = spring + c_n * weight * rheo.eta0 * v_z_half  # N, element and mirror image
+        force_end = spring + c_n * weight * rheo.eta0 * v_z_end  # at the step end
+        # no adhesion: an element whose force would pull at the step end leaves
+        leaving = touching & (force_end <= 0.0)
         now_in = touching & ~leaving
         left = leaving & was_in
-        alpha = np.zeros(n)
-        if left.any():
-            # the time the last of them left: interpolate its force to zero
-            alpha[left] = f_last[left] / (f_last[left] - force[left])
-            t_leave = ((step + alpha[left]) * h).max()
-        contact = now_in
-        f_last[now_in] = force[now_in]
 
-        # Partial contact within the step: the kick's trapezoid h/2 (F_start + F_end)
-        # gets, per such element, the end force that makes it the integral of the
-        # element's force taken linear in time over the part of the step in contact.
-        # Leaving after alpha h: normal force f0 -> 0, tangential f0_t -> trial ft1.
-        corr_z = float((alpha[left] * force[left]).sum())
-        corr_x = 0.0
+        # Partial contact within the step. The kick's trapezoid h/2 (F_start + F_end)
+        # of the applied forces (dashpots at the half-step velocities) gets, per
+        # element in contact for part of the step, what makes it the integral of
+        # the element's force over that part, the force linear in time between
+        # its values at the step ends (dashpots at v_start and v_end).
+        corr_z, corr_x = 0.0, 0.0
         if left.any():
+            dash_z = c_n * weight * rheo.eta0
+            T0 = f_last[left] + dash_z * v_z_start
+            T1 = force_end[left]
+            alpha = np.where(T0 <= 0.0, 0.0, np.where(T1 >= 0.0, 1.0, T0 / np.where(
+                T0 - T1 > 0.0, T0 - T1, 1.0)))
+            t_leave = ((step + alpha) * h).max()
+            corr_z += float((alpha * T0 - (f_last[left] + dash_z * v_z_half)).sum())
+            # tangential: from T0t at the start to the stick trial T1t at the end
             s_l = np.full(int(left.sum()), u_c_new) if memory == "seed" else s[left] + du_c
             p_l = advance_arms(p[left], s[left], s_l, arms_h)  # trial only, not kept
-            ft1 = c_t * weight * (rheo.spring_stress(s_l, p_l) + rheo.eta0 * v_c_half)
+            T1t = c_t * weight * (rheo.spring_stress(s_l, p_l) + rheo.eta0 * v_c_end_step)
             if friction:  # the cone shrinks to zero with the normal force
-                ft1 = np.copysign(mu, ft1) * force[left]  # force < 0
-            a_l = alpha[left]
-            corr_x += float((a_l**2 * ft1 - (1.0 - a_l) ** 2 * ft_last[left]).sum())
+                T1t = np.copysign(mu, T1t) * T1
+            sg = slip_sign[left]
+            dash_t = c_t * weight * rheo.eta0
+            T0t = ft_pos[left] + np.where(sg != 0.0, sg * mu * dash_z * v_z_start if friction
+                                          else 0.0, dash_t * v_c_start)
+            A_t = ft_pos[left] + np.where(sg != 0.0, sg * mu * dash_z * v_z_half if friction
+                                          else 0.0, dash_t * v_c_half)
+            if friction:
+                T1t = np.where(sg != 0.0, sg * mu * T1, T1t)
+            corr_x += float((2.0 * alpha * T0t + alpha**2 * (T1t - T0t) - A_t).sum())
+        contact = now_in
+        f_last[now_in] = spring[now_in]
         new = now_in & entering
-        # Entering for the last theta h: from the force at entry to the end force.
-        corr_z += float((theta[new] * (f_entry[new] + force[new]) - force[new]).sum())
+        # entering for the last theta h: from the force at entry to the end force
+        corr_z += float((theta[new] * (f_entry[new] + force_end[new]) - force[new]).sum())
 
         # tangential state of the elements in contact (PHYSICS.md section 6)
         s_start, p_start = s.copy(), p.copy()  # relaxed state for the entering ones
@@ -315,19 +340,26 @@ def naive_impact(scene, steps, elements, row_width=1.05, max_time=100.0, mu=None
         p[stay] = advance_arms(p_start[stay], s_start[stay], s_new[stay], arms_h)
         p[new] = advance_arms(p_start[new], s_start[new], s_new[new], arms_new)
         s[now_in] = s_new[now_in]
-        f_t = np.zeros(n)  # end-of-step tangential force of each element in contact, N
-        f_t[now_in] = c_t * weight * (rheo.spring_stress(s[now_in], p[now_in])
-                                      + rheo.eta0 * v_c_half)
+        t_spring = np.zeros(n)  # tangential force without the dashpot, N
+        t_spring[now_in] = c_t * weight * rheo.spring_stress(s[now_in], p[now_in])
+        f_t = t_spring + c_t * weight * rheo.eta0 * v_c_half  # stick trial as applied, N
+        v_c_entry = v_c_start + 2.0 * (1.0 - theta) * (v_c_half - v_c_start)
         ft_entry = np.zeros(n)
         ft_entry[new] = c_t * weight * (rheo.spring_stress(s_start[new], p_start[new])
-                                        + rheo.eta0 * v_c_half)
+                                        + rheo.eta0 * v_c_entry[new])
+        ft_end = t_spring + c_t * weight * rheo.eta0 * v_c_end_step
         if memory == "seed":  # the element jumps to the total displacement at entry
-            ft_entry[new] = f_t[new]
+            ft_entry[new] = ft_end[new]
         slip = np.zeros(n, dtype=bool)
         if friction:
             slip = now_in & (np.abs(f_t) > mu * force)
-            ft_entry[new] = np.clip(ft_entry[new], -mu * np.maximum(f_entry[new], 0.0),
-                                    mu * np.maximum(f_entry[new], 0.0))
+            cone_entry = mu * np.maximum(f_entry[new], 0.0)
+            ft_entry[new] = np.clip(ft_entry[new], -cone_entry, cone_entry)
+        stick_new = new & ~slip
+        corr_x += float((theta[stick_new] * (ft_entry[stick_new] + ft_end[stick_new])
+                         - f_t[stick_new]).sum())
+        ft_pos[now_in] = t_spring[now_in]
+        slip_sign[now_in] = 0.0
         if slip.any():
             # the element's own path s_start -> s1 over dt (h, or theta h when
             # entering) with its force on the cone: the force is affine in s1
@@ -343,33 +375,37 @@ def naive_impact(scene, steps, elements, row_width=1.05, max_time=100.0, mu=None
             f_a, _ = path_force(s_a)
             s_b = np.where(s_new[idx] != s_a, s_new[idx], s_a + dx)
             f_b, _ = path_force(s_b)
-            target = np.copysign(mu * force[idx], f_t[idx])
+            sg = np.copysign(1.0, f_t[idx])
+            target = sg * mu * force[idx]
             s_slip = s_a + (target - f_a) * (s_b - s_a) / (f_b - f_a)
             _, p[idx] = path_force(s_slip)
             w_friction += float((target * (s_new[idx] - s_slip)).sum())
             s[idx] = s_slip
             f_t[idx] = target
-            # an element that entered slipping was on the cone at entry too
-            entered = idx[~was_in[idx]]
-            ft_entry[entered] = np.copysign(mu, f_t[entered]) * np.maximum(f_entry[entered], 0.0)
+            ft_pos[idx] = sg * mu * spring[idx]
+            slip_sign[idx] = sg
+            # entering slipping: mu times the normal force over the whole part
+            ent = ~was_in[idx]
+            corr_x += float((sg[ent] * mu * (theta[idx][ent] * (f_entry[idx][ent]
+                             + force_end[idx][ent]) - force[idx][ent])).sum())
             slip_width_max = max(slip_width_max, idx.size * dx)
-        ft_last[now_in] = f_t[now_in]
-        corr_x += float((theta[new] * (ft_entry[new] + f_t[new]) - f_t[new]).sum())
         if check_cone and friction and now_in.any():
-            excess = np.abs(f_t[now_in]) - mu * force[now_in] * (1.0 + 1e-12)
+            # slipping elements sit on the cone by construction (f_t = mu f_n
+            # sign, f_n may be slightly negative in an element's last step: its
+            # dashpot at the half-step velocity), sticking ones inside it
+            excess = np.abs(f_t[now_in]) - mu * np.abs(force[now_in]) * (1.0 + 1e-12)
             if excess.max() > 0.0:
                 raise AssertionError(f"step {step}: |f_t| > mu f_n by {excess.max():.3e} N")
 
         # forces of the new state
         n_c = int(now_in.sum())
         stick = now_in & ~slip
-        Fz_spring = c_n * weight * spring[now_in].sum()
+        Fz_spring = spring[now_in].sum()
         Cz = c_n * weight * rheo.eta0 * n_c
         Fx_spring = c_t * weight * rheo.spring_stress(s[stick], p[stick]).sum()
         Cx = c_t * weight * rheo.eta0 * int(stick.sum())
-        sign = np.sign(f_t[slip])
-        Fx_slip = float((sign * mu * c_n * weight * spring[slip]).sum()) if slip.any() else 0.0
-        Cx_slip = float((sign * mu * c_n * weight * rheo.eta0).sum()) if slip.any() else 0.0
+        Fx_slip = float(ft_pos[slip].sum()) if slip.any() else 0.0
+        Cx_slip = float((slip_sign[slip] * mu * c_n * weight * rheo.eta0).sum()) if slip.any() else 0.0
         if n_c > 0 and int(slip.sum()) == n_c:
             t_gross += h
         if n_c == 0 and left.any():
@@ -390,7 +426,7 @@ def naive_impact(scene, steps, elements, row_width=1.05, max_time=100.0, mu=None
         u_max = max(u_max, u)
         if n_c > 0:
             j_outer_max = max(j_outer_max, int(np.flatnonzero(now_in)[-1]))
-        if j_outer_max >= n - 1:
+        if j_outer_max >= n - 1 and flat_punch is None:
             status = "row_exceeded"
             break
         # ---- end: no contact, moving away, and no free surface catches up ----
