@@ -516,12 +516,18 @@ class RestitutionTable:
         return value if isinstance(value, dict) else None
 
     def error_bound(self, method: str = "cubic") -> dict | None:
-        """Output -> the largest error measured between the nodes for ``method``
-        (``{"e_z": ..., "beta_x": ..., "e_x": ...}``), or None if not measured."""
+        """Output -> the error bound measured between the nodes for ``method``
+        (``{"e_z": ..., "beta_x": ..., "e_x": ...}``: the stored ``bound``, 1.5 times
+        the largest error found at the held-out points, see
+        :data:`vimpact.lookup.verify.BOUND_FACTOR`), or None if not measured."""
         err = self.interpolation_error
         if not err or err.get("method", "cubic") != method:
             return None
-        return {k: float(v["max"]) for k, v in err.get("outputs", {}).items()}
+        out = {}
+        for k, v in err.get("outputs", {}).items():
+            value = v.get("bound", v.get("max")) if isinstance(v, dict) else None
+            out[k] = None if value is None else float(value)
+        return out
 
     def lookup(self, Q1, nu, Q2=None, extrapolate: bool = False, theta_ratio=None,
                method: str = "cubic") -> dict:
