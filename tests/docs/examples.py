@@ -30,8 +30,10 @@ accepts ``0.152555`` .. ``0.152557``, which absorbs a rounding-boundary flip
 from last-bit floating-point differences between machines, and rejects
 ``0.15243``). Everything that is not a number must match exactly. A line of
 the expected output that contains ``...`` matches any text in its place (for
-output that is not reproducible, such as wall times); ``python -m
-tests.docs.refresh`` keeps such lines as written when they still match.
+output that is not reproducible, such as wall times), and a line that is only
+``...`` stands for any number of lines (to show the start of a long output);
+``python -m tests.docs.refresh`` keeps such lines as written when the output
+still matches.
 """
 
 from __future__ import annotations
@@ -56,7 +58,7 @@ PYCON_LANG = "pycon"
 #: marks a part of an expected line that matches anything
 ELLIPSIS = "..."
 
-_FENCE = re.compile(r"^(?P<fence>`{3,}|~{3,})\s*(?P<info>[^`\s]*)")
+_FENCE = re.compile(r"^(?P<indent> {0,12})(?P<fence>`{3,}|~{3,})\s*(?P<info>[^`\s]*)")
 # a number standing on its own: not part of a name (Q1, fig5_2) or a version (0.1.0)
 _NUMBER_TEXT = r"(?<![\w.])[-+]?(?:\d+\.\d*|\.\d+|\d+)(?:[eE][-+]?\d+)?(?![\w.])"
 _NUMBER = re.compile(_NUMBER_TEXT)
@@ -79,6 +81,11 @@ class Block:
     start: int
     lang: str
     body: list[str]
+    indent: str = ""
+
+    def indented(self, body: list[str]) -> list[str]:
+        """``body`` lines as they are written in the file (with the fence's indentation)."""
+        return [self.indent + ln if ln else ln for ln in body]
 
     @property
     def line(self) -> int:
@@ -87,7 +94,12 @@ class Block:
 
     @property
     def where(self) -> str:
-        return f"{self.path.relative_to(ROOT)}:{self.line}"
+        return f"{self.name}:{self.line}"
+
+    @property
+    def name(self) -> str:
+        """The file, relative to the repository when it is in it."""
+        return str(self.path.relative_to(ROOT)) if self.path.is_relative_to(ROOT) else str(self.path)
 
     @property
     def is_shell(self) -> bool:
@@ -106,7 +118,8 @@ def doc_files() -> list[Path]:
 
 
 def blocks(path: Path) -> list[Block]:
-    """Every top-level fenced block of ``path``, in order."""
+    """Every fenced block of ``path``, in order (also those indented in a list item:
+    their body is given without the fence's indentation)."""
     lines = path.read_text(encoding="utf-8").splitlines()
     found, i = [], 0
     while i < len(lines):
@@ -114,12 +127,14 @@ def blocks(path: Path) -> list[Block]:
         if not m:
             i += 1
             continue
-        fence, info = m.group("fence"), m.group("info").lower()
+        indent, fence, info = m.group("indent"), m.group("fence"), m.group("info").lower()
         j = i + 1
-        while j < len(lines) and not (lines[j].startswith(fence[0] * len(fence))
-                                      and not lines[j].strip(fence[0]).strip()):
+        while j < len(lines) and not (lines[j].strip().startswith(fence[0] * len(fence))
+                                      and not lines[j].strip().strip(fence[0])):
             j += 1
-        found.append(Block(path, i, info, lines[i + 1:j]))
+        body = [ln[len(indent):] if ln.startswith(indent) else ln.lstrip()
+                for ln in lines[i + 1:j]]
+        found.append(Block(path, i, info, body, indent))
         i = j + 1
     return found
 
@@ -184,10 +199,18 @@ def _lines(text: str) -> list[str]:
     return lines
 
 
+def _match(e: list[str], g: list[str]) -> bool:
+    """Line lists: a line that is only ``...`` stands for any number of lines."""
+    if not e:
+        return not g
+    if e[0].strip() == ELLIPSIS:
+        return any(_match(e[1:], g[k:]) for k in range(len(g) + 1))
+    return bool(g) and same_line(e[0], g[0]) and _match(e[1:], g[1:])
+
+
 def same_output(expected: str, got: str) -> bool:
     """Whole output against the expected one, line by line (rules in the module docstring)."""
-    e, g = _lines(expected), _lines(got)
-    return len(e) == len(g) and all(same_line(a, b) for a, b in zip(e, g))
+    return _match(_lines(expected), _lines(got))
 
 
 def difference(expected: str, got: str) -> str:
@@ -205,6 +228,8 @@ def difference(expected: str, got: str) -> str:
 def refreshed(expected: str, got: str) -> list[str]:
     """The output lines to write back: ``got``, keeping expected lines with ``...`` that still match."""
     e, g = _lines(expected), _lines(got)
+    if any(line.strip() == ELLIPSIS for line in e) and _match(e, g):
+        return e  # an abbreviated output that still matches stays as written
     if len(e) == len(g):
         return [a if ELLIPSIS in a and same_line(a, b) else b for a, b in zip(e, g)]
     return g
@@ -258,7 +283,7 @@ def commands(block: Block) -> list[Command]:
     while k < len(body):
         line = body[k]
         if not line.startswith("$ "):
-            raise ValueError(f"{block.path.relative_to(ROOT)}:{block.line + k}: output line "
+            raise ValueError(f"{block.name}:{block.line + k}: output line "
                              f"before any command: {line!r}")
         first, text = k, line[2:]
         while text.endswith("\\") and k + 1 < len(body):
@@ -337,7 +362,7 @@ def pycon_failures(blocks_of_file: list[Block]) -> list[str]:
     for block, ex, got in run_pycon_blocks(blocks_of_file):
         if not _same_example_output(ex.want, got):
             src = ex.source.rstrip().replace("\n", "\n    ... ")
-            failures.append(f"{block.path.relative_to(ROOT)}:{block.line + ex.lineno}: "
+            failures.append(f"{block.name}:{block.line + ex.lineno}: "
                             f">>> {src}\n{difference(ex.want, got)}")
     return failures
 
@@ -348,6 +373,6 @@ def shell_failures(block: Block) -> list[str]:
     for cmd, got in run_shell_block(block):
         expected = "\n".join(cmd.expected)
         if not same_output(expected, got):
-            failures.append(f"{block.path.relative_to(ROOT)}:{block.line + cmd.first}: "
+            failures.append(f"{block.name}:{block.line + cmd.first}: "
                             f"$ {cmd.text}\n{difference(expected, got)}")
     return failures

@@ -45,7 +45,7 @@ def _refresh_pycon(blocks: list[ex.Block]) -> dict[int, list[str]]:
             else:
                 lines = ex.refreshed(want, got)
                 if got.startswith("Traceback") and not want.startswith("Traceback"):
-                    print(f"warning: {block.path.relative_to(ex.ROOT)}:"
+                    print(f"warning: {block.name}:"
                           f"{block.line + example.lineno}: the example now raises; "
                           f"{ex._lines(got)[-1]}", file=sys.stderr)
             out += [(" " * example.indent) + line if line else line for line in lines]
@@ -70,7 +70,7 @@ def refresh_file(path: Path) -> list[str]:
             continue
         if body != block.body:
             changed.append(block.where)
-            lines[block.start + 1:block.start + 1 + len(block.body)] = body
+            lines[block.start + 1:block.start + 1 + len(block.body)] = block.indented(body)
     if changed:
         path.write_text("\n".join(lines) + "\n", encoding="utf-8")
     return sorted(changed)

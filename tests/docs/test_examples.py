@@ -52,6 +52,9 @@ def test_python_examples(path):
     ("vimpact 0.1.0: kelvin_voigt", "vimpact 0.1.1: kelvin_voigt", False),  # versions are text
     ("wrote 306 rows in ... s", "wrote 306 rows in 1.2 s", True),
     ("wrote 306 rows in ... s", "wrote 307 rows in 1.2 s", False),
+    ("first\n...\nlast", "first\nlast", True),                        # ... alone: any lines
+    ("first\n...\nlast", "first\na\nb\nlast", True),
+    ("first\n...\nlast", "first\na\nb\nlast but one", False),
 ])
 def test_comparison_rules(expected, got, same):
     assert ex.same_output(expected, got) is same
@@ -69,3 +72,33 @@ def test_a_changed_number_in_the_code_fails_the_example(monkeypatch):
     monkeypatch.setattr(hertz, "HERTZ_TIME_FACTOR", 2.94)
     failures = ex.shell_failures(tour)
     assert len(failures) == 1 and "t_hertz" in failures[0], failures
+
+
+def test_refresh_rewrites_outputs_and_keeps_everything_else(tmp_path):
+    """python -m tests.docs.refresh: stale numbers rewritten, indentation and
+    abbreviations (``...``) kept, prose untouched."""
+    from tests.docs.refresh import refresh_file
+
+    table = "sweeps/tables/kelvin_voigt_table.parquet"
+    page = tmp_path / "page.md"
+    page.write_text("\n".join([
+        "Prose stays.", "",
+        "1. In a list:", "",
+        "   ```console",
+        f"   $ vimpact table lookup {table} --Q1 0.1 --nu 0.5",
+        "   ...",
+        "   ```", "",
+        "```text",
+        f"$ vimpact table lookup {table} --Q1 0.1 --nu 0.5",
+        "stale",
+        "```", "",
+        "```pycon",
+        ">>> 6 * 7",
+        "41",
+        "```", ""]), encoding="utf-8")
+    assert len(refresh_file(page)) == 2  # the abbreviated block still matches
+    text = page.read_text(encoding="utf-8")
+    assert text.startswith("Prose stays.\n") and "   ...\n   ```\n" in text
+    assert "stale" not in text and "\n>>> 6 * 7\n42\n" in text
+    shell = [b for b in ex.blocks(page) if b.is_shell]
+    assert all(not ex.shell_failures(b) for b in shell)
