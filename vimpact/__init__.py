@@ -44,6 +44,11 @@ _EXPORTS = {
     "simulate": "vimpact.engine.simulate",
     "simulate_batch": "vimpact.engine.simulate",
     "RestitutionTable": "vimpact.lookup.table",
+    "Body": "vimpact.model.pair",
+    "Wall": "vimpact.model.pair",
+    "pair_material": "vimpact.model.pair",
+    "simulate_pair": "vimpact.model.pair",
+    "simulate_pair_batch": "vimpact.model.pair",
 }
 
 __all__ = sorted(_EXPORTS) + ["__version__"]

@@ -6,7 +6,7 @@ import argparse
 
 
 def add_parser(sub) -> None:
-    from vimpact.dem.export import CODES
+    from vimpact.dem import CODES  # the light list: the exports load scipy
 
     p = sub.add_parser(
         "dem", help="fit a DEM code's contact constants to vimpact's restitution",

@@ -12,8 +12,6 @@ from pathlib import Path
 from vimpact import __version__
 from vimpact.cli.material_args import add_material_arguments, material_from_args, missing
 from vimpact.engine.result import STATUSES, UNITS
-from vimpact.engine.routing import choose_path
-from vimpact.engine.simulate import simulate
 from vimpact.model.material import MODELS
 from vimpact.model.numerics import INTEGRATORS, PRESETS, Numerics
 from vimpact.model.scene import DEFAULT_THETA_RATIO, TANGENTIAL_EFFECTS, TANGENTIAL_MEMORY, Scene
@@ -214,6 +212,9 @@ def _check_output(flag: str, path: str, suffixes: tuple[str, ...]) -> Path:
 
 def run(a) -> int:
     """Handler of ``vimpact simulate``; returns the exit code."""
+    from vimpact.engine.routing import choose_path  # the engine loads numba: only when run
+    from vimpact.engine.simulate import simulate
+
     if a.trajectory:
         _check_output("--trajectory", a.trajectory, (".csv", ".parquet"))
     if a.scene is not None:

@@ -8,3 +8,6 @@ from a TOML file), one module per code (:mod:`~vimpact.dem.lammps`,
 :mod:`~vimpact.dem.yade`, :mod:`~vimpact.dem.mfix`, :mod:`~vimpact.dem.rebound`)
 and :mod:`~vimpact.dem.report`. Guide: ``docs/dem.md``.
 """
+
+#: The DEM codes ``vimpact dem --for`` exports to (one module each).
+CODES = ("lammps", "liggghts", "mercurydpm", "yade", "mfix", "rebound")

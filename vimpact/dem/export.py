@@ -6,12 +6,11 @@ import importlib
 from dataclasses import dataclass
 from pathlib import Path
 
+from vimpact.dem import CODES  # noqa: F401 - the one list of the codes (module vimpact.dem.<code>)
 from vimpact.dem.fit import ContactFit, Targets, compute_targets
 from vimpact.dem.problem import DemProblem
 from vimpact.model.validation import one_of
 
-#: code name -> module ``vimpact.dem.<name>``
-CODES = ("lammps", "liggghts", "mercurydpm", "yade", "mfix", "rebound")
 
 
 @dataclass

@@ -4,8 +4,10 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, fields
+from typing import TYPE_CHECKING
 
-import pandas as pd
+if TYPE_CHECKING:  # the trajectory is a DataFrame; pandas is loaded only where one is made
+    import pandas as pd
 
 #: Units of every output (``"1"`` = dimensionless).
 UNITS = {
@@ -121,7 +123,7 @@ class ImpactResult:
     gross_slip_fraction: float = math.nan
     friction_energy: float = math.nan
     error: str | None = None
-    trajectory: pd.DataFrame | None = field(default=None, repr=False, compare=False)
+    trajectory: "pd.DataFrame | None" = field(default=None, repr=False, compare=False)
 
     def to_dict(self) -> dict:
         """Outputs as a plain dict (NaN kept as float NaN; no trajectory)."""
