@@ -32,7 +32,7 @@ def test_physical_summary_and_trajectory(tmp_path, capsys):
     assert "kelvin_voigt" in text and "e_z" in text and "status        ok" in text
     traj = pd.read_parquet(path)
     assert list(traj.columns) == ["t_s", "u_z_m", "v_z_m_s", "v_x_m_s", "omega_rad_s",
-                                  "F_z_N", "F_x_N", "a_m"]
+                                  "F_z_N", "F_x_N", "a_m", "slip_width_m"]
     assert traj.t_s.is_monotonic_increasing and (traj.F_z_N >= 0).all()
     # the sphere is released with the velocities it had when the force vanished
     assert traj.v_z_m_s.iloc[-1] < 0 < traj.v_z_m_s.iloc[0]
