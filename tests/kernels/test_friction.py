@@ -273,10 +273,12 @@ def test_flat_punch_is_a_stick_slip_oscillator(mu):
     scene = Scene(Material.elastic(nu=nu, G=G), R=R, m=m, v_z0=1.0, v_x0=0.8, omega0=0.0,
                   mu=mu)
     a0 = 0.5 * scene.hertz.a_H
-    ref = naive_impact(scene, 2000, 200, flat_punch=a0)
+    ref = naive_impact(scene, 1000, 200, flat_punch=a0)
     E_star = 2.0 * G / (1.0 - nu)
     k_n, k_t = 2.0 * a0 * E_star, 2.0 * a0 * 4.0 / (2.0 - nu) * G
     v_c = flat_punch_oscillator(m, scene.Theta, R, k_n, k_t, mu, 1.0, 0.8)
     assert math.isclose(ref["e_z"], 1.0, rel_tol=1e-6)
     v_c_ref = ref["v_x_end"] + R * ref["omega_end"]
-    assert abs(v_c_ref - v_c) < 2e-3 * 0.8, (v_c_ref, v_c)
+    # measured 1e-14 (gross slip, mu = 0.1) and 1.4e-7 (stick-slip) at 1000 steps
+    # per t_H: the stick/slip switches are located to within a step
+    assert abs(v_c_ref - v_c) < 1e-6 * 0.8, (v_c_ref, v_c)
