@@ -156,6 +156,19 @@ def test_shipped_specs_are_valid():
         assert spec.output.parent.name == "tables"
 
 
+def test_shipped_tables_are_current():
+    """Every shipped table was made by its spec with this package and schema version
+    (stale otherwise: regenerate it with `vimpact sweep sweeps/NAME.toml`)."""
+    from vimpact.sweep import store
+    shipped = [load_spec(p) for p in sorted(SWEEPS.glob("*.toml"))]
+    shipped = [s for s in shipped if s.output.exists()]
+    assert len(shipped) >= 6
+    stale = [s.path.name for s in shipped if not store.is_complete(s, s.output)]
+    assert not stale, f"stale tables, regenerate with `vimpact sweep`: {stale}"
+    for spec in shipped:
+        assert read_metadata(spec.output)["schema_version"] == sweep.SCHEMA_VERSION
+
+
 # ---- end to end ---------------------------------------------------------------
 
 def test_random_sweep_matches_single_simulations(tmp_path):
