@@ -148,9 +148,9 @@ def _n_unload(n, tang):
     return 4 + n + (2 + n if tang else 0)
 
 
-@jit()
-def _rhs_load(y, dy, tau0, g, itau, n, kappa, mu_t, tang):
-    """Loading right-hand side ``dy/dsigma``; returns ``(F_z, F_x)``."""
+@jit(inline="always")
+def _rhs_load(y, K, r, tau0, g, itau, n, kappa, mu_t, tang):
+    """Loading right-hand side ``dy/dsigma`` into ``K[r]``; returns ``(F_z, F_x)``."""
     s = y[0]
     v = y[1]
     s2 = s * s
@@ -158,12 +158,12 @@ def _rhs_load(y, dy, tau0, g, itau, n, kappa, mu_t, tang):
     for i in range(n):
         a = y[3 + i]
         acc += g[i] * ((s2 - a) * s + y[3 + n + i])
-        dy[3 + i] = 2.0 * s * (s2 - a) * itau[i]
-        dy[3 + n + i] = -2.0 * s * y[3 + n + i] * itau[i] + (a - s2) * v
+        K[r, 3 + i] = 2.0 * s * (s2 - a) * itau[i]
+        K[r, 3 + n + i] = -2.0 * s * y[3 + n + i] * itau[i] + (a - s2) * v
     Fz = GN * acc
-    dy[0] = v
-    dy[1] = -2.0 * s * Fz
-    dy[2] = 2.0 * s
+    K[r, 0] = v
+    K[r, 1] = -2.0 * s * Fz
+    K[r, 2] = 2.0 * s
     Fx = 0.0
     if tang:
         o = 3 + 2 * n
@@ -173,12 +173,12 @@ def _rhs_load(y, dy, tau0, g, itau, n, kappa, mu_t, tang):
         for i in range(n):
             bb = y[o + 3 + i]
             accx += g[i] * ((wc - bb) * s + y[o + 3 + n + i])
-            dy[o + 3 + i] = 2.0 * s * (wc - bb) * itau[i]
-            dy[o + 3 + n + i] = -2.0 * s * y[o + 3 + n + i] * itau[i] + (bb - wc) * v
+            K[r, o + 3 + i] = 2.0 * s * (wc - bb) * itau[i]
+            K[r, o + 3 + n + i] = -2.0 * s * y[o + 3 + n + i] * itau[i] + (bb - wc) * v
         Fx = GN * kappa * accx
-        dy[o] = 2.0 * s * vc
-        dy[o + 1] = -2.0 * s * mu_t * Fx
-        dy[o + 2] = wc * v
+        K[r, o] = 2.0 * s * vc
+        K[r, o + 1] = -2.0 * s * mu_t * Fx
+        K[r, o + 2] = wc * v
     return Fz, Fx
 
 
@@ -251,8 +251,8 @@ def _edge(rc, hs, nh, s_t):
 
 
 @jit()
-def _rhs_unload(z, dz, tau0, g, itau, n, kappa, mu_t, tang, rc, hs, nh, e_val):
-    """Unloading right-hand side ``dz/dsigma``; returns ``(F_z, F_x)``.
+def _rhs_unload(z, K, r, tau0, g, itau, n, kappa, mu_t, tang, rc, hs, nh, e_val):
+    """Unloading right-hand side ``dz/dsigma`` into ``K[r]``; returns ``(F_z, F_x)``.
 
     ``e_val`` receives the decay factors ``E_i`` at the edge and, at ``n``,
     the force density there (zero up to the integration error).
@@ -278,14 +278,14 @@ def _rhs_unload(z, dz, tau0, g, itau, n, kappa, mu_t, tang, rc, hs, nh, e_val):
         den += g[i] * e
         fe += g[i] * ((u - a) + e * (ae - ue))
         ft += g[i] * (v - ((u - a) + e * (ae - ue)) * itau[i])
-        dz[4 + i] = 2.0 * s * (u - a) * itau[i]
+        K[r, 4 + i] = 2.0 * s * (u - a) * itau[i]
     Fz = GN * acc
     e_val[n] = fe  # force density at the edge (0 up to the integration error)
     ft += v - tau0 * Fz
-    dz[0] = ft / den
-    dz[1] = -2.0 * s * Fz
-    dz[2] = 2.0 * s
-    dz[3] = 2.0 * s * v
+    K[r, 0] = ft / den
+    K[r, 1] = -2.0 * s * Fz
+    K[r, 2] = 2.0 * s
+    K[r, 3] = 2.0 * s * v
     Fx = 0.0
     if tang:
         o = 4 + n
@@ -298,18 +298,18 @@ def _rhs_unload(z, dz, tau0, g, itau, n, kappa, mu_t, tang, rc, hs, nh, e_val):
             bb = z[o + 2 + i]
             ue_i = _dense(rc, k, th, lo + 3 + n + i)
             accx += g[i] * ((wc - bb) * s + e_val[i] * ue_i)
-            dz[o + 2 + i] = 2.0 * s * (wc - bb) * itau[i]
+            K[r, o + 2 + i] = 2.0 * s * (wc - bb) * itau[i]
         Fx = GN * kappa * accx
-        dz[o] = 2.0 * s * vc
-        dz[o + 1] = -2.0 * s * mu_t * Fx
+        K[r, o] = 2.0 * s * vc
+        K[r, o + 1] = -2.0 * s * mu_t * Fx
     return Fz, Fx
 
 
-@jit()
-def _rhs(phase, y, dy, tau0, g, itau, n, kappa, mu_t, tang, rc, hs, nh, e_val):
+@jit(inline="always")
+def _rhs(phase, y, K, r, tau0, g, itau, n, kappa, mu_t, tang, rc, hs, nh, e_val):
     if phase == 0:
-        return _rhs_load(y, dy, tau0, g, itau, n, kappa, mu_t, tang)
-    return _rhs_unload(y, dy, tau0, g, itau, n, kappa, mu_t, tang, rc, hs, nh, e_val)
+        return _rhs_load(y, K, r, tau0, g, itau, n, kappa, mu_t, tang)
+    return _rhs_unload(y, K, r, tau0, g, itau, n, kappa, mu_t, tang, rc, hs, nh, e_val)
 
 
 @jit()
@@ -320,24 +320,24 @@ def _step(phase, m, y, h, K, y1, tmp, tau0, g, itau, n, kappa, mu_t, tang, rc, h
     (``K[6]`` the derivative at ``y1``). Returns the error norm."""
     for c in range(m):
         tmp[c] = y[c] + h * _A21 * K[0, c]
-    _rhs(phase, tmp, K[1], tau0, g, itau, n, kappa, mu_t, tang, rc, hs, nh, e_val)
+    _rhs(phase, tmp, K, 1, tau0, g, itau, n, kappa, mu_t, tang, rc, hs, nh, e_val)
     for c in range(m):
         tmp[c] = y[c] + h * (_A31 * K[0, c] + _A32 * K[1, c])
-    _rhs(phase, tmp, K[2], tau0, g, itau, n, kappa, mu_t, tang, rc, hs, nh, e_val)
+    _rhs(phase, tmp, K, 2, tau0, g, itau, n, kappa, mu_t, tang, rc, hs, nh, e_val)
     for c in range(m):
         tmp[c] = y[c] + h * (_A41 * K[0, c] + _A42 * K[1, c] + _A43 * K[2, c])
-    _rhs(phase, tmp, K[3], tau0, g, itau, n, kappa, mu_t, tang, rc, hs, nh, e_val)
+    _rhs(phase, tmp, K, 3, tau0, g, itau, n, kappa, mu_t, tang, rc, hs, nh, e_val)
     for c in range(m):
         tmp[c] = y[c] + h * (_A51 * K[0, c] + _A52 * K[1, c] + _A53 * K[2, c] + _A54 * K[3, c])
-    _rhs(phase, tmp, K[4], tau0, g, itau, n, kappa, mu_t, tang, rc, hs, nh, e_val)
+    _rhs(phase, tmp, K, 4, tau0, g, itau, n, kappa, mu_t, tang, rc, hs, nh, e_val)
     for c in range(m):
         tmp[c] = y[c] + h * (_A61 * K[0, c] + _A62 * K[1, c] + _A63 * K[2, c] + _A64 * K[3, c]
                              + _A65 * K[4, c])
-    _rhs(phase, tmp, K[5], tau0, g, itau, n, kappa, mu_t, tang, rc, hs, nh, e_val)
+    _rhs(phase, tmp, K, 5, tau0, g, itau, n, kappa, mu_t, tang, rc, hs, nh, e_val)
     for c in range(m):
         y1[c] = y[c] + h * (_B1 * K[0, c] + _B3 * K[2, c] + _B4 * K[3, c] + _B5 * K[4, c]
                             + _B6 * K[5, c])
-    _rhs(phase, y1, K[6], tau0, g, itau, n, kappa, mu_t, tang, rc, hs, nh, e_val)
+    _rhs(phase, y1, K, 6, tau0, g, itau, n, kappa, mu_t, tang, rc, hs, nh, e_val)
     acc = 0.0
     for c in range(m):
         e = h * (_E1 * K[0, c] + _E3 * K[2, c] + _E4 * K[3, c] + _E5 * K[4, c] + _E6 * K[5, c]
@@ -348,18 +348,9 @@ def _step(phase, m, y, h, K, y1, tmp, tau0, g, itau, n, kappa, mu_t, tang, rc, h
 
 
 @jit()
-def _store(rc, hs, sig_h, nh, y, y1, K, h, m):
-    """Append the dense output of an accepted loading step; returns the
-    (possibly grown) buffers."""
-    if nh + 1 >= rc.shape[0]:
-        cap = 2 * rc.shape[0]
-        rc2 = np.empty((cap, 5, rc.shape[2]))
-        rc2[:nh] = rc[:nh]
-        hs2 = np.empty(cap + 1)
-        hs2[:nh + 1] = hs[:nh + 1]
-        sg2 = np.empty(cap + 1)
-        sg2[:nh + 1] = sig_h[:nh + 1]
-        rc, hs, sig_h = rc2, hs2, sg2
+def _store(rc, hs, nh, y, y1, K, h, m):
+    """Write the dense output of an accepted loading step into row ``nh``
+    (Hairer, Norsett & Wanner's ``contd5`` coefficients) and its end ``s``."""
     for c in range(m):
         dif = y1[c] - y[c]
         bspl = h * K[0, c] - dif
@@ -370,7 +361,6 @@ def _store(rc, hs, sig_h, nh, y, y1, K, h, m):
         rc[nh, 4, c] = h * (_D1 * K[0, c] + _D3 * K[2, c] + _D4 * K[3, c] + _D5 * K[4, c]
                             + _D6 * K[5, c] + _D7 * K[6, c])
     hs[nh + 1] = y1[0]
-    return rc, hs, sig_h
 
 
 @jit()
@@ -503,7 +493,6 @@ def maxwell_stick_impact(tau0, g, tau, kappa, mu_t, tangential, rtol, max_steps,
     cap = 64
     rc = np.zeros((cap, 5, m_l))
     hs = np.zeros(cap + 1)
-    sig_h = np.zeros(cap + 1)
     nh = 0
 
     phase = 0
@@ -511,7 +500,7 @@ def maxwell_stick_impact(tau0, g, tau, kappa, mu_t, tangential, rtol, max_steps,
     y[1] = 1.0
     if tang:
         y[3 + 2 * n + 1] = 1.0
-    Fz, Fx = _rhs(phase, y, K[0], tau0, ga, itau, n, kappa, mu_t, tang, rc, hs, nh, e_val)
+    Fz, Fx = _rhs(phase, y, K, 0, tau0, ga, itau, n, kappa, mu_t, tang, rc, hs, nh, e_val)
     h = 0.05 * min(1.0, s_scale)
     sig = 0.0
     err_old = 1e-4
@@ -594,8 +583,14 @@ def maxwell_stick_impact(tau0, g, tau, kappa, mu_t, tangential, rtol, max_steps,
                 for c in range(m):
                     K[r, c] = Ks[r, c]
         if phase == 0:
-            rc, hs, sig_h = _store(rc, hs, sig_h, nh, y, y1, K, h, m)
-            sig_h[nh + 1] = sig + h
+            if nh + 1 >= rc.shape[0]:  # grow the history (rare: doubling)
+                rc2 = np.empty((2 * rc.shape[0], 5, m_l))
+                rc2[:nh] = rc[:nh]
+                hs2 = np.empty(2 * rc.shape[0] + 1)
+                hs2[:nh + 1] = hs[:nh + 1]
+                rc = rc2
+                hs = hs2
+            _store(rc, hs, nh, y, y1, K, h, m)
             nh += 1
         elif y1[0] > y[0] + 100.0 * rtol * s_max:  # edge moving outward: re-entry
             status = STATUS_ASSUMPTION
@@ -644,7 +639,7 @@ def maxwell_stick_impact(tau0, g, tau, kappa, mu_t, tangential, rtol, max_steps,
             atol[3] = rtol * (s_scale * s_scale)
             if tau0 > 0.0:
                 atol[0] = rtol * min(s_max, (v_scale / (1.25 * tau0)) ** (1.0 / 3.0))
-            Fz, Fx = _rhs(phase, y, K[0], tau0, ga, itau, n, kappa, mu_t, tang, rc, hs, nh,
+            Fz, Fx = _rhs(phase, y, K, 0, tau0, ga, itau, n, kappa, mu_t, tang, rc, hs, nh,
                           e_val)
             # restart small: the right-hand side is not smooth in the edge state
             # at the turning point, and there the error estimate of a long step
@@ -691,7 +686,7 @@ def maxwell_stick_impact(tau0, g, tau, kappa, mu_t, tangential, rtol, max_steps,
 @jit()
 def _rec_state(rec, i_rec, phase, y, K, tau0, g, itau, n, kappa, mu_t, tang, rc, hs, nh, e_val):
     """Record the current state (forces recomputed at it)."""
-    Fz, Fx = _rhs(phase, y, K[6], tau0, g, itau, n, kappa, mu_t, tang, rc, hs, nh, e_val)
+    Fz, Fx = _rhs(phase, y, K, 6, tau0, g, itau, n, kappa, mu_t, tang, rc, hs, nh, e_val)
     if phase == 0:
         u = y[0] * y[0]
         vc = y[3 + 2 * n + 1] if tang else 0.0
