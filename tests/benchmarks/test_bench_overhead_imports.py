@@ -89,3 +89,35 @@ def test_imports(tmp_path, monkeypatch):
 def test_imports_probe_reports_a_failed_import():
     with pytest.raises(RuntimeError, match="no_such_module"):
         imports.probe("import no_such_module")
+
+
+def test_a_benchmark_is_registered_by_one_line(tmp_path, monkeypatch, capsys):
+    """A module with ``run``/``plot`` (and figures in its data) outside the
+    package runs as ``vimpact bench NAME`` once it has its line in BENCHMARKS."""
+    from vimpact import bench
+
+    (tmp_path / "tiny_bench.py").write_text(
+        'TITLE = "tiny"\n'
+        "from vimpact.bench.machine import figure, machine_info, save_figure, use_agg\n"
+        "def run(quick):\n"
+        "    return {'machine': machine_info(), 'x': [1, 2],\n"
+        "            'figures': {'t_s': figure(0.5, 's', samples=[0.4, 0.5, 0.6])}}\n"
+        "def plot(data, path):\n"
+        "    use_agg()\n"
+        "    import matplotlib.pyplot as plt\n"
+        "    fig, ax = plt.subplots()\n"
+        "    ax.plot(data['x'])\n"
+        "    save_figure(fig, path)\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    monkeypatch.setitem(bench.BENCHMARKS, "tiny", "tiny_bench")  # the one line
+    out = tmp_path / "out"
+    assert main(["bench", "list"]) == 0
+    assert "tiny         tiny" in capsys.readouterr().out
+    assert main(["bench", "tiny", "--quick", "--out", str(out)]) == 0
+    data = json.loads((out / "tiny.json").read_text())
+    assert (out / "tiny.png").stat().st_size > 0
+    _check_common(data, "tiny")
+    assert data["figures"]["t_s"]["spread"] == pytest.approx(0.2)
+    monkeypatch.setitem(bench.BENCHMARKS, "gone", "no_such_module_here")
+    assert main(["bench", "gone"]) == 2
+    assert "not importable here" in capsys.readouterr().err

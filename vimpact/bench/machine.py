@@ -185,8 +185,9 @@ def _json_safe(x):
 
 def annotate(name: str, module, data: dict, quick: bool) -> dict:
     """``data`` with ``benchmark``, ``schema``, ``quick`` and ``figures`` (from
-    ``module.figures(data)``) added, strict-JSON safe."""
-    figs = module.figures(data) if hasattr(module, "figures") else {}
+    ``module.figures(data)``, or the ``figures`` the data carry for a module
+    without that function) added, strict-JSON safe."""
+    figs = module.figures(data) if hasattr(module, "figures") else data.get("figures", {})
     head = {"benchmark": name, "schema": SCHEMA, "quick": bool(quick)}
     body = {k: x for k, x in data.items() if k not in ("benchmark", "schema", "quick", "figures")}
     return _json_safe({**head, **body, "figures": figs})
