@@ -73,9 +73,11 @@ class Numerics:
 
         The continuum paths (every full-stick scene with incremental memory;
         the Kelvin-Voigt normal impact) get ``rtol = tolerance / 1000``: rtol
-        bounds the local error of each step, and the measured global error of
-        beta_x is up to about 100 rtol (e_z about rtol; tests/engine/test_tolerance.py
-        on random scenes); they cost microseconds to a fraction of a millisecond. The element path (friction,
+        bounds the local error of each step, and the measured global error is
+        about 0.6 rtol on e_z and typically 3-30 rtol on beta_x, but up to 125
+        rtol on beta_x for a standard solid with a stiff arm (Q2 = 0.01; random
+        scenes against rtol 1e-13, tests/engine/test_tolerance.py); they cost
+        microseconds to a fraction of a millisecond. The element path (friction,
         seed memory, stiff arms, hand-overs) gets steps and elements from the
         error model measured by ``python -m benchmarks.accuracy``
         (:data:`ERROR_MODEL`: an envelope ``a / steps^p + b / elements^q``),
@@ -151,7 +153,7 @@ PRESETS = {
     "fast": Numerics(steps=500, elements=70),  # measured 3.1e-4 at 0.11 ms/impact
     "default": Numerics(),  # 1400/200: measured 6.4e-5 at 0.56 ms/impact
     # elements: the best the element path verifiably reaches (e_x ~2e-6, e_z ~1.4e-7);
-    # continuum paths: rtol 1e-12 gives about 1e-10 on beta_x (its error is up to ~100 rtol)
+    # continuum paths: rtol 1e-12 gives 1e-10 and better on beta_x (error up to ~125 rtol)
     "precise": Numerics(steps=16000, elements=3200, rtol=1e-12),
     "thesis": Numerics(integrator="euler", steps=5000, elements=500),
 }
