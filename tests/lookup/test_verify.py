@@ -160,3 +160,23 @@ def test_to_xarray_labels_axes_or_says_it_is_missing(kv):
     np.testing.assert_allclose(ds["Q1"].values, Q1_NODES, rtol=1e-12)
     row = kv.data.iloc[7]
     assert float(ds["beta_x"].sel(Q1=row.Q1, nu=row.nu)) == row.beta_x
+
+
+def test_cli_verify_writes_the_bound_that_info_and_lookup_report(kv, tmp_path, capsys):
+    from vimpact.cli.main import main
+
+    fresh = {k: v for k, v in kv.metadata.items() if not k.endswith("interpolation_error")}
+    path = str(RestitutionTable(kv.data, fresh).save(tmp_path / "kv.parquet"))
+    assert main(["table", "verify", path, "--n", "20", "--json"]) == 0
+    first = json.loads(capsys.readouterr().out)
+    assert RestitutionTable.open(path).interpolation_error is None  # not written without --write
+    assert main(["table", "verify", path, "--n", "20", "--write"]) == 0
+    assert "stored as vimpact.interpolation_error" in capsys.readouterr().out
+    assert RestitutionTable.open(path).interpolation_error["outputs"] == first["outputs"]
+    assert main(["table", "info", path]) == 0
+    assert "interpolation   cubic: max error e_z" in capsys.readouterr().out
+    assert main(["table", "lookup", path, "--Q1", "0.3", "--nu", "0.3", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["error_bound"]["e_z"] == pytest.approx(1.5 * first["outputs"]["e_z"]["max"])
+    assert main(["table", "lookup", path, "--Q1", "0.3", "--nu", "0.3", "--method", "linear"]) == 0
+    assert "not measured for linear" in capsys.readouterr().out
