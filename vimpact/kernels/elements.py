@@ -130,6 +130,10 @@ def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT, FRICTION,
     Cs = 0.0  # slipping elements: tangential force per unit normal velocity (mu f_n's dashpot)
     t_gross = 0.0
     PARTIAL = INTEGRATOR == VERLET  # weigh partial contact within a step (see below)
+    # ... in the normal force only where it jumps at entry: the dashpot (else the
+    # force is continuous at entry and exit, and the elastic Verlet impact stays
+    # time reversible: e_z = 1 to rounding)
+    NCORR = PARTIAL and DASHPOT
     # last step's position part of each element's tangential force (/ k_el kappa)
     # and, with friction, its slip direction (0: sticking)
     ftp = np.zeros(n_t if PARTIAL else 0)
@@ -258,7 +262,8 @@ def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT, FRICTION,
                             alpha = 1.0
                         else:
                             alpha = T0 / (T0 - T1)
-                        corr_n += alpha * T0 - (f[j] + c0 * v_test)
+                        if NCORR:
+                            corr_n += alpha * T0 - (f[j] + c0 * v_test)
                         if TANGENTIAL:  # tangential force T0t -> trial T1t over the step
                             s0 = s[j]
                             s1 = uc1 if MEMORY == 1 else s0 + duc
@@ -266,7 +271,11 @@ def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT, FRICTION,
                             if ARMS:
                                 T1t += _follow_value(s0, s1, p[j], g, E, omE, phi)
                             sg = fsgn[j] if FRIC else 0.0
-                            if sg != 0.0:  # slipping: mu times the normal force
+                            if sg != 0.0 and not NCORR:  # slipping: mu times the normal
+                                T0t = 0.0  # force, which takes no correction here
+                                A_t = 0.0
+                                T1t = 0.0
+                            elif sg != 0.0:  # slipping: mu times the normal force
                                 T0t = ftp[j] + sg * mu_k / kappa * c0 * v
                                 A_t = ftp[j] + sg * mu_k / kappa * c0 * v_test
                                 T1t = sg * mu_k / kappa * T1
@@ -282,7 +291,7 @@ def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT, FRICTION,
                     t_leave = max(t_leave, (step + alpha) * h)
                 contact[j] = False
                 continue
-            if PARTIAL and not was_in:  # from f_entry to the end force over theta h
+            if NCORR and not was_in:  # from f_entry to the end force over theta h
                 corr_n += theta * (f_entry + r + c0 * ve) - fj
             contact[j] = True
             f[j] = r if PARTIAL else fj
@@ -372,7 +381,7 @@ def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT, FRICTION,
                     if PARTIAL:  # mu times the normal force, entering or not
                         ftp[j] = sgn * mu_k / kappa * r
                         fsgn[j] = sgn
-                        if not was_in:
+                        if NCORR and not was_in:
                             corr_t += sgn * mu_k / kappa * (theta * (f_entry + r + c0 * ve) - fj)
         if n_c == 0 and t_leave > 0.0:
             t_exit = t_leave  # the last elements left within this step

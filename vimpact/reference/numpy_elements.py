@@ -21,7 +21,8 @@ integrator, so for the same discretization both agree to rounding (about
 contact for only part of a step weighed by that part (its force taken
 linear in time over it: from its last force to zero at the leave fraction
 ``alpha``, from its force at the moment of entry over the entering fraction
-``theta``).
+``theta``); the normal force only with a dashpot (without one it is
+continuous at entry and exit).
 
 Coulomb friction (PHYSICS.md section 12), written here independently of the
 kernel: every element in contact first takes the stick trial; if its
@@ -307,7 +308,8 @@ def naive_impact(scene, steps, elements, row_width=1.05, max_time=100.0, mu=None
             alpha = np.where(T0 <= 0.0, 0.0, np.where(T1 >= 0.0, 1.0, T0 / np.where(
                 T0 - T1 > 0.0, T0 - T1, 1.0)))
             t_leave = ((step + alpha) * h).max()
-            corr_z += float((alpha * T0 - (f_last[left] + dash_z * v_z_half)).sum())
+            if rheo.eta0 > 0.0:  # the normal force jumps at entry only with a dashpot
+                corr_z += float((alpha * T0 - (f_last[left] + dash_z * v_z_half)).sum())
             # tangential: from T0t at the start to the stick trial T1t at the end
             s_l = np.full(int(left.sum()), u_c_new) if memory == "seed" else s[left] + du_c
             p_l = advance_arms(p[left], s[left], s_l, arms_h)  # trial only, not kept
@@ -322,12 +324,16 @@ def naive_impact(scene, steps, elements, row_width=1.05, max_time=100.0, mu=None
                                           else 0.0, dash_t * v_c_half)
             if friction:
                 T1t = np.where(sg != 0.0, sg * mu * T1, T1t)
-            corr_x += float((2.0 * alpha * T0t + alpha**2 * (T1t - T0t) - A_t).sum())
+            path = 2.0 * alpha * T0t + alpha**2 * (T1t - T0t) - A_t
+            if rheo.eta0 == 0.0:  # slipping: mu times the normal force, not corrected
+                path = np.where(sg != 0.0, 0.0, path)
+            corr_x += float(path.sum())
         contact = now_in
         f_last[now_in] = spring[now_in]
         new = now_in & entering
         # entering for the last theta h: from the force at entry to the end force
-        corr_z += float((theta[new] * (f_entry[new] + force_end[new]) - force[new]).sum())
+        if rheo.eta0 > 0.0:
+            corr_z += float((theta[new] * (f_entry[new] + force_end[new]) - force[new]).sum())
 
         # tangential state of the elements in contact (PHYSICS.md section 6)
         s_start, p_start = s.copy(), p.copy()  # relaxed state for the entering ones
@@ -385,7 +391,7 @@ def naive_impact(scene, steps, elements, row_width=1.05, max_time=100.0, mu=None
             ft_pos[idx] = sg * mu * spring[idx]
             slip_sign[idx] = sg
             # entering slipping: mu times the normal force over the whole part
-            ent = ~was_in[idx]
+            ent = ~was_in[idx] & (rheo.eta0 > 0.0)
             corr_x += float((sg[ent] * mu * (theta[idx][ent] * (f_entry[idx][ent]
                              + force_end[idx][ent]) - force[idx][ent])).sum())
             slip_width_max = max(slip_width_max, idx.size * dx)
