@@ -266,16 +266,19 @@ class HermiteGrid:
                 base += i0 * self.strides[k]
                 weights.append(w)
             idx = base[:, None] + offsets[None, :]
-            # (B, corner bits d-1..0, mask bits d-1..0, outputs), contracted axis by axis
-            G = np.take(self._rows, idx, axis=0).reshape((B,) + (2,) * (2 * d) + (n_out,))
-            for r in range(d, 0, -1):  # axis r - 1 leads both the corner and the mask bits
-                w0, w1, g0, g1 = (w.reshape((B,) + (1,) * (2 * r - 2) + (1,))
-                                  for w in weights[r - 1])
-                lo, hi = G[:, 0], G[:, 1]
-                pick = (slice(None),) * r
-                G = (w0 * lo[pick + (0,)] + g0 * lo[pick + (1,)]
-                     + w1 * hi[pick + (0,)] + g1 * hi[pick + (1,)])
-            acc = G.reshape(B, n_out)
+            # W[b, corner bits d-1..0, mask bits d-1..0] = prod_k w_k[b, bit_k, mask_k]
+            W = np.ones((B,) + (1,) * (2 * d))
+            for k, (w0, w1, g0, g1) in enumerate(weights):
+                wk = np.stack([np.stack([w0, g0], -1), np.stack([w1, g1], -1)], 1)  # (B, 2, 2)
+                bshape = [B] + [1] * (2 * d)
+                bshape[d - k] = 2
+                bshape[2 * d - k] = 2
+                W = W * wk.reshape(bshape)
+            W = W.reshape(B, nc * nc)
+            G = np.take(self._rows, idx, axis=0).reshape(B, nc * nc, n_out)
+            acc = np.empty((B, n_out))
+            for j in range(n_out):
+                acc[:, j] = np.einsum("bj,bj->b", W, G[:, :, j])
             if self.bad.any():
                 # NaN where a failed node's value or derivative carries weight
                 nz = [[(w0 != 0.0, g0 != 0.0), (w1 != 0.0, g1 != 0.0)]
