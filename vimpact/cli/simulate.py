@@ -158,7 +158,7 @@ def _scene_from_args(a) -> Scene:
 
 def _scene_file(a) -> tuple[Scene, Numerics | None]:
     """Scene and numerics of ``--scene FILE``; scene options beside it are refused."""
-    from vimpact.model.scene_file import load_scene  # imports the sweep machinery: only when asked
+    from vimpact.model.scene_file import load_scene  # TOML reading: only when asked
 
     given = [f"--{n.replace('_', '-')}" for n in _PHYSICAL + ("Q1", "Q2", "nu") + tuple(_EFFECTS)
              if getattr(a, n) is not None]
