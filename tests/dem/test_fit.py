@@ -74,7 +74,7 @@ def test_yade_et_fit_recovers_et():
 
 def test_kelvin_voigt_fit_is_close_to_tau_and_residual_is_second_order():
     """For a Kelvin-Voigt wall contact the viscoelastic Hertz law's loading branch is ours
-    with A = tau (PHYSICS.md section 5): the fitted A is near tau, and the residual of the
+    with A = tau (docs/physics.md#kelvin-voigt-continuum): the fitted A is near tau, and the residual of the
     fit is small compared with 1 - e (the laws differ at second order in the damping)."""
     from vimpact.dem.fit import compute_targets
 

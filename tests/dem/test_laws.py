@@ -36,7 +36,7 @@ def test_elastic_hertz_law_is_hertz():
 
 
 def test_viscoelastic_hertz_small_damping_slope():
-    """1 - e = 1.8917 alpha to first order (PHYSICS.md section 5), with the second-order
+    """1 - e = 1.8917 alpha to first order (docs/physics.md#kelvin-voigt-continuum), with the second-order
     term visible as a linear trend of the slope in alpha."""
     alphas = np.array([1e-5, 2e-5, 4e-5])
     slopes = np.array([(1 - laws.viscoelastic_hertz_e(a)[0]) / a for a in alphas])

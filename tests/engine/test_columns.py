@@ -107,7 +107,7 @@ def test_held_spin_is_not_an_energy_gain():
 
 def test_gross_slip_through_the_batch_path():
     """Large incidence: F_x = mu F_z throughout, so
-    v_c,end = v_c0 - mu (1 + m R^2/Theta)(1 + e_z) v_z0 (PHYSICS: Coulomb friction)."""
+    v_c,end = v_c0 - mu (1 + m R^2/Theta)(1 + e_z) v_z0 (docs/physics.md#coulomb-friction)."""
     mu = 0.1
     res = v.simulate(v.Scene.from_dimensionless(0.2, 0.5, mu=mu), FAST)  # v_c0 = v_z0 = 1
     assert res.path.endswith("friction]") and res.status == "ok"

@@ -28,7 +28,7 @@ scene at twice the steps and twice the elements (``test_converged``).
 
 No row may end with ``half_space`` (or ``row_exceeded``): every scene has
 ``a_H = 0.01 R``, and the contact of a passive material whose Hertz scale is
-set by the relaxed modulus ``G_inf`` stays within ``a_H`` (PHYSICS.md
+set by the relaxed modulus ``G_inf`` stays within ``a_H`` (docs/physics.md
 section 3; the dashpot and the arms only stiffen the loading, so ``u_max <=
 d``). That includes ``Q1 = 100``: the heavily overdamped sphere is stopped by
 the dashpot at a fraction of ``d`` (``a_max`` about 0.18 ``a_H``), it does not
@@ -299,7 +299,7 @@ def test_elastic_limits_return_the_normal_speed():
 
 def test_elastic_limit_of_every_rheology_is_the_elastic_material():
     """Kelvin-Voigt with eta = 0, a standard solid with eta = 0 and a Prony series
-    without arms are the elastic material (PHYSICS.md section 4): same answer."""
+    without arms are the elastic material (docs/physics.md#rheologies): same answer."""
     rows = _by_id("limits")
     for nu in (0.0, 0.25, 0.5):
         ref = rows[f"elastic-nu={fmt(nu)}"]
@@ -313,7 +313,7 @@ def test_elastic_limit_of_every_rheology_is_the_elastic_material():
 
 
 def test_normal_problem_ignores_tangential_state_and_nu():
-    """PHYSICS.md sections 7, 8: the normal problem does not depend on the
+    """docs/physics.md#energy-and-passivity, docs/physics.md#dimensionless-parameters: the normal problem does not depend on the
     tangential one, and in Hertz units not on nu. Across grazing, spin, spin
     against sliding and v_c0 = 0, and across nu and theta, e_z is one number
     (up to the accuracy aim of the numerics, should they refine differently)."""
@@ -331,7 +331,7 @@ def test_normal_problem_ignores_tangential_state_and_nu():
 
 
 def test_tangential_is_linear_in_vc0():
-    """PHYSICS.md section 7: beta_x does not depend on the size or sign of v_c0
+    """docs/physics.md#energy-and-passivity: beta_x does not depend on the size or sign of v_c0
     (1e-3 ... 1e3 v_z0) nor on how it splits into v_x0 and R omega0 (grazing,
     pure spin, spin against sliding)."""
     rows = _by_id("tangential")
@@ -364,7 +364,7 @@ def _theta_for_same_tangential_stiffness(nu_a, theta_a, nu_b):
                                   lambda nu: material("standard_solid", nu, q1=1.0, q2=0.3)],
                          ids=["kv-Q1=1e-3", "sls-Q1=1-Q2=0.3"])
 def test_tangential_depends_on_nu_and_theta_only_through_one_stiffness(nu_a, theta_a, nu_b, make):
-    """PHYSICS.md sections 3, 6, 7: the tangential elements have stiffness c_t G,
+    """docs/physics.md#method-of-dimensionality-reduction, docs/physics.md#full-stick, docs/physics.md#energy-and-passivity: the tangential elements have stiffness c_t G,
     the normal ones c_n G, and the contact point has the mass 1 / (1/m + R^2/Theta);
     in Hertz units the normal contact does not depend on nu. So beta_x depends on
     nu and Theta / (m R^2) only through (c_t / c_n)(1 + m R^2 / Theta): two scenes

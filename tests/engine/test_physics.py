@@ -1,4 +1,4 @@
-"""The element kernel against closed forms, limits and conservation laws (PHYSICS.md)."""
+"""The element kernel against closed forms, limits and conservation laws (docs/physics.md)."""
 
 import math
 
@@ -103,7 +103,7 @@ def test_default_numerics_reach_1e4_on_kelvin_voigt(q1):
 
 
 def test_kelvin_voigt_small_damping_slope():
-    """1 - e_z = 1.8917 tau/T to first order (PHYSICS.md section 5)."""
+    """1 - e_z = 1.8917 tau/T to first order (docs/physics.md#kelvin-voigt-continuum)."""
     slope = kelvin_voigt_small_damping_slope()
     assert abs(slope - 1.8917) < 1e-4
     for q1 in (1e-3, 3e-4):
@@ -191,7 +191,7 @@ def test_incremental_memory_is_passive(model):
 
 
 def test_seed_memory_is_not_passive_for_elastic_nu0():
-    """PHYSICS.md section 6: the thesis's total-displacement rule returns energy."""
+    """docs/physics.md#full-stick: the thesis's total-displacement rule returns energy."""
     mat = v.Material.elastic(nu=0.0, E=1e8)
     seed = v.simulate(v.Scene(mat, R=0.05, m=0.05, v_z0=1.0, v_x0=1.0, tangential_memory="seed"))
     incr = v.simulate(v.Scene(mat, R=0.05, m=0.05, v_z0=1.0, v_x0=1.0))
@@ -200,7 +200,7 @@ def test_seed_memory_is_not_passive_for_elastic_nu0():
 
 
 def test_thesis_table_4_1_explicit_euler():
-    """PHYSICS.md section 10: explicit Euler, elastic, 1.1254 % (500 steps), 0.5608 % (1000)."""
+    """docs/physics.md#elastic-impact: explicit Euler, elastic, 1.1254 % (500 steps), 0.5608 % (1000)."""
     scene = v.Scene(v.Material.elastic(nu=0.5, E=5e10), R=0.2, m=10.0, v_z0=10.0)
     for steps, percent in ((500, 1.1254), (1000, 0.5608)):
         res = v.simulate(scene, v.Numerics(integrator="euler", steps=steps, elements=100, continuum=False))

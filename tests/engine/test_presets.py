@@ -3,7 +3,7 @@
 The points are drawn here (log-uniform Q1 in [1e-3, 10], nu in [0, 0.5],
 Q2 log-uniform in [0.1, 10] for the standard solid); the seed only makes CI
 reproducible. References: the Kelvin-Voigt continuum solution to 1e-12
-(PHYSICS.md section 5) for e_z, and the ``precise`` preset for e_x and the
+(docs/physics.md#kelvin-voigt-continuum) for e_z, and the ``precise`` preset for e_x and the
 standard solid (itself checked against the continuum on e_z).
 """
 

@@ -1,13 +1,13 @@
-"""The kernel against the slow physical-units reference and PHYSICS.md properties.
+"""The kernel against the slow physical-units reference and docs/physics.md properties.
 
 Oracles, none of them produced by the kernel:
 - ``tests/naive.py``: the same element model and time stepping written in SI
   units, with ``v_x`` and ``omega`` tracked separately (so the kernel's
   nondimensionalization, its ``v_c = v_x + R omega`` reduction and the
   normalization of the tangential problem by ``v_c0`` are tested);
-- PHYSICS.md section 8 (restitution depends only on ``Q1``, ``Q2``, ``nu``,
+- docs/physics.md#dimensionless-parameters (restitution depends only on ``Q1``, ``Q2``, ``nu``,
   ``Theta / (m R^2)``), with ``eta`` computed here from the section 2 formulas;
-- PHYSICS.md section 7 (the tangential problem is linear in ``v_c0`` and
+- docs/physics.md#energy-and-passivity (the tangential problem is linear in ``v_c0`` and
   sees ``v_x0``, ``omega0`` only through ``v_c0``).
 
 Coarse numerics keep the file fast; the agreement asked for is about rounding,
@@ -28,10 +28,10 @@ STEPS, ELEMENTS = 150, 30
 NUM = Numerics(steps=STEPS, elements=ELEMENTS, continuum=False)  # the element kernel itself
 
 RTOL_NAIVE = 1e-8  # kernel vs naive: same algorithm, different units
-RTOL_COLLAPSE = 1e-9  # PHYSICS.md section 8: equal dimensionless parameters
+RTOL_COLLAPSE = 1e-9  # docs/physics.md#dimensionless-parameters: equal dimensionless parameters
 
-HERTZ_TIME = 2.9432751843  # PHYSICS.md section 2, t_H / T
-Q1_PER_TAU = math.sqrt(15.0 / 32.0)  # PHYSICS.md section 8, Q1 per (eta / G_inf) / T
+HERTZ_TIME = 2.9432751843  # docs/physics.md#hertz-scales, t_H / T
+Q1_PER_TAU = math.sqrt(15.0 / 32.0)  # docs/physics.md#dimensionless-parameters, Q1 per (eta / G_inf) / T
 RHEOLOGIES = ("elastic", "kelvin_voigt", "standard_solid", "prony")
 OUTPUTS = ("e_z", "e_x", "beta_x", "v_z_end", "v_x_end", "omega_end", "t_contact", "u_max",
            "a_max")
@@ -60,7 +60,7 @@ def assert_close(label, a, b, rtol, scale=0.0):
 # ---------------------------------------------------------------- scenes
 
 def hertz_physics(G, nu, R, m, v_z0):
-    """``(d, a_H, T)`` in m, m, s from the PHYSICS.md section 2 formulas."""
+    """``(d, a_H, T)`` in m, m, s from the docs/physics.md#hertz-scales formulas."""
     E_star = 2.0 * G / (1.0 - nu)
     d = (15.0 * m * v_z0**2 / (16.0 * E_star * math.sqrt(R))) ** 0.4
     return d, math.sqrt(R * d), d / v_z0
@@ -121,7 +121,7 @@ def compare_with_naive(scene, res, ref, tag):
 
 def test_naive_uses_physics_hertz_scales():
     """The naive reference takes t_H and a_H from vimpact.model.hertz: check them
-    against PHYSICS.md section 2 so that the reference stays independent."""
+    against docs/physics.md#hertz-scales so that the reference stays independent."""
     rng = np.random.default_rng(7)
     for _ in range(20):
         G, nu = log_uniform(rng, 1e4, 1e11), float(rng.uniform(0.0, 0.5))
@@ -158,7 +158,7 @@ def test_batch_with_mixed_arm_counts_matches_naive():
 def collapse_scenes(rng, n, Q1, nu, Q2=None, theta_ratio=0.4):
     """``n`` physical scenes spanning decades with the given ``Q1`` (and ``Q2``).
 
-    ``eta`` is computed from the PHYSICS.md formulas here, not by vimpact.
+    ``eta`` is computed from the docs/physics.md formulas here, not by vimpact.
     Draws whose Hertz radius exceeds 0.1 R are rejected (``a_max <= a_H``
     for these passive materials, so the half-space limit 0.2 R is safe).
     """

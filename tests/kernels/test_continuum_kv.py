@@ -2,7 +2,7 @@
 
 Oracles: the scipy DOP853 solution of the same ODE (analytic.kelvin_voigt_continuum),
 the Hertz contact time by quadrature, the first-order damping slope, the
-kernel's own convergence in rtol, and the PHYSICS.md section 5 formulas for
+kernel's own convergence in rtol, and the docs/physics.md#kelvin-voigt-continuum formulas for
 force and contact half-width along a recorded trajectory.
 """
 
@@ -60,7 +60,7 @@ def test_elastic_is_hertz():
 
 
 def test_small_damping_slope():
-    """(1 - e_z) / tau0 -> 1.5 B(3/5, 3/2) = 1.8917 (PHYSICS.md 5), linearly in tau0."""
+    """(1 - e_z) / tau0 -> 1.5 B(3/5, 3/2) = 1.8917 (docs/physics.md#kelvin-voigt-continuum), linearly in tau0."""
     slope = kelvin_voigt_small_damping_slope()
     assert abs(slope - 1.8917) < 1e-4
     s = {tau: (1.0 + run(tau, 1e-13)[OUT_VZ_END]) / tau for tau in (1e-4, 2e-4)}
@@ -187,7 +187,7 @@ def test_trajectory_record(q1, rec_every):
     assert np.all(np.diff(r[:, REC_T]) > 0.0)
     assert np.max(r[:, REC_U]) <= out[OUT_U_MAX]
     assert np.max(r[:, REC_B]) <= out[OUT_B_MAX]
-    # PHYSICS.md 5: b = sqrt(min(u, u + tau v)), F by branch
+    # docs/physics.md#kelvin-voigt-continuum: b = sqrt(min(u, u + tau v)), F by branch
     u, v, b, F = r[:, REC_U], r[:, REC_V], r[:, REC_B], r[:, REC_FZ]
     w = np.minimum(u, u + tau0 * v)
     assert np.allclose(b * b, w, rtol=1e-12, atol=1e-14)

@@ -1,7 +1,7 @@
 """The continuum full-stick kernel for every rheology, vimpact.kernels.continuum_maxwell.
 
 Oracles (nothing here was produced by the kernel): the Kelvin-Voigt closed
-form of PHYSICS.md section 5 (scipy), the Hertz contact time, an independent
+form of docs/physics.md#kelvin-voigt-continuum (scipy), the Hertz contact time, an independent
 scipy implementation of section 11 (tests/oracles/maxwell_continuum_scipy.py:
 time as the unloading variable, the edge by brentq), the element rows refined
 and extrapolated, the mirror identity of the tangential problem, the standard

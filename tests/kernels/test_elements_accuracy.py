@@ -3,10 +3,10 @@
 Oracles, none produced by the kernel run under test:
 - convergence trends: the error against a much finer run falls with the
   observed order asked for under joint refinement of steps and elements;
-- the Kelvin-Voigt continuum closed form (PHYSICS.md section 5) for e_z;
+- the Kelvin-Voigt continuum closed form (docs/physics.md#kelvin-voigt-continuum) for e_z;
 - the e_x jitter: a converged method gives nearly the same e_x for step
   counts a few per cent apart (the spread measures the error that is not
-  smooth in ``h``; PHYSICS.md section 7 makes e_x independent of ``v_c0``).
+  smooth in ``h``; docs/physics.md#energy-and-passivity makes e_x independent of ``v_c0``).
 """
 
 from __future__ import annotations
@@ -19,8 +19,8 @@ import pytest
 from vimpact.kernels.elements import (N_OUT, N_REC, OUT_STATUS, OUT_VC_END, OUT_VZ_END,
                                       STATUS_OK, VERLET, KernelSpec, element_kernel)
 
-HERTZ_TIME = 2.9432751843  # t_H / T, PHYSICS.md section 2
-Q1_PER_TAU = math.sqrt(15.0 / 32.0)  # PHYSICS.md section 8
+HERTZ_TIME = 2.9432751843  # t_H / T, docs/physics.md#hertz-scales
+Q1_PER_TAU = math.sqrt(15.0 / 32.0)  # docs/physics.md#dimensionless-parameters
 
 
 def run_rows(spec: KernelSpec, *, h, dxi, tau0=0.0, g=(), tau=(), nu=0.3, theta_ratio=0.4,
@@ -79,7 +79,7 @@ def test_ex_jitter_is_gone():
 
 
 def test_kelvin_voigt_ez_against_the_continuum():
-    """e_z on elements converges to the closed-form continuum (PHYSICS.md 5)
+    """e_z on elements converges to the closed-form continuum (docs/physics.md#kelvin-voigt-continuum)
     at second order under joint refinement."""
     from vimpact.reference.closed_forms import kelvin_voigt_continuum
 

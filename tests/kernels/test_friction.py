@@ -1,4 +1,4 @@
-"""Coulomb friction in the element kernel (PHYSICS.md section 12).
+"""Coulomb friction in the element kernel (docs/physics.md#coulomb-friction).
 
 Oracles, none produced by the kernel:
 - gross slip throughout (large psi): ``F_x = mu F_z`` at every instant, so
@@ -8,7 +8,7 @@ Oracles, none produced by the kernel:
   (``v_c`` unchanged);
 - passivity: friction never adds tangential kinetic energy;
 - the NumPy reference in SI units (friction written independently there);
-- the flat punch (PHYSICS.md section 9) as a 1-DOF stick-slip oscillator
+- the flat punch (docs/physics.md#linear-model) as a 1-DOF stick-slip oscillator
   solved here with scipy (the kernel takes no profile: the reference does);
 - convergence with friction (observed order).
 """
@@ -263,7 +263,7 @@ def flat_punch_oscillator(m, Theta, R, k_n, k_t, mu, v_z0, v_c0):
 @pytest.mark.slow
 @pytest.mark.parametrize("mu", [0.1, 0.3, 3.0])
 def test_flat_punch_is_a_stick_slip_oscillator(mu):
-    """PHYSICS.md sections 9 and 12 in the SI reference: a flat punch (every
+    """docs/physics.md#linear-model, docs/physics.md#coulomb-friction in the SI reference: a flat punch (every
     element enters at once and leaves together) with friction against the
     independent 1-DOF stick-slip oscillator."""
     from vimpact import Material, Scene

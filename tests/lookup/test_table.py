@@ -191,7 +191,7 @@ def test_interpolation_of_monotone_data_is_monotone(kv):
 def test_lookup_broadcasts(kv):
     res = kv.lookup(np.array([[0.02], [0.2]]), np.array([0.0, 0.25, 0.5]))
     assert res["e_z"].shape == res["e_x"].shape == res["nu"].shape == (2, 3)
-    # e_z does not depend on nu (PHYSICS.md section 8), so neither does its
+    # e_z does not depend on nu (docs/physics.md#dimensionless-parameters), so neither does its
     # interpolation, up to the time step (refined for the tangential mode, which
     # depends on nu): about 1e-4 at the coarse test numerics
     np.testing.assert_allclose(res["e_z"], res["e_z"][:, :1] * np.ones((1, 3)), atol=1e-3)

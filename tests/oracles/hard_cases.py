@@ -5,7 +5,7 @@ Every scene is built on the dimensionless base of
 ``Scene.from_dimensionless`` (``R = 1 m``, ``m = 1 kg``, ``v_z0 = 1 m/s``,
 ``a_H = 0.01 R``), so moduli are given relative to the relaxed modulus
 ``G_inf`` and relaxation times relative to the Hertz time unit ``T = d / v_z0``
-(PHYSICS.md section 2); ``h = t_H / steps = 2.94e-3 T`` at the default
+(docs/physics.md#hertz-scales); ``h = t_H / steps = 2.94e-3 T`` at the default
 numerics. Only the public API is used.
 """
 
@@ -49,7 +49,7 @@ def hertz_unit(nu: float = 0.5) -> tuple[float, float]:
 
 
 def tau_of_q1(q1: float) -> float:
-    """``eta / G_inf`` in units of T for damping ``Q1`` (PHYSICS.md section 8)."""
+    """``eta / G_inf`` in units of T for damping ``Q1`` (docs/physics.md#dimensionless-parameters)."""
     return q1 / math.sqrt(15.0 / 32.0)
 
 

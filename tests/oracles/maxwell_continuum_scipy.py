@@ -1,4 +1,4 @@
-"""Slow, plain reference of the full-stick continuum impact (PHYSICS.md section 11).
+"""Slow, plain reference of the full-stick continuum impact (docs/physics.md#continuum-limit).
 
 Independent of :mod:`vimpact.kernels.continuum_maxwell` (no shared code, a
 different unloading formulation): written with ``scipy.integrate.solve_ivp``

@@ -1,4 +1,4 @@
-"""The friction figures' data against the gross-slip closed form (PHYSICS: Coulomb friction).
+"""The friction figures' data against the gross-slip closed form (docs/physics.md#coulomb-friction).
 
 In gross slip the tangential impulse is mu times the normal one, so for a
 solid sphere ``omega_end - omega0 = -mu (1 + e_z) v_z0 / (0.4 R)`` and

@@ -1,8 +1,8 @@
 """Tests of vimpact.reference.closed_forms against independent oracles.
 
-Oracles: the PHYSICS.md section 9 closed forms (atan2 / log forms, velocity
+Oracles: the docs/physics.md#linear-model closed forms (atan2 / log forms, velocity
 from the explicit solution), direct numerical integration of the ODEs written
-here, quadrature, and the numbers PHYSICS.md quotes.
+here, quadrature, and the numbers docs/physics.md quotes.
 """
 
 from __future__ import annotations
@@ -26,15 +26,15 @@ from vimpact.reference.closed_forms import (
 )
 from vimpact.model.hertz import HERTZ_TIME_FACTOR, Q1_PER_TAU
 
-PHYSICS_HERTZ_TIME = 2.9432751843   # PHYSICS.md section 2
-PHYSICS_KV_SLOPE = 1.8917            # PHYSICS.md section 5, per tau/T
-PHYSICS_KV_SLOPE_Q1 = 2.7630         # PHYSICS.md section 5, per Q1
+PHYSICS_HERTZ_TIME = 2.9432751843   # docs/physics.md#hertz-scales
+PHYSICS_KV_SLOPE = 1.8917            # docs/physics.md#kelvin-voigt-continuum, per tau/T
+PHYSICS_KV_SLOPE_Q1 = 2.7630         # docs/physics.md#kelvin-voigt-continuum, per Q1
 
 
 # ---------------------------------------------------------------- oracles
 
 def physics_closed_form(zeta: float) -> tuple[float, float]:
-    """PHYSICS.md section 9 formulas with omega0 = 1, as written there."""
+    """docs/physics.md#linear-model formulas with omega0 = 1, as written there."""
     d = zeta
     if zeta < 1.0:
         wd = math.sqrt(1.0 - zeta**2)

@@ -9,7 +9,7 @@ and ``accuracy.png``); the full-size run of the repository is
 - Scenes: oblique impacts (``v_c0 != 0``, so ``e_x`` is computed), Kelvin-Voigt
   at ``nu = 0`` and ``0.5`` and the standard solid at ``Q2 = 0.1`` and ``10``
   (``nu = 0.5``), ``Q1`` log-spaced over ``[1e-3, 10]``.
-- Reference: ``e_z`` of Kelvin-Voigt from the continuum solution (PHYSICS.md
+- Reference: ``e_z`` of Kelvin-Voigt from the continuum solution (docs/physics.md
   section 5, solved to 1e-12); ``e_x`` of every scene and ``e_z`` of the
   standard solid from a fine Verlet run at ``(2S, 2E)``, whose own
   uncertainty is its distance to the run at ``(S, E)``, per scene.

@@ -22,7 +22,7 @@ The tangential problem (full stick) is included, so that the baseline does
 the same work per element as the kernel on the oblique benchmark scenes; it
 is skipped for ``v_c0 = 0``, as in the kernel. Only the contact-point
 velocity ``v_c = v_x + R omega`` is tracked (``dv_c/dt = -F_x (1/m +
-R^2/Theta)``, PHYSICS.md section 7), which is what ``e_x`` needs;
+R^2/Theta)``, docs/physics.md#energy-and-passivity), which is what ``e_x`` needs;
 ``naive_impact`` splits it into ``v_x`` and ``omega``, which is the same to
 rounding.
 
@@ -44,7 +44,7 @@ def _arm_coefficients(tau: float, dt: float) -> tuple[float, float, float]:
     """``(E, 1 - E, phi)`` of the exact arm update over ``dt`` (s) for arm time ``tau`` (s).
 
     ``q(dt) = E q0 + (1 - E) w0 + phi (w1 - w0)`` for ``w`` linear from ``w0``
-    to ``w1`` (PHYSICS.md section 4); ``tau = inf`` gives ``(1, 0, 0)``.
+    to ``w1`` (docs/physics.md#rheologies); ``tau = inf`` gives ``(1, 0, 0)``.
     """
     x = dt / tau
     one_minus_E = -math.expm1(-x)

@@ -131,7 +131,7 @@ def viscoelastic_hertz_curve(alpha) -> np.ndarray:
     return np.where(tiny, 1.0 - SMALL_DAMPING_SLOPE * alpha, e)
 
 
-#: ``1 - e = 1.5 B(3/5, 3/2) alpha`` to first order in the damping (PHYSICS.md section 5)
+#: ``1 - e = 1.5 B(3/5, 3/2) alpha`` to first order in the damping (docs/physics.md#kelvin-voigt-continuum)
 SMALL_DAMPING_SLOPE = 1.5 * math.gamma(0.6) * math.gamma(1.5) / math.gamma(2.1)
 
 
@@ -205,7 +205,7 @@ def linear_spring_dashpot(zeta: float, ends: str = "overlap", tangential=None
     ----------
     zeta : normal damping ratio ``c / (2 sqrt(k m))``, >= 0; time unit ``1/omega0``
     ends : ``"overlap"`` (contact ends when the overlap returns to zero: Yade,
-        MFiX) or ``"force"`` (when the force does; PHYSICS.md section 9)
+        MFiX) or ``"force"`` (when the force does; docs/physics.md#linear-model)
     tangential : ``(w_t, zeta_t)`` of a tangential spring-dashpot acting on the
         contact-point velocity in stick: angular frequency ``w_t / omega0`` and
         damping ratio ``zeta_t`` of the tangential oscillator (with the

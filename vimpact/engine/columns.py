@@ -120,7 +120,7 @@ class SceneColumns:
     def __len__(self) -> int:
         return self.nu.shape[0]
 
-    # ---- derived, vectorized (PHYSICS.md sections 3, 7, 8) ------------------
+    # ---- derived, vectorized (docs/physics.md#method-of-dimensionality-reduction, docs/physics.md#energy-and-passivity, docs/physics.md#dimensionless-parameters) ------------------
     @property
     def valid(self) -> np.ndarray:
         return np.equal(self.reasons, None)

@@ -5,7 +5,7 @@ A scene names its effects (tangential problem or not, rotation, rheology);
 
 - ``continuum``: the Kelvin-Voigt (or elastic) normal-only impact as a
   one-degree-of-freedom ODE with the closed-form continuum force
-  (PHYSICS.md section 5), adaptive Dormand-Prince 5(4) with event location;
+  (docs/physics.md#kelvin-voigt-continuum), adaptive Dormand-Prince 5(4) with event location;
 - ``elements``: the MDR element kernel, compiled for exactly the scene's
   effects (:class:`vimpact.kernels.elements.KernelSpec`): no tangential state
   without a tangential problem, no arm variables without Maxwell arms, no
@@ -84,7 +84,7 @@ _INTEGRATOR_NAMES = {code: name for name, code in INTEGRATORS.items()}
 
 #: path of the Kelvin-Voigt/elastic normal-only continuum kernel
 CONTINUUM_KV = Path(CONTINUUM, None, ())
-#: path of the full-stick continuum kernel (every rheology, PHYSICS section 11)
+#: path of the full-stick continuum kernel (every rheology, docs/physics.md#continuum-limit)
 CONTINUUM_FULL_STICK = Path(CONTINUUM_STICK, None, ())
 
 
@@ -188,7 +188,7 @@ def choose_path(scene: Scene, numerics: Numerics) -> Path:
         return Path(CONTINUUM, None, tuple(reasons))
     if path.kind == CONTINUUM_STICK:
         reasons.append("full stick with incremental memory: the exact continuum limit of the "
-                       "element row (docs/physics.md, continuum limit for every rheology), "
+                       "element row (docs/physics.md#continuum-limit), "
                        "adaptive Dormand-Prince 5(4) with event location, "
                        f"rtol = {numerics.rtol:g}; should the contact split or an element "
                        "re-enter, the element kernel takes over")

@@ -1,4 +1,4 @@
-"""Maxwell-arm helpers of the element kernels (PHYSICS.md section 4, exact update).
+"""Maxwell-arm helpers of the element kernels (docs/physics.md#rheologies, exact update).
 
 Every arm is advanced with the exact exponential update for a linear
 displacement path over the step; nothing divides by a viscosity or a
@@ -20,7 +20,7 @@ def _arm_coefficient(tau, h):
 
     For ``tau dq/dt = w - q`` with ``w`` linear from ``w0`` to ``w1``:
     ``q1 = E q0 + (1 - E) w0 + phi (w1 - w0)`` with ``E = exp(-h/tau)`` and
-    ``phi = 1 - (tau/h)(1 - E)`` (PHYSICS.md section 4). Valid for ``tau = 0``
+    ``phi = 1 - (tau/h)(1 - E)`` (docs/physics.md#rheologies). Valid for ``tau = 0``
     (the arm follows ``w``) and ``tau = inf`` (the arm is frozen).
     """
     x = h / tau if tau > 0.0 else np.inf
@@ -72,7 +72,7 @@ def _follow(w0, w1, qrow, g, E, omE, phi):
 def _relax(w0, qrow, g, E, omE, phi, tau0_h, den_free, decay0):
     """Free surface relaxation under zero force over one step; returns the new ``w``.
 
-    Solves ``tau0 dw/dt + G_inf w + sum g_i (w - q_i) = 0`` (PHYSICS.md
+    Solves ``tau0 dw/dt + G_inf w + sum g_i (w - q_i) = 0`` (docs/physics.md
     section 5) for an element with arms, implicit in the end value (L-stable),
     the arms on the exact linear-path update. (Without arms the kernel uses
     the exact ``w decay0`` instead, 0 for an elastic element.)
@@ -109,7 +109,7 @@ def _free_rate(w, qrow, g, tau, tau0):
 @jit(inline="always")
 def _to_stress(target, s0, p0, prow, g, E, omE, phi, tau0_dt):
     """The end value ``s1`` of a path ``s0 -> s1`` (linear over a time ``dt``)
-    whose element stress is ``target``: Coulomb slip (PHYSICS.md section 12).
+    whose element stress is ``target``: Coulomb slip (docs/physics.md#coulomb-friction).
 
     Solves ``s1 + sum g_i (s1 - p_i(s1)) + tau0 (s1 - s0) / dt = target`` with
     the arms on the exact linear-path update from ``p0`` (``E``, ``omE``,

@@ -1,6 +1,6 @@
 """Continuum (1-DOF) kernel of the normal Kelvin-Voigt impact.
 
-PHYSICS.md section 5: for a Kelvin-Voigt half-space with normal motion only,
+docs/physics.md#kelvin-voigt-continuum: for a Kelvin-Voigt half-space with normal motion only,
 the element row has a closed-form force, and the impact is the ODE (kernel
 units of :mod:`vimpact.kernels.elements`: ``u`` / d, ``t`` / T, ``v`` / v_z0, unit
 mass, ``tau0 = eta / (G T)``)

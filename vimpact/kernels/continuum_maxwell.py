@@ -1,6 +1,6 @@
 """Continuum (``dx -> 0``) kernel of the full-stick impact for every rheology.
 
-PHYSICS.md section 11: with incremental tangential memory (Maw, Barber and
+docs/physics.md#continuum-limit: with incremental tangential memory (Maw, Barber and
 Fawcett) and full stick, the element row's continuum limit is a small ODE
 system for any generalized Maxwell half-space with an optional parallel
 dashpot (elastic, Kelvin-Voigt, standard solid, Prony series), any ``nu``

@@ -2,18 +2,18 @@
 
 Unit-free numba kernels; nothing here imports the user-facing layer.
 
-Kernel units (PHYSICS.md sections 2, 3, 7): indentation ``u`` and normal
+Kernel units (docs/physics.md#hertz-scales, docs/physics.md#method-of-dimensionality-reduction, docs/physics.md#energy-and-passivity): indentation ``u`` and normal
 surface displacements ``w`` in units of the Hertz indentation ``d``; element
 positions ``xi`` in units of the Hertz radius ``a_H`` (so the MDR profile is
 ``g = xi^2``); time in units of ``T = d / v_z0``; normal velocity in units of
-``v_z0``. The tangential problem is linear in ``v_c0`` (PHYSICS.md section 7),
+``v_z0``. The tangential problem is linear in ``v_c0`` (docs/physics.md#energy-and-passivity),
 so tangential displacements and velocities are in units of ``v_c0 T`` and
 ``v_c0``: the contact point starts with ``v_c = 1``. Forces are in units of
 ``m v_z0 / T`` (normal) and ``m v_c0 / T`` (tangential); the element
 stiffness per unit length is then ``15/16`` (normal) and ``kappa * 15/16``
 (tangential) with ``kappa = c_t / c_n = 2 (1 - nu) / (2 - nu)``.
 
-Material (PHYSICS.md section 4), relative to the relaxed modulus ``G_inf``:
+Material (docs/physics.md#rheologies), relative to the relaxed modulus ``G_inf``:
 ``tau0 = eta0 / (G_inf T)`` (parallel dashpot), arms ``g_i = G_i / G_inf``
 with times ``tau_i / T``. Every arm is advanced with the exact exponential
 update for a linear displacement path over the step; nothing divides by a
@@ -81,7 +81,7 @@ def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT, FRICTION,
     ARMS : the material has Maxwell arms (``g``, ``tau`` non-empty)
     DASHPOT : the material has a parallel dashpot (``tau0 > 0``)
     FRICTION : Coulomb friction: every element in contact keeps
-        ``|f_t| <= mu f_n`` (PHYSICS.md section 12); needs ``TANGENTIAL`` and
+        ``|f_t| <= mu f_n`` (docs/physics.md#coulomb-friction); needs ``TANGENTIAL`` and
         incremental memory
     tau0 : parallel dashpot time ``eta0 / (G_inf T)``
     g, tau : arm moduli ``G_i / G_inf`` and times ``tau_i / T`` (1-D, equal length)

@@ -30,7 +30,7 @@ multilinear interpolant. The error between the nodes, measured against direct
 simulation (:func:`vimpact.lookup.verify.interpolation_error`), is stored as
 the metadata entry ``vimpact.interpolation_error`` and returned with every
 lookup (``error_bound``). Since ``e_z``, ``e_x`` depend only on these parameters
-(PHYSICS.md section 8), :meth:`RestitutionTable.restitution_curve` turns a
+(docs/physics.md#dimensionless-parameters), :meth:`RestitutionTable.restitution_curve` turns a
 table into ``e_z(v_z0)``, ``e_x(v_z0)`` for one material and sphere, the form
 a DEM code needs.
 """

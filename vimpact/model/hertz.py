@@ -1,6 +1,6 @@
 """Hertz scales of the elastic impact of a rigid sphere on a half-space.
 
-PHYSICS.md section 2. All lengths in m, times in s, moduli in Pa, masses in kg.
+docs/physics.md#hertz-scales. All lengths in m, times in s, moduli in Pa, masses in kg.
 The kernels work in the units defined here: indentation in units of ``d``,
 element positions in units of ``a_H``, time in units of ``T = d / v_z0``,
 velocities in units of ``v_z0``.
@@ -14,10 +14,10 @@ from typing import NamedTuple
 import numpy as np
 
 #: ``t_H / T = 2 * int_0^1 dxi / sqrt(1 - xi^(5/2)) = (4/5) B(2/5, 1/2)``
-#: (substitute ``s = xi^(5/2)``); PHYSICS.md quotes 2.9432751843.
+#: (substitute ``s = xi^(5/2)``); docs/physics.md quotes 2.9432751843.
 HERTZ_TIME_FACTOR: float = 0.8 * math.gamma(0.4) * math.gamma(0.5) / math.gamma(0.9)
 
-#: ``Q1 = sqrt(15/32) * (eta / G_inf) / T`` (PHYSICS.md section 8).
+#: ``Q1 = sqrt(15/32) * (eta / G_inf) / T`` (docs/physics.md#dimensionless-parameters).
 Q1_PER_TAU: float = math.sqrt(15.0 / 32.0)
 
 #: Element stiffness per unit length in kernel units: ``E* a_H d^2 / (m v_z0^2) = 15/16``.
@@ -30,7 +30,7 @@ def effective_modulus(G, nu):
 
 
 class HertzScales(NamedTuple):
-    """Hertz reference values of an elastic impact (PHYSICS.md section 2).
+    """Hertz reference values of an elastic impact (docs/physics.md#hertz-scales).
 
     Attributes
     ----------

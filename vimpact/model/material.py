@@ -1,4 +1,4 @@
-"""Viscoelastic half-space materials (PHYSICS.md section 4).
+"""Viscoelastic half-space materials (docs/physics.md#rheologies).
 
 Every material is a generalized Maxwell solid with an optional parallel
 dashpot, ``G(t) = G_inf + sum_i G_i exp(-t/tau_i) (+ eta0 delta(t))``, and a
@@ -101,7 +101,7 @@ class Material:
     @property
     def kappa(self) -> float:
         """Tangential over normal element stiffness ``c_t / c_n = 2 (1 - nu) / (2 - nu)``
-        (PHYSICS.md section 3), dimensionless."""
+        (docs/physics.md#method-of-dimensionality-reduction), dimensionless."""
         return 2.0 * (1.0 - self.nu) / (2.0 - self.nu)
 
     @property

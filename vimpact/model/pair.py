@@ -1,7 +1,7 @@
 """Two spheres, and a sphere on a wall, mapped onto the rigid-sphere problem.
 
 An impact of two bodies is the impact of one rigid sphere on one half-space
-(:class:`vimpact.Scene`) when (PHYSICS.md section 13 in the project's words):
+(:class:`vimpact.Scene`) when (docs/physics.md#pairs-and-walls in the project's words):
 
 - the normal problem has the effective radius ``R = R1 R2 / (R1 + R2)`` and
   mass ``m = m1 m2 / (m1 + m2)`` and the two half-space compliances add;

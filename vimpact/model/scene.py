@@ -1,4 +1,4 @@
-"""One impact: sphere, material, initial velocities and options (PHYSICS.md section 1)."""
+"""One impact: sphere, material, initial velocities and options (docs/physics.md#the-problem)."""
 
 from __future__ import annotations
 
@@ -14,7 +14,7 @@ from vimpact.model.validation import InputError, finite, flag, friction_coeffici
 TANGENTIAL_MEMORY = ("incremental", "seed")
 
 #: What a scene asks of the tangential problem: ``auto`` (stick whenever
-#: ``v_c0 != 0``), ``stick`` (full stick, PHYSICS.md section 6) or ``none``
+#: ``v_c0 != 0``), ``stick`` (full stick, docs/physics.md#full-stick) or ``none``
 #: (normal impact only: no tangential state at all, e_x and beta_x NaN).
 #: Slip is not modelled yet.
 TANGENTIAL_EFFECTS = ("auto", "stick", "none")
@@ -49,7 +49,7 @@ class Scene:
         ``Theta -> inf``: the tangential force changes ``v_x`` only and
         ``omega`` keeps ``omega0`` (``Theta`` is then not used)
     mu : Coulomb friction coefficient, dimensionless, >= 0 (default ``inf``:
-        full stick, PHYSICS section 6; finite: every element obeys
+        full stick, docs/physics.md#full-stick; finite: every element obeys
         ``|f_t| <= mu f_n``, section 12)
     """
 
@@ -109,7 +109,7 @@ class Scene:
 
         Kelvin-Voigt for ``Q2 = None``, standard solid otherwise. Restitution
         depends only on ``Q1`` (``Q2``), ``nu`` and ``theta_ratio = Theta /
-        (m R^2)`` (PHYSICS.md section 8), so any scene with these values gives
+        (m R^2)`` (docs/physics.md#dimensionless-parameters), so any scene with these values gives
         the same ``e_z``, ``e_x``; this one has ``R = 1 m``, ``m = 1 kg``,
         ``v_z0 = v_x0 = 1 m/s``, ``omega0 = 0`` and a modulus chosen so that
         ``a_H = 0.01 R``.
@@ -146,14 +146,14 @@ class Scene:
     @property
     def computes_tangential(self) -> bool:
         """The tangential problem is solved: asked for (``tangential`` is not
-        ``"none"``) and not trivially zero (``v_c0 != 0``, PHYSICS.md section 7)."""
+        ``"none"``) and not trivially zero (``v_c0 != 0``, docs/physics.md#energy-and-passivity)."""
         return self.tangential != "none" and self.v_c0 != 0.0
 
     @property
     def contact_mass_factor(self) -> float:
         """``1 + m R^2 / Theta`` (``1`` without rotation): the contact point
         accelerates this much faster than the centre under a tangential force
-        (PHYSICS.md section 7), dimensionless."""
+        (docs/physics.md#energy-and-passivity), dimensionless."""
         return 1.0 + 1.0 / self.theta_ratio if self.rotation else 1.0
 
     def tangential_end_state(self, vc_ratio):

@@ -212,7 +212,7 @@ def fig3_2(out, zeta=None) -> Path:
 
 
 def thesis_scene() -> Scene:
-    """The example of thesis fig. 4.2 (PHYSICS.md section 10): Kelvin-Voigt
+    """The example of thesis fig. 4.2 (docs/physics.md#elastic-impact): Kelvin-Voigt
     ``E = 5e10 Pa``, ``nu = 0.5``, ``eta = 1e5 Pa s``, ``R = 0.2 m``, ``m = 10 kg``,
     ``v_z0 = 10 m/s``, with ``v_x0 = 5 m/s`` and backspin ``omega0 = -10 rad/s``."""
     material = Material.kelvin_voigt(nu=0.5, E=5e10, eta=1e5)

@@ -1,11 +1,11 @@
 """Closed forms and high-accuracy reference solutions (oracles for the kernels).
 
 - :func:`linear_model`: the simplified linear spring-dashpot model
-  (PHYSICS.md section 9), all damping regimes in real arithmetic.
+  (docs/physics.md#linear-model), all damping regimes in real arithmetic.
 - :func:`hertz_time_factor_quadrature`: the Hertz contact time ``t_H / T`` by
   quadrature, an independent check of :data:`vimpact.model.hertz.HERTZ_TIME_FACTOR`.
 - :func:`kelvin_voigt_continuum`: the normal Kelvin-Voigt impact in the
-  continuum limit (PHYSICS.md section 5), a one-degree-of-freedom ODE solved
+  continuum limit (docs/physics.md#kelvin-voigt-continuum), a one-degree-of-freedom ODE solved
   to about 1e-12.
 """
 
@@ -57,7 +57,7 @@ def _scalar_or_array(x: np.ndarray) -> float | np.ndarray:
 
 
 # --------------------------------------------------------------------------
-# 1. the simplified linear model (PHYSICS.md section 9)
+# 1. the simplified linear model (docs/physics.md#linear-model)
 # --------------------------------------------------------------------------
 
 class LinearModelResult(NamedTuple):
@@ -124,9 +124,9 @@ def linear_model(omega0, delta) -> LinearModelResult:
     A mass on a spring and dashpot in parallel (``omega0^2 = k/m``,
     ``2 delta = c/m``), ``m u'' + c u' + k u = 0``, ``u(0) = 0``,
     ``u'(0) = v0``; contact ends at the first ``t* > 0`` where the force
-    ``k u + c u'`` returns to zero (PHYSICS.md section 9).
+    ``k u + c u'`` returns to zero (docs/physics.md#linear-model).
 
-    With ``zeta = delta / omega0`` the PHYSICS.md closed forms reduce to
+    With ``zeta = delta / omega0`` the docs/physics.md closed forms reduce to
 
     - ``zeta < 1``: ``omega0 t* = 2 arccos(zeta) / sqrt(1 - zeta^2)``
       (i.e. ``omega_d t* = atan2(2 delta omega_d, 2 delta^2 - omega0^2)``)
@@ -188,7 +188,7 @@ def linear_model_zeta(zeta) -> LinearModelResult:
 
 
 def linear_tangential_frequency(k_x, m, R, Theta):
-    """Angular frequency of the tangential linear model (PHYSICS.md section 9).
+    """Angular frequency of the tangential linear model (docs/physics.md#linear-model).
 
     ``omega_x = sqrt((1 + m R^2 / Theta) k_x / m)``: a tangential spring acting
     at the contact point of a sphere that can both slide and roll.
@@ -230,7 +230,7 @@ def hertz_time_factor_quadrature() -> float:
     ``2 s / sqrt(1 - (1 - s^2)^(5/2))`` (limit ``2 / sqrt(5/2)`` at ``s = 0``),
     whose denominator is evaluated as ``-expm1(2.5 log1p(-s^2))`` to avoid
     cancellation. Independent of the Beta-function closed form in
-    :data:`vimpact.model.hertz.HERTZ_TIME_FACTOR`; PHYSICS.md quotes 2.9432751843.
+    :data:`vimpact.model.hertz.HERTZ_TIME_FACTOR`; docs/physics.md quotes 2.9432751843.
 
     Returns
     -------
@@ -248,7 +248,7 @@ def hertz_time_factor_quadrature() -> float:
 
 
 # --------------------------------------------------------------------------
-# 3. Kelvin-Voigt continuum normal impact (PHYSICS.md section 5)
+# 3. Kelvin-Voigt continuum normal impact (docs/physics.md#kelvin-voigt-continuum)
 # --------------------------------------------------------------------------
 
 class KelvinVoigtResult(NamedTuple):
@@ -269,7 +269,7 @@ class KelvinVoigtResult(NamedTuple):
 def kelvin_voigt_small_damping_slope() -> float:
     """First-order slope ``(1 - e_z) / (tau/T) = 1.5 B(3/5, 3/2) = 1.8917...``, -.
 
-    PHYSICS.md section 5; in terms of ``Q1``: ``1 - e_z = slope / Q1_PER_TAU * Q1``.
+    docs/physics.md#kelvin-voigt-continuum; in terms of ``Q1``: ``1 - e_z = slope / Q1_PER_TAU * Q1``.
     """
     return 1.5 * float(beta(0.6, 1.5))
 
@@ -331,7 +331,7 @@ def _kv_single(tau_hat: float, rtol: float) -> tuple[float, float, float]:
 def kelvin_voigt_continuum(q1, rtol: float = 1e-12) -> KelvinVoigtResult:
     """Normal impact of a rigid sphere on a Kelvin-Voigt half-space, continuum limit.
 
-    Kernel units (PHYSICS.md sections 2, 5, 8): indentation ``u`` in units of
+    Kernel units (docs/physics.md#hertz-scales, docs/physics.md#kelvin-voigt-continuum, docs/physics.md#dimensionless-parameters): indentation ``u`` in units of
     ``d``, velocity in ``v_z0``, time in ``T = d / v_z0``, force in
     ``m v_z0^2 / d``; ``tau_hat = tau / T = q1 / Q1_PER_TAU``. The ODE
 

@@ -1,7 +1,7 @@
 """Slow, independent reference of the MDR impact in physical (SI) units.
 
 This is the documentation-grade restatement of the element model of
-PHYSICS.md sections 3-7, written directly in metres, seconds, kilograms and
+docs/physics.md#method-of-dimensionality-reduction-7, written directly in metres, seconds, kilograms and
 pascals. It shares no code with :mod:`vimpact.kernels.elements` and does not
 nondimensionalize anything: it only takes the discretization (``t_H`` and
 ``a_H`` for the step and the element spacing) from
@@ -24,7 +24,7 @@ linear in time over it: from its last force to zero at the leave fraction
 ``theta``); the normal force only with a dashpot (without one it is
 continuous at entry and exit).
 
-Coulomb friction (PHYSICS.md section 12), written here independently of the
+Coulomb friction (docs/physics.md#coulomb-friction), written here independently of the
 kernel: every element in contact first takes the stick trial; if its
 tangential force exceeds ``mu`` times its normal force it slips, its
 displacement (and arms) solved so that the force sits on the cone (the
@@ -49,14 +49,14 @@ from vimpact import Numerics
 from vimpact.model.hertz import hertz_scales
 from vimpact.engine.routing import choose_path, refinement
 
-#: PHYSICS.md section 1: the half-space model holds up to a = 0.2 R.
+#: docs/physics.md#the-problem: the half-space model holds up to a = 0.2 R.
 HALF_SPACE_LIMIT = 0.2
 
 
 # --------------------------------------------------------------- rheology
 
 def arm_update_coefficients(tau, dt):
-    """Coefficients of the exact arm update over a time ``dt`` (PHYSICS.md section 4).
+    """Coefficients of the exact arm update over a time ``dt`` (docs/physics.md#rheologies).
 
     For ``tau dq/dt = w - q`` with ``w`` linear in time from ``w0`` to ``w1``::
 
@@ -84,7 +84,7 @@ def advance_arms(q, w0, w1, coefficients):
 
 
 class Rheology:
-    """The general element of PHYSICS.md section 4, per unit length and per
+    """The general element of docs/physics.md#rheologies, per unit length and per
     unit of the geometric factor ``c`` (``c_n`` or ``c_t``)::
 
         stress(w, q, dw/dt) = G_inf w + eta0 dw/dt + sum_i G_i (w - q_i)
@@ -104,7 +104,7 @@ class Rheology:
         return self.G_inf * w + (self.G * (w[:, None] - q)).sum(axis=1)
 
     def relax(self, w0, q0, h, coefficients):
-        """Free surface under zero force over one step ``h`` (PHYSICS.md section 5).
+        """Free surface under zero force over one step ``h`` (docs/physics.md#kelvin-voigt-continuum).
 
         Solves ``eta0 dw/dt + G_inf w + sum G_i (w - q_i) = 0``:
         without arms exactly (``w0 exp(-h G_inf/eta0)``, or 0 for an elastic
@@ -155,7 +155,7 @@ def naive_impact(scene, steps, elements, row_width=1.05, max_time=100.0, mu=None
     check_cone : raise ``AssertionError`` if an element in contact ends a
         step with ``|f_t| > mu f_n (1 + 1e-12)``
     flat_punch : radius ``a0`` (m) of a flat punch instead of the sphere's
-        MDR profile (PHYSICS.md section 9): ``g = 0`` on ``|x| < a0``, no
+        MDR profile (docs/physics.md#linear-model): ``g = 0`` on ``|x| < a0``, no
         element outside; every element enters at once and leaves together
 
     Returns
@@ -335,7 +335,7 @@ def naive_impact(scene, steps, elements, row_width=1.05, max_time=100.0, mu=None
         if rheo.eta0 > 0.0:
             corr_z += float((theta[new] * (f_entry[new] + force_end[new]) - force[new]).sum())
 
-        # tangential state of the elements in contact (PHYSICS.md section 6)
+        # tangential state of the elements in contact (docs/physics.md#full-stick)
         s_start, p_start = s.copy(), p.copy()  # relaxed state for the entering ones
         if memory == "seed":  # thesis eq. 4.16: total contact-point displacement
             s_new = np.full(n, u_c_new)
