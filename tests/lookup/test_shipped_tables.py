@@ -10,11 +10,9 @@ its spec (``sweeps/<model>_table.toml``), fail with the spec to re-run when:
   made by older numerics or code),
 - it carries no measured interpolation error (``vimpact table verify --write``).
 
-EXPECTED TO FAIL until the tables are regenerated with the final sweep driver
-(issue 11: the shipped tables carry beta_x errors up to 2e-4 from old numerics
-and no interpolation error). The ``xfail(strict=True)`` mark below says so:
-once the tables are regenerated this test passes, strict xfail turns that into
-a failure, and the mark must be removed (set ``REGENERATED = True``).
+Live since the tables were regenerated with the final sweep driver and verified
+(``REGENERATED = True``); the mark stays for the next time the tables must be
+remade.
 """
 
 from pathlib import Path
@@ -27,7 +25,7 @@ import pytest
 ROOT = Path(__file__).resolve().parents[2]
 SHIPPED = ("kelvin_voigt", "standard_solid")
 #: Set to True once the shipped tables are regenerated (issue 11); then this guard is live.
-REGENERATED = False
+REGENERATED = True
 SAMPLE = 12
 NODE_TOLERANCE = 1e-6
 
