@@ -185,8 +185,10 @@ def _cmd_lookup(a) -> int:
             print("  ".join(f"{'nan' if row[k] is None else format(row[k], '.6g'):>12}"
                             for k in names))
         if bound:
-            print("measured interpolation error (max between nodes): "
-                  + ", ".join(f"{k} {v:.2g}" for k, v in bound.items()))
+            from vimpact.lookup.verify import BOUND_FACTOR
+
+            print(f"interpolation error bound ({BOUND_FACTOR:g} x the max measured between "
+                  "nodes): " + ", ".join(f"{k} {v:.2g}" for k, v in bound.items()))
         else:
             print(f"interpolation error not measured for {a.method} "
                   f"(`vimpact table verify {a.table} --method {a.method} --write`)")
