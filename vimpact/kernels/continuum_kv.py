@@ -300,6 +300,23 @@ def _force(s, v, tau0, unloading):
     return 1.25 * s * s * s + 1.875 * tau0 * s * v
 
 
+@jit(inline="always")
+def rejected_step_factor(err):
+    """Factor (< 1) for the step after a rejected one with error norm ``err`` (NaN: the smallest)."""
+    if math.isfinite(err):
+        return min(max(_FAC_MIN, _SAFETY * err ** (-_ALPHA)), _SAFETY)
+    return _FAC_MIN
+
+
+@jit(inline="always")
+def accepted_step_factor(err, err_old, rejected):
+    """PI step-size factor after an accepted step (Hairer, Norsett & Wanner); not above 1
+    right after a rejection."""
+    fac = _SAFETY * err ** (-_ALPHA) * err_old ** _BETA if err > 0.0 else _FAC_MAX
+    fac = min(_FAC_MAX, max(_FAC_MIN, fac))
+    return min(fac, 1.0) if rejected else fac
+
+
 @jit()
 def kv_normal_impact(tau0, rtol, max_steps, rec, rec_every, out):
     """One normal Kelvin-Voigt impact, continuum limit; results into ``out``.
@@ -388,22 +405,14 @@ def kv_normal_impact(tau0, rtol, max_steps, rec, rec_every, out):
         s1, v1, t1, fs1, fv1, ft1, es, ev, et = _dp_step(s, v, t, fs, fv, ft, h, tau0, unloading)
         err = _err_norm(es, ev, et, s, v, t, s1, v1, t1, rtol, atol_s, atol_v, atol)
         if not (err <= 1.0):  # rejected (also NaN)
-            if math.isfinite(err):
-                fac = max(_FAC_MIN, _SAFETY * err ** (-_ALPHA))
-                h *= min(fac, _SAFETY)
-            else:
-                h *= _FAC_MIN
+            h *= rejected_step_factor(err)
             rejected = True
             continue
         # ---- accepted ----
         steps += 1
-        fac = _SAFETY * err ** (-_ALPHA) * err_old ** _BETA if err > 0.0 else _FAC_MAX
-        fac = min(_FAC_MAX, max(_FAC_MIN, fac))
-        if rejected:
-            fac = min(fac, 1.0)
+        h_next = h * accepted_step_factor(err, err_old, rejected)
         err_old = max(err, 1e-4)
         rejected = False
-        h_next = h * fac
 
         event = (v1 <= 0.0) if not unloading else (s1 <= 0.0)
         if event:

@@ -114,8 +114,8 @@ from numba import prange
 
 from vimpact.kernels.continuum_kv import (
     _A21, _A31, _A32, _A41, _A42, _A43, _A51, _A52, _A53, _A54, _A61, _A62, _A63, _A64, _A65,
-    _ALPHA, _B1, _B3, _B4, _B5, _B6, _BETA, _E1, _E3, _E4, _E5, _E6, _E7, _FAC_MAX, _FAC_MIN,
-    _SAFETY, RTOL_MAX, RTOL_MIN)
+    _B1, _B3, _B4, _B5, _B6, _E1, _E3, _E4, _E5, _E6, _E7, RTOL_MAX, RTOL_MIN,
+    accepted_step_factor, rejected_step_factor)
 from vimpact.kernels.jit import jit
 from vimpact.kernels.layout import (
     ELEMENT_STIFFNESS, N_REC, OUT_B_MAX, OUT_N_REC, OUT_STATUS, OUT_STEPS, OUT_T_CONTACT,
@@ -526,20 +526,13 @@ def maxwell_stick_impact(tau0, g, tau, kappa, mu_t, tangential, rtol, max_steps,
         err = _step(phase, m, y, h, K, y1, tmp, tau0, ga, itau, n, kappa, mu_t, tang, rc, hs, nh,
                     e_val, atol, rtol)
         if not (err <= 1.0):
-            if math.isfinite(err):
-                h *= min(max(_FAC_MIN, _SAFETY * err ** (-_ALPHA)), _SAFETY)
-            else:
-                h *= _FAC_MIN
+            h *= rejected_step_factor(err)
             rejected = True
             continue
         steps += 1
-        fac = _SAFETY * err ** (-_ALPHA) * err_old ** _BETA if err > 0.0 else _FAC_MAX
-        fac = min(_FAC_MAX, max(_FAC_MIN, fac))
-        if rejected:
-            fac = min(fac, 1.0)
+        h_next = h * accepted_step_factor(err, err_old, rejected)
         err_old = max(err, 1e-4)
         rejected = False
-        h_next = h * fac
         comp = 1 if phase == 0 else 0
         event = y1[comp] <= 0.0
         if event and y1[comp] < 0.0:
