@@ -1,7 +1,7 @@
 """Slow, independent reference of the MDR impact in physical (SI) units.
 
 This is the documentation-grade restatement of the element model of
-docs/physics.md#method-of-dimensionality-reduction-7, written directly in metres, seconds, kilograms and
+docs/physics.md (method of dimensionality reduction to energy and passivity), written directly in metres, seconds, kilograms and
 pascals. It shares no code with :mod:`vimpact.kernels.elements` and does not
 nondimensionalize anything: it only takes the discretization (``t_H`` and
 ``a_H`` for the step and the element spacing) from
