@@ -467,7 +467,9 @@ class KernelSpec(NamedTuple):
     tangential : the tangential problem is advanced
     memory : 0 incremental, 1 seed (meaningful only with ``tangential``)
     arms : the material has Maxwell arms
-    dashpot : the material has a parallel dashpot
+    dashpot : the material has a parallel dashpot; it also selects how an element
+        in contact for part of a step is weighted, so a kernel must only run rows
+        whose dashpot matches its flag (routing groups rows that way)
     friction : Coulomb friction (finite ``mu``); ``False`` is full stick
     """
 
