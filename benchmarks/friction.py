@@ -21,7 +21,10 @@ import numba
 import numpy as np
 
 from benchmarks.element_orders import HERTZ_TIME, TANGENTIAL_FACTOR, run_rows
-from benchmarks.machine import bench_main, machine_info, median_time, save_figure
+from benchmarks.machine import figure, machine_info, median_time, repository_main, save_figure
+from vimpact.kernels.elements import OUT_T_CONTACT, OUT_T_GROSS_SLIP, OUT_VC_END, VERLET, KernelSpec
+
+TITLE = "Coulomb friction: friction kernel against stick kernel, beta_x error vs time"
 
 
 def interleaved_medians(fns: dict, repeats: int) -> dict:
@@ -34,7 +37,7 @@ def interleaved_medians(fns: dict, repeats: int) -> dict:
             fn()
             times[k].append(time.perf_counter() - t0)
     return {k: float(np.median(v)) for k, v in times.items()}
-from vimpact.kernels.elements import OUT_T_CONTACT, OUT_T_GROSS_SLIP, OUT_VC_END, VERLET, KernelSpec
+
 
 NU, THETA = 0.3, 0.4
 KAPPA = 2.0 * (1.0 - NU) / (2.0 - NU)
@@ -136,8 +139,22 @@ def plot(data: dict, path) -> None:
     save_figure(fig, path)
 
 
+def figures(data: dict) -> dict:
+    """Time ratio friction / stick kernel per material and case, and the
+    finest beta_x error of the friction ladder."""
+    out = {}
+    for name, cost in data["cost"].items():
+        for label, c in cost.items():
+            if label != "stick":
+                out[f"{name}_{label}_over_stick"] = figure(c["ratio_to_stick"], "-")
+        pts = data["ladder"][name]["friction_psi_3chi"]["points"]
+        out[f"{name}_friction_finest_beta_x_error"] = figure(pts[-1]["beta_x_error"], "-",
+                                                             kind="accuracy")
+    return out
+
+
 def main(argv=None):
-    return bench_main(__doc__, run, plot, "friction", argv=argv)
+    return repository_main("friction", argv)
 
 
 if __name__ == "__main__":

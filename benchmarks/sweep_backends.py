@@ -30,6 +30,7 @@ import time
 from pathlib import Path
 
 RESULTS = Path(__file__).parent / "results"
+TITLE = "Sweeps: in-process against a Dask LocalCluster, and a large sweep's wall over kernel time"
 
 SPEC = """
 description = "benchmark: random oblique Kelvin-Voigt impacts"
@@ -120,6 +121,46 @@ def large(rows: int, chunk: int) -> dict:
             "overhead_us_per_row": 1e6 * (wall - kernel) / rows,
             "peak_rss_mb": {"self": self_kb / 1024, "children": children_kb / 1024},
             "table_bytes": size, "statuses": counts}
+
+
+def run(quick: bool) -> dict:
+    """Both parts (``quick``: 200 rows side by side, a 2000-row large sweep;
+    full: 2000 rows side by side, a 1e6-row large sweep)."""
+    return {"machine": machine(),
+            "backends": backends(200 if quick else 2000, 20 if quick else 100),
+            "large": large(2000 if quick else 1_000_000, 500 if quick else 10_000)}
+
+
+def plot(data: dict, path) -> None:
+    """Rows per second of each backend, and the large sweep's wall and kernel time."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from vimpact.bench.machine import save_figure
+
+    fig, axes = plt.subplots(1, 2, figsize=(10, 4))
+    b, big = data["backends"], data["large"]
+    axes[0].bar(["in-process\n2 threads", "Dask\n2 workers x 1"],
+                [b["rows_per_s"]["in_process"], b["rows_per_s"]["dask"]], color=["C0", "C1"])
+    axes[0].set(ylabel="rows / s", title=f"same sweep, {b['rows']} rows ({b['numerics']})")
+    axes[1].bar(["wall", "kernel"], [big["wall_s"], big["kernel_s"]], color=["C2", "C3"])
+    axes[1].set(ylabel="s", title=f"{big['rows']:.0e}-row sweep: wall / kernel = "
+                f"{big['wall_over_kernel']:.2f}")
+    save_figure(fig, path)
+
+
+def figures(data: dict) -> dict:
+    """Dask over in-process time, the large sweep's wall over kernel time, its
+    rows/s and Python overhead per row."""
+    from vimpact.bench.machine import figure
+
+    b, big = data["backends"], data["large"]
+    return {"dask_over_in_process": figure(b["dask_over_in_process"], "-"),
+            "large_wall_over_kernel": figure(big["wall_over_kernel"], "-"),
+            "large_rows_per_s": figure(big["rows_per_s"], "1/s", better="higher"),
+            "large_overhead_us_per_row": figure(big["overhead_us_per_row"], "us/row")}
 
 
 def main(argv=None) -> dict:

@@ -33,6 +33,8 @@ BENCHMARKS: dict[str, str] = {
     "paths": "vimpact.bench.paths",
     "overhead": "vimpact.bench.overhead",
     "imports": "vimpact.bench.imports",
+    "friction": "benchmarks.friction",
+    "sweep_backends": "benchmarks.sweep_backends",
 }
 
 
