@@ -99,6 +99,12 @@ def finished_rows_have_no_nan(df):
     ('model = "standard_solid"\nseed = 1\n[random]\nrows = 3\nG1_Pa = 1e7\nG2_Pa = "big"\n'
      'eta_Pa_s = 1.0\nR_m = 0.1\nm_kg = 1.0\nv_z0_m_s = 1.0\nnu = 0.5\n', "random.G2_Pa"),
     ('model = "kelvin_voigt"\n[grid\nQ1 = 0.1\n', "TOML"),
+    ('model = "kelvin_voigt"\n[grid]\nQ1 = 0.1\nnu = 0.5\ntolerance = 0.5\n', "grid.tolerance"),
+    ('model = "kelvin_voigt"\n[grid]\nQ1 = 0.1\nnu = 0.5\ntolerance = 1e-12\n',
+     "grid.tolerance"),
+    ('model = "kelvin_voigt"\n[grid]\nQ1 = 0.1\nnu = 0.5\ntolerance = [1e-5]\n',
+     "grid.tolerance"),
+    ('model = "kelvin_voigt"\n[grid]\nQ1 = 0.1\nnu = 0.5\ntolerance = nan\n', "grid.tolerance"),
 ])
 def test_bad_spec_names_file_and_key(tmp_path, text, key):
     path = write(tmp_path, text, "bad_spec.toml")
@@ -107,6 +113,18 @@ def test_bad_spec_names_file_and_key(tmp_path, text, key):
     message = str(info.value)
     assert "bad_spec.toml" in message and key in message
     assert "\n" not in message.strip() or key == "TOML"
+
+
+def test_grid_tolerance_is_a_field_not_an_axis(tmp_path):
+    plain = load_spec(write(tmp_path, GRID_SS, "plain.toml"))
+    assert plain.grid_tolerance is None and plain.metadata()["grid_tolerance"] is None
+    spec = load_spec(write(tmp_path, GRID_SS + "tolerance = 1e-5\n", "tol.toml"))
+    assert spec.grid_tolerance == 1e-5 and spec.metadata()["grid_tolerance"] == 1e-5
+    assert list(spec.axes) == list(plain.axes) and spec.rows == plain.rows == 12
+    assert spec.columns() == plain.columns()
+    for lo_hi in ("1e-9", "0.1"):  # both ends of the allowed range
+        assert load_spec(write(tmp_path, GRID_SS + f"tolerance = {lo_hi}\n", "end.toml")) \
+            .grid_tolerance == float(lo_hi)
 
 
 def test_missing_spec_file(tmp_path):

@@ -30,7 +30,10 @@ scene files live in :mod:`vimpact.model.toml_input`.
 ``[grid]``: parameter sets on a grid of the dimensionless parameters, simulated
 on the reference scene of :meth:`vimpact.Scene.from_dimensionless` (the grid is
 the product of all axes; ``Q1`` runs fastest, then ``Q2``, ``nu``,
-``theta_ratio``). Keys: ``Q1`` (kelvin_voigt, standard_solid; >= 0), ``Q2``
+``theta_ratio``). Keys: ``tolerance`` (optional, not an axis: the interpolation
+error the grid should meet between its nodes, a number in [1e-9, 1e-1]; stored
+as :attr:`SweepSpec.grid_tolerance` and in the metadata as ``grid_tolerance``,
+for a refinement of the grid to read), ``Q1`` (kelvin_voigt, standard_solid; >= 0), ``Q2``
 (standard_solid; > 0), ``nu`` (required; in [0, 0.5]), ``theta_ratio``
 (Theta / (m R^2), default 0.4). An axis is a number, a list of numbers, or a
 table ``{ start, stop, per_decade }`` (log-spaced, both ends included) or
@@ -125,6 +128,8 @@ MAX_ROWS = 10**12
 LAYOUTS = ("auto", "file", "dataset")
 #: ``layout = "auto"`` writes one file up to this many rows, a dataset above.
 FILE_LAYOUT_MAX_ROWS = 1_000_000
+#: Allowed ``[grid] tolerance`` (interpolation error between nodes, dimensionless).
+GRID_TOLERANCE_RANGE = (1e-9, 1e-1)
 #: Points of one grid axis at most (the axes are held in memory, the grid is not).
 MAX_AXIS_POINTS = 10**7
 
@@ -327,6 +332,9 @@ class SweepSpec:
     rotation : the sphere may spin
     layout : ``"auto"``, ``"file"`` or ``"dataset"`` as written (:attr:`table_layout`
         resolves ``"auto"``)
+    grid_tolerance : grid mode: ``[grid] tolerance``, the interpolation error the grid
+        should meet between its nodes (dimensionless, in [1e-9, 1e-1]; ``None``: not
+        asked). Not an axis: a refinement of the grid reads it
     """
 
     path: Path
@@ -346,6 +354,7 @@ class SweepSpec:
     tangential: str = "auto"
     rotation: bool = True
     layout: str = "auto"
+    grid_tolerance: float | None = None
 
     @property
     def n_chunks(self) -> int:
@@ -457,6 +466,7 @@ class SweepSpec:
             "tangential_memory": self.tangential_memory,
             "tangential": self.tangential,
             "rotation": self.rotation,
+            "grid_tolerance": self.grid_tolerance,
             "units": self.units(),
             "columns": {c: _describe(c) for c in self.columns()},
             "statuses": SWEEP_STATUSES,
@@ -513,17 +523,19 @@ def load_spec(path) -> SweepSpec:
     else:
         mode = "grid"
         seed = spec.integer("seed", data.get("seed", 0), 0)
-        axes = _grid(spec, model, data["grid"])
+        axes, grid_tolerance = _grid(spec, model, data["grid"])
         rows = math.prod(len(v) for v in axes.values())
         if rows > MAX_ROWS:
             raise spec.error("grid", f"{rows} rows; at most {MAX_ROWS} are allowed")
         draws, arms = {}, ()
+    if mode == "random":
+        grid_tolerance = None
     return SweepSpec(path=path, text=text, model=model, mode=mode, seed=seed,
                      chunk_size=chunk_size, output=output, numerics=numerics,
                      tangential_memory=header.tangential_memory,
                      description=header.description, rows=rows, draws=draws, arms=arms,
                      axes=axes, tangential=header.tangential, rotation=header.rotation,
-                     layout=layout)
+                     layout=layout, grid_tolerance=grid_tolerance)
 
 
 def _random(spec: TomlSource, model: str, table) -> tuple[dict, tuple, int]:
@@ -567,13 +579,20 @@ def _random(spec: TomlSource, model: str, table) -> tuple[dict, tuple, int]:
     return draws, arms, rows
 
 
-def _grid(spec: TomlSource, model: str, table) -> dict[str, np.ndarray]:
+def _grid(spec: TomlSource, model: str, table) -> tuple[dict[str, np.ndarray], float | None]:
+    """The axes (outermost first) and the optional ``tolerance`` of a ``[grid]`` table."""
     if model not in _GRID_KEYS:
         raise spec.error("grid", f"model {model!r} has no dimensionless grid; use [random]")
     if not isinstance(table, dict):
         raise spec.bad("grid", table, "a table")
     keys = _GRID_KEYS[model]
-    spec.unknown(table, keys, "grid")
+    spec.unknown(table, keys + ("tolerance",), "grid")
+    tolerance = None
+    if "tolerance" in table:
+        tolerance = spec.number("grid.tolerance", table["tolerance"],
+                                lambda x: GRID_TOLERANCE_RANGE[0] <= x <= GRID_TOLERANCE_RANGE[1],
+                                f"a number in [{GRID_TOLERANCE_RANGE[0]:g}, "
+                                f"{GRID_TOLERANCE_RANGE[1]:g}]")
     axes = {}
     for key in keys:
         if key not in table:
@@ -587,7 +606,7 @@ def _grid(spec: TomlSource, model: str, table) -> dict[str, np.ndarray]:
             if not (math.isfinite(x) and check(x)):
                 raise spec.bad(f"grid.{key}", float(x), allowed)
         axes[key] = values
-    return axes
+    return axes, tolerance
 
 
 __all__ = ["COLUMNS", "Draw", "FILE_LAYOUT_MAX_ROWS", "LAYOUTS", "MAX_ROWS", "OUTPUTS",
