@@ -112,3 +112,41 @@ def test_extrapolates_linearly_with_the_end_slope():
 def test_log_axis_refuses_zero_nodes():
     with pytest.raises(InputError, match="Q2 nodes .* log Q2 axis"):
         HermiteGrid(["Q2"], [np.array([0.0, 1.0, 2.0])], {"f": np.ones(3)})
+
+
+@pytest.mark.parametrize("d", [1, 2, 3, 4])
+def test_numba_kernel_equals_the_numpy_reference(d):
+    """The numba kernel (default backend) and the NumPy evaluation are two codes for one
+    interpolant: equal to 1e-12 at random points, at nodes, beyond the ends (extrapolated),
+    with NaN at the same points around a failed node."""
+    rng = np.random.default_rng(10 + d)
+    names = ["Q1", "nu", "Q2", "theta_ratio"][:d]
+    nodes = [np.geomspace(1e-3, 10.0, 9), np.linspace(0.0, 0.5, 6), np.geomspace(0.01, 100, 5),
+             np.array([0.2, 0.3, 0.4, 0.55, 0.6667])][:d]
+    mesh = np.meshgrid(*[np.log(n) if a in ("Q1", "Q2") else n for a, n in zip(names, nodes)],
+                       indexing="ij")
+    smooth = sum(np.sin(0.7 * (k + 1) * m + k) for k, m in enumerate(mesh))
+    values = {"e_z": 0.5 + 0.1 * smooth, "beta_x": np.tanh(smooth) * np.exp(-mesh[0] ** 2 / 20)}
+    values["beta_x"][(2,) * d] = np.nan  # a failed node
+    grid = HermiteGrid(names, nodes, values)
+    n = 3000
+    inside = [np.exp(rng.uniform(np.log(x[0]), np.log(x[-1]), n)) if a in ("Q1", "Q2")
+              else rng.uniform(x[0], x[-1], n) for a, x in zip(names, nodes)]
+    for k, x in enumerate(nodes):  # some points on nodes of each axis
+        inside[k][k * 50:(k + 1) * 50] = rng.choice(x, 50)
+    beyond = [np.where(rng.random(n) < 0.5, p, np.where(rng.random(n) < 0.5, x[0] * 0.7,
+                                                        x[-1] * 1.3 + 0.1))
+              for p, x in zip(inside, nodes)]
+    for pts, extrapolate in ((inside, False), (inside, True), (beyond, True)):
+        fast = grid(pts, extrapolate, backend="numba")
+        ref = grid(pts, extrapolate, backend="numpy")
+        for name in values:
+            assert np.array_equal(np.isnan(fast[name]), np.isnan(ref[name]))
+            np.testing.assert_allclose(fast[name], ref[name], rtol=0, atol=1e-12, equal_nan=True)
+        assert np.isnan(ref["e_z"]).any() and np.isfinite(ref["e_z"]).sum() > n // 2
+
+
+def test_unknown_backend_is_refused():
+    grid = HermiteGrid(["nu"], [np.linspace(0, 0.5, 3)], {"f": np.ones(3)})
+    with pytest.raises(InputError, match="backend = 'c' is not allowed.*numba, numpy"):
+        grid([np.array([0.1])], backend="c")

@@ -24,9 +24,12 @@ order of magnitude in accuracy: measured on beta_x(Q1) of the Kelvin-Voigt
 table, 4e-4 with, 4e-6 without). Mixed derivatives are the slope operators of the other axes
 applied to the limited slopes.
 
-Evaluation is vectorized in NumPy: per axis one ``searchsorted`` and four
-basis weights, then one gather of the ``2**d`` corner nodes (all outputs and
-derivatives at once) and a weighted sum, in chunks of points.
+Evaluation: by default the numba kernel :func:`vimpact.kernels.hermite.hermite_eval`
+(one pass per point: per axis a binary search and four basis weights, then the
+``4**d`` terms of the tensor product; parallel over blocks of points). The
+NumPy evaluation (``backend="numpy"``: per axis one ``searchsorted`` and four
+basis weights, then one gather of the ``2**d`` corner nodes and a weighted sum,
+in chunks of points) is kept as the reference the kernel is tested against.
 """
 
 from __future__ import annotations
@@ -35,10 +38,12 @@ import numpy as np
 
 from vimpact.model.validation import InputError
 
-__all__ = ["HermiteGrid", "LOG_AXES", "derivative_matrix", "hermite_slopes"]
+__all__ = ["BACKENDS", "HermiteGrid", "LOG_AXES", "derivative_matrix", "hermite_slopes"]
 
-#: Axes interpolated in the logarithm of the value (> 0 required).
+#: Axes interpolated in the logarithm of the value by default (> 0 required).
 LOG_AXES = ("Q1", "Q2")
+#: Evaluations of :meth:`HermiteGrid.__call__`: the numba kernel, the NumPy reference.
+BACKENDS = ("numba", "numpy")
 #: Points evaluated per block (bounds the temporary memory).
 _BLOCK = 1 << 16
 #: Nodes of a slope stencil (the degree of the local polynomial + 1).
@@ -157,18 +162,20 @@ class HermiteGrid:
     values : output name -> node values, shape ``tuple(len(n) for n in nodes)``
         (NaN at a node whose impact failed: lookups that need it give NaN)
     monotone : limit the slopes where the data is monotone (default True)
+    log_axes : names of the axes interpolated in ``log x`` (default :data:`LOG_AXES`)
     """
 
     def __init__(self, axes: list[str], nodes: list[np.ndarray], values: dict[str, np.ndarray],
-                 monotone: bool = True):
+                 monotone: bool = True, log_axes: tuple[str, ...] = LOG_AXES):
         self.axes = list(axes)
         self.nodes = [np.asarray(n, dtype=float) for n in nodes]
+        self.log_axes = tuple(log_axes)
         for name, n in zip(self.axes, self.nodes):
-            if name in LOG_AXES and np.any(n <= 0.0):
+            if name in self.log_axes and np.any(n <= 0.0):
                 raise InputError(f"{name} nodes = {n[n <= 0.0][:3].tolist()} are not allowed on "
                                  f"the log {name} axis of a cubic lookup: give {name} > 0 (a "
                                  "Kelvin-Voigt row is Q2 = NaN, not 0)")
-        self.coords = [np.log(n) if a in LOG_AXES else n for a, n in zip(self.axes, self.nodes)]
+        self.coords = [np.log(n) if a in self.log_axes else n for a, n in zip(self.axes, self.nodes)]
         self.names = list(values)
         self.shape = tuple(len(n) for n in self.nodes)
         d = len(self.axes)
@@ -192,35 +199,67 @@ class HermiteGrid:
         self.data = np.nan_to_num(data.reshape(-1, 1 << d, len(self.names)))
         self._rows = self.data.reshape(len(self.data), -1)  # one row of numbers per node
         self.strides = np.array([int(np.prod(self.shape[k + 1:])) for k in range(d)], dtype=np.int64)
+        self._kernel_args = None
 
-    # ---- per-axis weights ---------------------------------------------------------
-    def _axis(self, k: int, x: np.ndarray, extrapolate: bool):
-        """Cell index and the four 1-D weights ``(value lo, value hi, slope lo, slope hi)``."""
-        name, nodes, c = self.axes[k], self.nodes[k], self.coords[k]
+    def _kernel_arrays(self) -> tuple:
+        """The grid as the arrays :func:`vimpact.kernels.hermite.hermite_eval` takes
+        (everything but the points, ``extrapolate`` and ``out``)."""
+        if self._kernel_args is None:
+            from vimpact.kernels.hermite import term_tables
+
+            d = len(self.axes)
+            is_log = np.array([a in self.log_axes for a in self.axes], dtype=np.bool_)
+            coords = np.ascontiguousarray(np.concatenate(self.coords), dtype=np.float64)
+            raw = np.ascontiguousarray(np.concatenate(self.nodes), dtype=np.float64)
+            start = np.concatenate([[0], np.cumsum(self.shape)]).astype(np.int64)
+            offset = np.array([sum(int(self.strides[k]) for k in range(d)
+                                   if c >> k & 1 and self.shape[k] > 1)
+                               for c in range(1 << d)], dtype=np.int64)
+            pair_corner, pair_mask = term_tables(d)
+            self._kernel_args = (is_log, coords, raw, start, self.strides.astype(np.int64),
+                                 offset, pair_corner, pair_mask,
+                                 np.ascontiguousarray(self.data, dtype=np.float64),
+                                 np.ascontiguousarray(self.bad, dtype=np.bool_))
+        return self._kernel_args
+
+    # ---- range checks ---------------------------------------------------------
+    def _check(self, k: int, x: np.ndarray, extrapolate: bool) -> None:
+        """Raise :class:`InputError` for a point outside axis ``k`` (unless
+        ``extrapolate``) or at ``x <= 0`` on a log axis."""
+        if x.size == 0:
+            return
+        name, nodes = self.axes[k], self.nodes[k]
         lo, hi = nodes[0], nodes[-1]
         tol_lo = _NODE_RTOL * abs(lo) + _NODE_ATOL
         tol_hi = _NODE_RTOL * abs(hi) + _NODE_ATOL
-        inside = (x >= lo - tol_lo) & (x <= hi + tol_hi)
-        if not extrapolate and not np.all(inside):
+        if not extrapolate and (x.min() < lo - tol_lo or x.max() > hi + tol_hi):
+            inside = (x >= lo - tol_lo) & (x <= hi + tol_hi)
             bad = float(x[~inside].flat[0])
             covered = (f"{name} = {_fmt(lo)} only (a single grid value)" if len(nodes) == 1
                        else f"{name} in [{_fmt(lo)}, {_fmt(hi)}]")
             raise InputError(
                 f"{name} = {bad:.6g} is outside the table's range: it covers {covered}; "
                 "extrapolate=True (--extrapolate) extrapolates linearly"
-                + (f" in log {name}" if name in LOG_AXES else ""))
+                + (f" in log {name}" if name in self.log_axes else ""))
+        if extrapolate and name in self.log_axes and len(nodes) > 1 and x.min() <= 0.0:
+            bad = float(x[x <= 0.0].flat[0])
+            raise InputError(
+                f"{name} = {bad:.6g} cannot be extrapolated on the table's log {name} axis: "
+                f"it covers {name} in [{_fmt(lo)}, {_fmt(hi)}]; give {name} > 0")
+
+    # ---- per-axis weights ---------------------------------------------------------
+    def _axis(self, k: int, x: np.ndarray, extrapolate: bool):
+        """Cell index and the four 1-D weights ``(value lo, value hi, slope lo, slope hi)``."""
+        name, nodes, c = self.axes[k], self.nodes[k], self.coords[k]
+        lo, hi = nodes[0], nodes[-1]
+        self._check(k, x, extrapolate)
         if not extrapolate:
             x = np.clip(x, lo, hi)
         n = len(nodes)
         if n == 1:
             zero = np.zeros(x.shape)
             return np.zeros(x.shape, dtype=np.int64), (np.ones(x.shape), zero, zero, zero)
-        if name in LOG_AXES:
-            if np.any(x <= 0.0):
-                bad = float(x[x <= 0.0].flat[0])
-                raise InputError(
-                    f"{name} = {bad:.6g} cannot be extrapolated on the table's log {name} axis: "
-                    f"it covers {name} in [{_fmt(lo)}, {_fmt(hi)}]; give {name} > 0")
+        if name in self.log_axes:
             u = np.log(x)
         else:
             u = x
@@ -243,10 +282,30 @@ class HermiteGrid:
             g1 = g1 + np.maximum(u - c[-1], 0.0)
         return i0, (w0, w1, g0, g1)
 
-    def __call__(self, coords: list[np.ndarray], extrapolate: bool = False) -> dict[str, np.ndarray]:
-        """Interpolated outputs at the points ``coords`` (one array per axis, same shape)."""
+    def __call__(self, coords: list[np.ndarray], extrapolate: bool = False,
+                 backend: str = "numba") -> dict[str, np.ndarray]:
+        """Interpolated outputs at the points ``coords`` (one array per axis, same shape).
+
+        Parameters
+        ----------
+        coords : one array of raw coordinates per axis (``Q1``, not ``log Q1``), one shape
+        extrapolate : continue linearly beyond the end nodes (with the end slopes)
+            instead of raising :class:`InputError` for a point outside
+        backend : ``"numba"`` (default, :func:`vimpact.kernels.hermite.hermite_eval`) or
+            ``"numpy"`` (the vectorized reference)
+
+        Returns
+        -------
+        dict output name -> array of ``coords``' shape (NaN where a failed node's
+        value or derivative carries weight)
+        """
+        if backend not in BACKENDS:
+            raise InputError(f"backend = {backend!r} is not allowed: must be one of "
+                             + ", ".join(BACKENDS))
         shape = np.shape(coords[0])
         flat = [np.asarray(c, dtype=float).ravel() for c in coords]
+        if backend == "numba":
+            return self._call_kernel(flat, shape, extrapolate)
         n = flat[0].size
         d = len(self.axes)
         nc = 1 << d
@@ -295,4 +354,17 @@ class HermiteGrid:
                         bad |= used
                 acc[bad] = np.nan
             out[start:stop] = acc
+        return {name: out[:, j].reshape(shape) for j, name in enumerate(self.names)}
+
+    def _call_kernel(self, flat: list[np.ndarray], shape: tuple, extrapolate: bool) -> dict:
+        from vimpact.kernels.hermite import hermite_eval
+
+        for k, x in enumerate(flat):
+            self._check(k, x, extrapolate)
+        n = flat[0].size
+        points = np.empty((n, len(self.axes)))
+        for k, x in enumerate(flat):
+            points[:, k] = x
+        out = np.empty((n, len(self.names)))
+        hermite_eval(points, *self._kernel_arrays(), bool(extrapolate), out)
         return {name: out[:, j].reshape(shape) for j, name in enumerate(self.names)}
