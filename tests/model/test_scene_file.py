@@ -1,6 +1,7 @@
 """Scene files: the shipped examples, parity with a sweep's fixed values, errors."""
 
 import dataclasses
+import math
 from pathlib import Path
 
 import pytest
@@ -109,6 +110,28 @@ def test_defaults_and_options():
     assert numerics == v.Numerics.preset("default")
 
 
+def test_friction_coefficient_and_impact_angle():
+    scene, _ = scene_from_toml(KV)
+    assert scene.mu == math.inf  # default: full stick
+    for text, mu in (("mu = 0.3", 0.3), ("mu = 0", 0.0), ('mu = "inf"', math.inf),
+                     ("mu = inf", math.inf), ("mu = 2", 2.0)):
+        assert scene_from_toml(KV + text + "\n")[0].mu == mu
+    # 30 degrees from the normal at v_z0 = 1 m/s: v_x0 = tan(30 deg) = 1/sqrt(3) m/s
+    scene, _ = scene_from_toml(KV + "angle_deg = 30\nmu = 0.5\n")
+    assert scene.v_x0 == pytest.approx(1.0 / math.sqrt(3.0), rel=1e-15)
+    assert (scene.v_z0, scene.mu) == (1.0, 0.5)
+    assert scene_from_toml(KV + "angle_deg = 0\n")[0].v_x0 == 0.0
+
+
+def test_friction_example():
+    scene, _ = load_scene(SCENES / "steel_on_polymer_friction.toml")
+    assert 0.0 < scene.mu < math.inf and scene.computes_tangential
+    # incidence of docs/physics.md (Maw, Barber and Fawcett): gross slip from the start
+    nu = scene.material.nu
+    psi = 2 * (1 - nu) / (scene.mu * (2 - nu)) * scene.v_c0 / scene.v_z0
+    assert psi > 4 * (1 - nu) * scene.contact_mass_factor / (2 - nu)  # psi > 4 chi
+
+
 def test_prony_arms_as_tables():
     scene, _ = scene_from_toml('model = "prony"\n[scene]\nG_Pa = 1e6\nnu = 0.5\nR_m = 0.01\n'
                                'm_kg = 0.001\nv_z0_m_s = 1.0\n'
@@ -158,6 +181,13 @@ def test_prony_arms_as_tables():
     ('model = "prony"\n[scene]\nG_Pa = 1e6\nnu = 0.5\nR_m = 0.01\nm_kg = 0.001\n'
      'v_z0_m_s = 1.0\narms = [{G_Pa = 2e6, tau_s = 1e-3, eta = 1}]\n', ["scene.arms[1].eta"]),
     ('model = "kelvin_voigt"\n[scene\n', ["TOML"]),
+    (KV + "mu = -0.1\n", ["scene.mu", ">= 0"]),
+    (KV + "mu = nan\n", ["scene.mu", ">= 0"]),
+    (KV + 'mu = "stick"\n', ["scene.mu", "inf"]),
+    (KV + "mu = [0.1, 0.2]\n", ["scene.mu", "one number"]),
+    (KV + "angle_deg = 90\n", ["scene.angle_deg", "[0, 90)"]),
+    (KV + "angle_deg = -5\n", ["scene.angle_deg", "[0, 90)"]),
+    (KV + "angle_deg = 30\nv_x0_m_s = 0.5\n", ["scene.angle_deg/v_x0_m_s"]),
 ])
 def test_bad_scene_file_names_file_and_key(tmp_path, text, keys):
     path = write(tmp_path, text, "bad_scene.toml")

@@ -28,6 +28,7 @@ with backspin)::
     v_x0_m_s = 0.8                  # tangential speed of the centre, m/s (default 0)
     omega0_rad_s = -40.0            # spin about y, rad/s (default 0)
     theta_ratio = 0.4               # Theta / (m R^2) (default 0.4, a solid sphere)
+    mu = 0.3                        # Coulomb friction coefficient (default inf: full stick)
 
 Top-level keys: ``model`` (required), ``description``, ``tangential_memory``,
 ``tangential``, ``rotation``, ``allow_large_contact``, ``numerics`` (a table,
@@ -38,6 +39,11 @@ or a preset name as a string) and ``scene`` (required).
 - all models: ``nu``, ``R_m``, ``m_kg``, ``v_z0_m_s`` (required),
   ``v_x0_m_s`` (default 0), ``omega0_rad_s`` (default 0), ``theta_ratio``
   (default 0.4)
+- friction, all models: ``mu`` (Coulomb friction coefficient, static =
+  kinetic, a number >= 0; ``inf`` (TOML) or ``"inf"`` is full stick, the
+  default) and ``angle_deg`` (impact angle from the normal, degrees, in
+  [0, 90): ``v_x0 = v_z0 tan(angle)``; an alternative to ``v_x0_m_s``, giving
+  both is an error)
 - elastic: ``E_Pa`` or ``G_Pa``; kelvin_voigt: ``E_Pa`` or ``G_Pa``, and
   ``eta_Pa_s``; standard_solid: ``G1_Pa``, ``G2_Pa``, ``eta_Pa_s``;
   prony: ``G_Pa`` (relaxed modulus), ``eta_Pa_s`` (parallel dashpot,
@@ -66,10 +72,10 @@ from pathlib import Path
 
 from vimpact.model.numerics import Numerics
 from vimpact.model.scene import Scene
-from vimpact.model.toml_input import (ARM_KEYS, PHYSICAL_DEFAULTS, SWEEP_TOP_KEYS,
-                                      TomlSource, parse_header, parse_numerics, parse_toml,
-                                      physical_keys, read_toml, required_keys,
-                                      scene_from_values)
+from vimpact.model.toml_input import (ARM_KEYS, PHYSICAL_DEFAULTS,
+                                      SWEEP_TOP_KEYS, TomlSource, friction_coefficient,
+                                      impact_angle, input_keys, parse_header, parse_numerics,
+                                      parse_toml, read_toml, required_keys, scene_from_values)
 
 #: Top-level keys of a scene file.
 TOP_KEYS = ("model", "description", "tangential_memory", "tangential", "rotation",
@@ -96,7 +102,7 @@ _CHECKS = {
 def allowed_scene_keys(model: str) -> tuple[str, ...]:
     """Keys of the ``[scene]`` table for ``model`` (those of a sweep's ``[random]``
     without ``rows``)."""
-    return physical_keys(model) + (("arms",) if model == "prony" else ())
+    return input_keys(model) + (("arms",) if model == "prony" else ())
 
 
 def required_scene_keys(model: str) -> tuple[str, ...]:
@@ -164,6 +170,10 @@ def _top_keys(spec: TomlSource, data: dict) -> None:
 def _number(spec: TomlSource, key: str, value, name: str) -> float:
     if isinstance(value, (list, dict)):
         raise spec.bad(key, value, _ONE_NUMBER)
+    if name == "mu":
+        return friction_coefficient(spec, key, value)
+    if name == "angle_deg":
+        return impact_angle(spec, key, value)
     check, allowed = _CHECKS.get(name, (None, "a finite number"))
     return spec.number(key, value, check, allowed)
 
@@ -179,10 +189,15 @@ def _scene_table(spec: TomlSource, model: str, table) -> tuple[dict, tuple]:
                          f"{model!r}: {', '.join(required_scene_keys(model))})")
     if model in ("elastic", "kelvin_voigt") and ("E_Pa" in table) == ("G_Pa" in table):
         raise spec.error("scene.E_Pa/G_Pa", "give exactly one of E_Pa or G_Pa")
+    if "angle_deg" in table and "v_x0_m_s" in table:
+        raise spec.error("scene.angle_deg/v_x0_m_s", "give at most one of angle_deg (impact "
+                         "angle from the normal, degrees) or v_x0_m_s (tangential speed, m/s)")
     draws = {}
-    for key in physical_keys(model):
+    for key in input_keys(model):
         if key in table:
             value = _number(spec, f"scene.{key}", table[key], key)
+        elif key == "v_x0_m_s" and "angle_deg" in table:
+            continue  # v_x0 = v_z0 tan(angle)
         elif key in DEFAULTS:
             value = DEFAULTS[key]
         else:  # the other of E_Pa / G_Pa

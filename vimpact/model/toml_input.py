@@ -13,6 +13,11 @@ One place for what both formats accept, so that the two cannot drift apart:
   with their unit as suffix (``E_Pa``, ``eta_Pa_s``, ``R_m``, ``m_kg``,
   ``v_z0_m_s``, ``v_x0_m_s``, ``omega0_rad_s``, ``theta_ratio``, arms
   ``G_Pa`` and ``tau_s``);
+- the friction keys (:data:`FRICTION_KEYS`): ``mu`` (Coulomb friction
+  coefficient, >= 0, ``inf`` or ``"inf"`` for full stick, the default) and
+  ``angle_deg`` (impact angle from the normal in degrees, in [0, 90): the
+  tangential speed ``v_x0 = v_z0 tan(angle)``, an alternative to ``v_x0_m_s``,
+  never both), read by :func:`friction_coefficient` and :func:`impact_angle`;
 - :func:`scene_from_values`: one :class:`~vimpact.model.scene.Scene` from
   such named values (a scene file; one row of a sweep when it is explained).
 """
@@ -25,9 +30,12 @@ import tomllib
 from pathlib import Path
 from typing import NamedTuple
 
+import numpy as np
+
 from vimpact.model.material import MODELS, Material
 from vimpact.model.numerics import PRESETS, Numerics
 from vimpact.model.scene import TANGENTIAL_EFFECTS, TANGENTIAL_MEMORY, Scene
+from vimpact.model.validation import InputError
 
 #: Material keys per model (Pa, Pa s).
 MATERIAL_KEYS = {
@@ -40,6 +48,12 @@ MATERIAL_KEYS = {
 SPHERE_KEYS = ("R_m", "m_kg", "v_z0_m_s", "v_x0_m_s", "omega0_rad_s")
 #: Defaults of the optional physical keys (``eta_Pa_s``: optional for Prony only).
 PHYSICAL_DEFAULTS = {"v_x0_m_s": 0.0, "omega0_rad_s": 0.0, "theta_ratio": 0.4}
+#: Optional friction keys (after the physical keys, in this order): Coulomb friction
+#: coefficient (1; default inf, full stick) and impact angle from the normal (degrees;
+#: an alternative to ``v_x0_m_s``).
+FRICTION_KEYS = ("mu", "angle_deg")
+#: Allowed impact angles from the normal, degrees: [0, 90).
+ANGLE_RANGE_DEG = (0.0, 90.0)
 #: Keys of one Maxwell arm of a Prony series (Pa, s).
 ARM_KEYS = ("G_Pa", "tau_s")
 #: Top-level keys of a sweep specification.
@@ -62,6 +76,43 @@ def required_keys(model: str) -> tuple[str, ...]:
         return ("G_Pa", "R_m", "m_kg", "v_z0_m_s", "nu")
     return tuple(k for k in MATERIAL_KEYS[model] if k not in ("E_Pa", "G_Pa")) + \
         ("R_m", "m_kg", "v_z0_m_s", "nu")
+
+
+def input_keys(model: str) -> tuple[str, ...]:
+    """Every value key of ``model`` in its fixed order: :func:`physical_keys`, then
+    :data:`FRICTION_KEYS` (arms separately)."""
+    return physical_keys(model) + FRICTION_KEYS
+
+
+def tangential_speed(v_z0, angle_deg):
+    """Tangential speed of the centre for an impact angle from the normal:
+    ``v_x0 = v_z0 tan(angle)``, m/s (arrays or numbers; the same floating-point
+    operations for a scene file and a sweep column).
+
+    Parameters
+    ----------
+    v_z0 : normal impact speed, m/s
+    angle_deg : impact angle measured from the normal, degrees, in [0, 90)
+    """
+    out = np.asarray(v_z0, dtype=float) * np.tan(np.radians(np.asarray(angle_deg, dtype=float)))
+    return float(out) if out.ndim == 0 else out
+
+
+def friction_coefficient(source: "TomlSource", key: str, value) -> float:
+    """A Coulomb friction coefficient: a number >= 0, or ``inf`` (TOML ``inf`` or the
+    string ``"inf"``) for full stick."""
+    if isinstance(value, str) and value.strip().lower() in ("inf", "+inf", "infinity"):
+        return math.inf
+    if not is_number(value) or math.isnan(value) or value < 0.0 or value == -math.inf:
+        raise source.bad(key, value, 'a number >= 0 or inf (or "inf": full stick)')
+    return float(value)
+
+
+def impact_angle(source: "TomlSource", key: str, value) -> float:
+    """An impact angle from the normal, degrees, in [0, 90)."""
+    lo, hi = ANGLE_RANGE_DEG
+    return source.number(key, value, lambda x: lo <= x < hi,
+                         f"a number of degrees in [{lo:g}, {hi:g}) from the normal")
 
 
 def is_number(x) -> bool:
@@ -185,13 +236,19 @@ def scene_from_values(model: str, values: dict, arms=(), *, tangential_memory="i
     Parameters
     ----------
     model : one of ``vimpact.MODELS``
-    values : key -> number, keys of :func:`physical_keys` (missing optional keys take
-        :data:`PHYSICAL_DEFAULTS`; ``eta_Pa_s`` defaults to 0 for Prony)
+    values : key -> number, keys of :func:`input_keys` (missing optional keys take
+        :data:`PHYSICAL_DEFAULTS`; ``eta_Pa_s`` defaults to 0 for Prony; ``mu`` to
+        ``inf``; ``angle_deg`` sets ``v_x0 = v_z0 tan(angle)`` and excludes ``v_x0_m_s``)
     arms : Prony series: ``[(G_Pa, tau_s), ...]``
 
     Raises ``ValueError`` (``InputError``) for an invalid combination.
     """
+    if "angle_deg" in values and "v_x0_m_s" in values:
+        raise InputError(f"angle_deg = {values['angle_deg']!r} is not allowed together with "
+                         f"v_x0_m_s = {values['v_x0_m_s']!r}: give one of them")
     p = {**PHYSICAL_DEFAULTS, **{k: float(v) for k, v in values.items()}}
+    if "angle_deg" in p:
+        p["v_x0_m_s"] = tangential_speed(p["v_z0_m_s"], p["angle_deg"])
     nu = p["nu"]
     if model == "standard_solid":
         mat = Material.standard_solid(nu=nu, G1=p["G1_Pa"], G2=p["G2_Pa"], eta=p["eta_Pa_s"])
@@ -206,10 +263,11 @@ def scene_from_values(model: str, values: dict, arms=(), *, tangential_memory="i
     return Scene(mat, R=R, m=m, v_z0=p["v_z0_m_s"], v_x0=p["v_x0_m_s"], omega0=p["omega0_rad_s"],
                  Theta=p["theta_ratio"] * m * R**2, tangential_memory=tangential_memory,
                  allow_large_contact=allow_large_contact, tangential=tangential,
-                 rotation=rotation)
+                 rotation=rotation, mu=p.get("mu", math.inf))
 
 
-__all__ = ["ARM_KEYS", "Header", "MATERIAL_KEYS", "NUMERICS_KEYS", "PHYSICAL_DEFAULTS",
-           "SPHERE_KEYS", "SWEEP_TOP_KEYS", "TomlSource", "is_number", "parse_header",
+__all__ = ["ANGLE_RANGE_DEG", "ARM_KEYS", "FRICTION_KEYS", "Header", "MATERIAL_KEYS",
+           "NUMERICS_KEYS", "PHYSICAL_DEFAULTS", "SPHERE_KEYS", "SWEEP_TOP_KEYS", "TomlSource",
+           "friction_coefficient", "impact_angle", "input_keys", "is_number", "parse_header",
            "parse_numerics", "parse_toml", "physical_keys", "read_toml", "required_keys",
-           "scene_from_values"]
+           "scene_from_values", "tangential_speed"]
