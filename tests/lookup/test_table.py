@@ -22,6 +22,7 @@ import vimpact
 from vimpact import Material, Numerics, Scene, simulate, simulate_batch
 from vimpact import cli
 from vimpact.lookup.table import RestitutionTable
+from vimpact.model.validation import InputError
 
 NUM = Numerics(steps=100, elements=20)
 Q1_GRID = np.logspace(-2, 1, 7)  # 0.01 .. 10, half a decade apart
@@ -31,7 +32,7 @@ COLUMNS = ["Q1", "Q2", "nu", "theta_ratio", "e_z", "e_x", "beta_x", "t_contact_s
            "a_max_m", "energy_ratio", "status"]
 UNITS = {"Q1": "1", "Q2": "1", "nu": "1", "theta_ratio": "1", "e_z": "1", "e_x": "1",
          "beta_x": "1", "t_contact_s": "s", "u_max_m": "m", "a_max_m": "m",
-         "energy_ratio": "1", "status": ""}
+         "energy_ratio": "1", "status": "", "psi": "1", "mu": "1"}
 
 
 def results_frame(scenes, numerics=NUM) -> pd.DataFrame:
@@ -290,8 +291,112 @@ def test_several_theta_ratios_need_one(tmp_path):
     # for the faster tangential mode), at the coarse test numerics about 2e-4
     assert thin["e_z"] == pytest.approx(hollow["e_z"], abs=1e-3)
     assert thin["e_x"] != pytest.approx(hollow["e_x"], abs=1e-3)
-    with pytest.raises(ValueError, match="theta_ratio = 0.5 is not allowed"):
-        table.lookup(0.1, 0.5, theta_ratio=0.5)
+    with pytest.raises(InputError, match=r"theta_ratio = 0.3 is outside .*\[0.4, 0.666667\]"):
+        table.lookup(0.1, 0.5, theta_ratio=0.3)
+    with pytest.raises(InputError, match="theta_ratio = -0.5 is not allowed: must be > 0"):
+        table.lookup(0.1, 0.5, theta_ratio=-0.5)
+
+
+def test_theta_ratio_is_a_cubic_axis_in_log_theta(tmp_path):
+    """Between theta_ratio nodes the lookup converges to direct simulation (held-out
+    theta values it did not see) at high order when the log-spaced nodes are refined:
+    error ratio > 8 per halving of the spacing (cubic: 16); at a node it is the row."""
+    q1, nu = Q1_GRID[2:5], 0.3
+    fine = np.geomspace(0.2, 0.8, 9)
+    direct = results_frame([Scene.from_dimensionless(q, nu, theta_ratio=t)
+                            for t in fine for q in q1])
+    held_out = np.sqrt(fine[:-1] * fine[1:])
+    ref = results_frame([Scene.from_dimensionless(q, nu, theta_ratio=t)
+                         for t in held_out for q in q1])
+    errors = []
+    for step in (4, 2, 1):
+        rows = direct[np.isin(direct.theta_ratio, fine[::step])]
+        path = tmp_path / f"theta{step}.parquet"
+        write_table(path, rows, "kelvin_voigt")
+        table = RestitutionTable.open(path)
+        if step > 1:  # nodes of the finest grid not in this one are held out
+            pts = direct[~np.isin(direct.theta_ratio, fine[::step])]
+        else:
+            pts = ref
+        got = table.lookup(pts.Q1.to_numpy(), nu, theta_ratio=pts.theta_ratio.to_numpy())
+        errors.append(np.max(np.abs(got["beta_x"] - pts.beta_x.to_numpy())))
+        assert table.info()["grid"] == {"Q1": 3, "nu": 1, "theta_ratio": len(fine[::step])}
+    assert errors[0] / errors[1] > 8 and errors[1] / errors[2] > 8, errors
+    at_node = table.lookup(q1, nu, theta_ratio=np.full(3, fine[3]))
+    np.testing.assert_allclose(at_node["beta_x"], direct.beta_x[np.isclose(
+        direct.theta_ratio, fine[3])].to_numpy(), rtol=0, atol=1e-12)
+
+
+def gross_slip_psi_table(path, psi_nodes, q1=Q1_GRID[2:5], nu=0.3, theta_ratio=0.4, mu=0.5):
+    """A friction table over psi filled in the gross-slip regime from its closed form
+    (docs/physics.md#coulomb-friction: ``F_x = mu F_z`` throughout, so
+    ``beta_x = -1 + 2 chi (1 + e_z) / psi`` with ``chi = (1 - nu)(1 + 1/theta_ratio)/(2 - nu)``),
+    ``e_z`` from a stick simulation (the normal impact does not feel friction).
+    Returns the stick rows and ``chi``."""
+    stick = results_frame([Scene.from_dimensionless(q, nu, theta_ratio=theta_ratio) for q in q1])
+    chi = (1 - nu) * (1 + 1 / theta_ratio) / (2 - nu)
+    frames = []
+    for psi in psi_nodes:
+        f = stick.copy()
+        f["beta_x"] = -1.0 + 2.0 * chi * (1.0 + f.e_z) / psi
+        f["e_x"] = f.beta_x.abs()
+        f["psi"], f["mu"] = psi, mu
+        frames.append(f)
+    write_table(path, pd.concat(frames, ignore_index=True), "kelvin_voigt")
+    return stick, chi
+
+
+def test_psi_is_an_interpolation_axis(tmp_path):
+    """On a psi axis the lookup converges to the gross-slip closed form between the nodes
+    (order > 3 per halving of the spacing) and gives the rows at the nodes."""
+    nu = 0.3
+    errors = []
+    for n in (7, 13, 25):
+        nodes = np.linspace(6.0, 24.0, n)
+        path = tmp_path / f"psi{n}.parquet"
+        stick, chi = gross_slip_psi_table(path, nodes)
+        table = RestitutionTable.open(path)
+        psi = np.linspace(6.0, 24.0, 61)
+        Q, P = np.meshgrid(stick.Q1.to_numpy(), psi, indexing="ij")
+        got = table.lookup(Q, nu, psi=P)
+        e_z = np.repeat(stick.e_z.to_numpy()[:, None], len(psi), axis=1)
+        np.testing.assert_allclose(got["e_z"], e_z, rtol=0, atol=1e-12)  # not a psi function
+        errors.append(np.max(np.abs(got["beta_x"] - (-1.0 + 2.0 * chi * (1.0 + e_z) / P))))
+        assert table.info()["grid"] == {"Q1": 3, "nu": 1, "psi": n}
+    assert errors[0] / errors[1] > 8 and errors[1] / errors[2] > 8, errors
+    with pytest.raises(InputError, match="psi is missing.*6 .. 24"):
+        table.lookup(0.1, nu)
+    with pytest.raises(InputError, match=r"psi = 30 is outside .*psi in \[6, 24\]"):
+        table.lookup(0.1, nu, psi=30.0)
+    with pytest.raises(InputError, match="psi = -1.0 is not allowed: must be >= 0"):
+        table.lookup(0.1, nu, psi=-1.0, extrapolate=True)
+
+
+def test_psi_on_a_stick_table_is_refused(kv):
+    with pytest.raises(InputError, match="psi = 1.0 is not allowed: the table has no psi column"):
+        kv.lookup(0.1, 0.5, psi=1.0)
+
+
+def test_kelvin_voigt_rows_read_as_q2_nan_with_model_or_old_q2_zero(tmp_path, kv):
+    rows = kv.data.drop(columns=["model"])
+    new, old = rows.assign(Q2=np.nan, model="kelvin_voigt"), rows.assign(Q2=0.0)
+    for name, frame in (("new", new), ("old", old)):
+        write_table(tmp_path / f"{name}.parquet", frame, "kelvin_voigt")
+    a, b = (RestitutionTable.open(tmp_path / f"{n}.parquet") for n in ("new", "old"))
+    assert np.isnan(b.data.Q2).all() and (b.data.model == "kelvin_voigt").all()
+    q1, nu = np.geomspace(0.01, 10, 13), np.linspace(0, 0.5, 13)
+    for method in ("cubic", "linear"):
+        ra, rb = a.lookup(q1, nu, method=method), b.lookup(q1, nu, method=method)
+        for k in ("e_z", "beta_x"):
+            np.testing.assert_array_equal(ra[k], rb[k])
+
+
+def test_to_xarray_carries_theta_and_psi_axes_with_units(tmp_path):
+    xr = pytest.importorskip("xarray")
+    gross_slip_psi_table(tmp_path / "psi.parquet", np.linspace(6.0, 24.0, 4))
+    ds = RestitutionTable.open(tmp_path / "psi.parquet").to_xarray()
+    assert isinstance(ds, xr.Dataset) and ds.e_z.dims == ("Q1", "nu", "psi")
+    assert ds.psi.attrs["units"] == "1" and "incidence" in ds.psi.attrs["long_name"]
 
 
 # --------------------------------------------------------------------------

@@ -46,10 +46,11 @@ import pandas as pd
 
 from vimpact.engine.result import STATUSES
 from vimpact.model.scene import HALF_SPACE_LIMIT, Scene
-from vimpact.model.validation import positive, require
+from vimpact.model.validation import InputError, positive, require
 
-__all__ = ["DATA_STATUSES", "LOOKUP_METHODS", "LOOKUP_MODELS", "OUTPUTS", "SPEC_HINTS",
-           "RestitutionTable", "format_info"]
+__all__ = ["AXES", "DATA_STATUSES", "LOG_AXES", "LOOKUP_METHODS", "LOOKUP_MODELS",
+           "MAX_CURVE_POINTS", "OUTPUTS", "SPEC_HINTS", "RestitutionTable", "format_info",
+           "incidence", "validate_table"]
 
 #: Interpolation methods of :meth:`RestitutionTable.lookup`.
 LOOKUP_METHODS = ("cubic", "linear")
@@ -69,6 +70,25 @@ SPEC_HINTS = {
 #: Outputs interpolated by :meth:`RestitutionTable.lookup` (all dimensionless).
 OUTPUTS = ("e_z", "e_x", "beta_x")
 
+#: Interpolation axes of a lookup, in grid order: ``theta_ratio`` when the table holds
+#: several values, ``psi`` when it has a ``psi`` column (friction incidence).
+AXES = ("Q1", "Q2", "nu", "theta_ratio", "psi")
+
+#: Axes interpolated in the logarithm of the value: the damping parameters, which span
+#: decades, and ``theta_ratio = Theta / (m R^2)``, which enters the tangential dynamics
+#: through the effective mass factor ``1 + m R^2 / Theta``, smoother in ``log theta_ratio``
+#: than in ``theta_ratio`` on nodes spaced by ratios. ``nu`` and ``psi`` (which is 0
+#: at normal incidence) are interpolated as they are.
+LOG_AXES = ("Q1", "Q2", "theta_ratio")
+
+#: The most points of an e(v) curve (:meth:`RestitutionTable.restitution_curve`,
+#: ``vimpact table export --n``).
+MAX_CURVE_POINTS = 100_000
+
+#: Largest allowed excess of ``e_z``, ``e_x``, ``|beta_x|`` over 1 in a data row
+#: (round-off of an elastic impact).
+BOUND_SLACK = 1e-6
+
 _REQUIRED = ("Q1", "nu", "e_z", "e_x", "beta_x", "status")
 _META_PREFIX = "vimpact."  # the sweep's vimpact.sweep.store.META_PREFIX
 #: Theta / (m R^2) of a table without a ``theta_ratio`` column (the solid sphere,
@@ -80,7 +100,7 @@ _NODE_ATOL = 1e-12
 
 
 def _axis_is_log(name: str) -> bool:
-    return name in ("Q1", "Q2")
+    return name in LOG_AXES
 
 
 def _fmt(x: float) -> str:
@@ -143,7 +163,7 @@ class _Grid:
             bad = float(x[~inside].flat[0])
             covered = (f"{name} = {_fmt(lo)} only (a single grid value)" if len(nodes) == 1
                        else f"{name} in [{_fmt(lo)}, {_fmt(hi)}]")
-            raise ValueError(
+            raise InputError(
                 f"{name} = {bad:.6g} is outside the table's range: it covers {covered}; "
                 "extrapolate=True (--extrapolate) extrapolates linearly"
                 + (f" in log {name}" if _axis_is_log(name) else ""))
@@ -157,7 +177,7 @@ class _Grid:
         if _axis_is_log(name):
             if np.any(x <= 0.0) and lo > 0.0:
                 bad = float(x[x <= 0.0].flat[0])
-                raise ValueError(
+                raise InputError(
                     f"{name} = {bad:.6g} cannot be extrapolated on the table's log {name} axis: "
                     f"it covers {name} in [{_fmt(lo)}, {_fmt(hi)}]; give {name} > 0")
             log_cell = a > 0.0  # a cell starting at 0 (an elastic node) is linear in the value
@@ -220,6 +240,134 @@ def _kelvin_voigt_rows(data: pd.DataFrame, model: str) -> pd.DataFrame:
     return data
 
 
+def incidence(angle_deg, mu, nu):
+    """Maw, Barber and Fawcett's incidence ``psi`` of a non-spinning sphere.
+
+    ``psi = 2 (1 - nu) / (mu (2 - nu)) * v_c0 / v_z0`` with ``v_c0 / v_z0 = tan(angle)``
+    (no initial spin: the contact point moves with the centre).
+
+    Parameters
+    ----------
+    angle_deg : impact angle from the surface normal, degrees, in [0, 90)
+    mu : Coulomb friction coefficient, > 0 (``inf``: full stick, ``psi = 0``)
+    nu : Poisson ratio, in [0, 0.5]
+
+    Returns
+    -------
+    float or ndarray, dimensionless
+    """
+    angle = np.asarray(angle_deg, dtype=float)
+    if not np.all(np.isfinite(angle) & (angle >= 0.0) & (angle < 90.0)):
+        bad = angle[~(np.isfinite(angle) & (angle >= 0.0) & (angle < 90.0))].flat[0]
+        raise InputError(f"angle_deg = {float(bad)!r} is not allowed: the impact angle from the "
+                         "normal must be in [0, 90) degrees")
+    mu = float(mu)
+    if not (mu > 0.0):  # NaN too
+        raise InputError(f"mu = {mu!r} is not allowed: the friction coefficient must be > 0 "
+                         "(inf for full stick)")
+    nu = np.asarray(nu, dtype=float)
+    if not np.all((nu >= 0.0) & (nu <= 0.5)):
+        raise InputError(f"nu = {float(nu[~((nu >= 0) & (nu <= 0.5))].flat[0])!r} is not "
+                         "allowed: must be in [0, 0.5]")
+    ratio = np.tan(np.radians(angle))
+    psi = 0.0 * ratio if math.isinf(mu) else 2.0 * (1.0 - nu) / (mu * (2.0 - nu)) * ratio
+    return float(psi) if np.ndim(psi) == 0 else psi
+
+
+def _rows_text(rows: np.ndarray, limit: int = 3) -> str:
+    rows = [int(r) for r in rows[:limit]]
+    return ("row " if len(rows) == 1 else "rows ") + ", ".join(str(r) for r in rows)
+
+
+def validate_table(data: pd.DataFrame, metadata: dict, path=None) -> None:
+    """Refuse a table that cannot be trusted for lookup, plots or exports.
+
+    Raises :class:`~vimpact.model.validation.InputError` naming the file, the column
+    (or metadata key), the first offending value and its row (0-based) for:
+
+    - no ``vimpact.model`` metadata (a Parquet file not written by vimpact: foreign);
+    - a ``status`` not among :data:`vimpact.engine.result.STATUSES`;
+    - an output ``e_z``, ``e_x``, ``beta_x`` that is NaN or infinite in a data row
+      (status ``ok``), ``e_z`` or ``e_x`` outside ``[0, 1 + 1e-6]``, ``|beta_x| > 1 + 1e-6``;
+    - an axis value that is NaN in a data row (``Q1``, ``nu``, ``theta_ratio``, ``psi``,
+      ``mu``; ``Q2`` except on Kelvin-Voigt rows, where it is NaN), or out of its domain in
+      any row: ``Q1 >= 0``, ``Q2 > 0``, ``0 <= nu <= 0.5``, ``theta_ratio > 0``,
+      ``psi >= 0``, ``mu > 0`` (``inf`` allowed);
+    - two rows at the same node (equal ``Q1``, ``Q2``, ``nu``, ``theta_ratio``, ``psi``,
+      ``mu``, ``model``: one impact recorded twice).
+
+    Parameters
+    ----------
+    data : the rows, Kelvin-Voigt rows already as ``Q2 = NaN`` (:class:`RestitutionTable`)
+    metadata : ``vimpact.*`` key -> text
+    path : the file, for the messages
+    """
+    where = f"table = {str(path)!r}" if path is not None else "the table"
+    if _META_PREFIX + "model" not in metadata:
+        raise InputError(f"{where} is not allowed: it has no vimpact metadata (no key "
+                         "vimpact.model): not a restitution table written by `vimpact sweep`")
+    status = data["status"].astype(str).to_numpy()
+    unknown = ~np.isin(status, list(STATUSES))
+    if unknown.any():
+        i = np.flatnonzero(unknown)
+        raise InputError(f"{where} is not allowed: column status = {status[i[0]]!r} at "
+                         f"{_rows_text(i)} is not a vimpact status (known: "
+                         + ", ".join(STATUSES) + ")")
+    ok = np.isin(status, DATA_STATUSES)
+    bounds = {"e_z": (0.0, 1.0 + BOUND_SLACK, "in [0, 1 + 1e-6]"),
+              "e_x": (0.0, 1.0 + BOUND_SLACK, "in [0, 1 + 1e-6]"),
+              "beta_x": (-1.0 - BOUND_SLACK, 1.0 + BOUND_SLACK, "|beta_x| <= 1 + 1e-6")}
+    for name, (lo, hi, allowed) in bounds.items():
+        v = pd.to_numeric(data[name], errors="coerce").to_numpy(float)
+        bad = ok & ~np.isfinite(v)
+        if bad.any():
+            i = np.flatnonzero(bad)
+            raise InputError(f"{where} is not allowed: column {name} = {v[i[0]]!r} at "
+                             f"{_rows_text(i)} with status ok (a data row needs a finite "
+                             f"{name})")
+        bad = ok & ((v < lo) | (v > hi))
+        if bad.any():
+            i = np.flatnonzero(bad)
+            raise InputError(f"{where} is not allowed: column {name} = {v[i[0]]!r} at "
+                             f"{_rows_text(i)} is outside its physical range ({allowed})")
+    kv = (data["model"] == "kelvin_voigt").to_numpy() if "model" in data.columns else \
+        np.zeros(len(data), dtype=bool)
+    domains = {"Q1": (lambda x: x >= 0.0, ">= 0"), "Q2": (lambda x: x > 0.0, "> 0"),
+               "nu": (lambda x: (x >= 0.0) & (x <= 0.5), "in [0, 0.5]"),
+               "theta_ratio": (lambda x: x > 0.0, "> 0"), "psi": (lambda x: x >= 0.0, ">= 0"),
+               "mu": (lambda x: x > 0.0, "> 0 (inf: full stick)")}
+    for name, (inside, allowed) in domains.items():
+        if name not in data.columns:
+            continue
+        v = pd.to_numeric(data[name], errors="coerce").to_numpy(float)
+        missing = ok & np.isnan(v) & (~kv if name == "Q2" else True)
+        if name == "Q2" and not kv.any() and np.isnan(v).all():
+            missing = np.zeros(len(v), dtype=bool)  # a Kelvin-Voigt table without model column
+        if missing.any():
+            i = np.flatnonzero(missing)
+            raise InputError(f"{where} is not allowed: column {name} = nan at {_rows_text(i)} "
+                             f"with status ok (a data row needs {name} {allowed})")
+        with np.errstate(invalid="ignore"):
+            bad = (~np.isnan(v) & ~inside(v)) | (np.isinf(v) & (name != "mu"))
+        if bad.any():
+            i = np.flatnonzero(bad)
+            raise InputError(f"{where} is not allowed: column {name} = {v[i[0]]!r} at "
+                             f"{_rows_text(i)} is outside its domain ({name} {allowed})")
+    keys = [c for c in ("Q1", "Q2", "nu", "theta_ratio", "psi", "mu", "model")
+            if c in data.columns]
+    dup = data.duplicated(subset=keys, keep=False).to_numpy()
+    if dup.any():
+        i = np.flatnonzero(dup)
+        first = data.iloc[i[0]]
+        text = data.iloc[i][keys].astype(str).agg("|".join, axis=1).to_numpy()
+        same = i[text == text[0]]
+        at = ", ".join(f"{k} = {first[k]:.6g}" if isinstance(first[k], (float, np.floating))
+                       else f"{k} = {first[k]}" for k in keys)
+        raise InputError(f"{where} is not allowed: duplicated node in columns "
+                         f"{', '.join(keys)}: {_rows_text(same, 4)} are all at {at} "
+                         "(one impact per node)")
+
+
 # --------------------------------------------------------------------------
 # the table
 # --------------------------------------------------------------------------
@@ -243,7 +391,7 @@ class RestitutionTable:
         require("data", type(data).__name__, isinstance(data, pd.DataFrame), "a pandas DataFrame")
         missing = [c for c in _REQUIRED if c not in data.columns]
         if missing:
-            raise ValueError(f"the table{self._where(path)} lacks the column(s) "
+            raise InputError(f"the table{self._where(path)} lacks the column(s) "
                              f"{', '.join(missing)}: a restitution table has "
                              f"{', '.join(_REQUIRED)} (and Q2 for a standard solid)")
         self.data = data.reset_index(drop=True)
@@ -259,7 +407,7 @@ class RestitutionTable:
                 key = _META_PREFIX + key
             self.metadata[key] = value
         if self.model == "standard_solid" and "Q2" not in self.data.columns:
-            raise ValueError(f"the standard_solid table{self._where(path)} lacks the column Q2")
+            raise InputError(f"the standard_solid table{self._where(path)} lacks the column Q2")
         self.data = _kelvin_voigt_rows(self.data, self.model)
         self._grids: dict = {}
         self._hermite: dict = {}
@@ -270,36 +418,68 @@ class RestitutionTable:
 
     # ---- reading and writing -------------------------------------------
     @classmethod
-    def open(cls, path) -> "RestitutionTable":
+    def open(cls, path, validate: bool = True) -> "RestitutionTable":
         """Read a restitution table and its ``vimpact.*`` metadata: one Parquet file, or a
         partitioned dataset written by a large sweep (a directory of part files plus
-        ``_common_metadata``, which holds the metadata)."""
+        ``_common_metadata``, which holds the metadata).
+
+        The table is checked before use: the file's integrity (page checksums and the
+        content hash, :func:`vimpact.sweep.store.verify_table`, where available), then
+        its rows (:func:`validate_table`: vimpact metadata, known statuses, finite
+        outputs within their physical bounds in data rows, axes in their domains, no
+        duplicated node). ``validate=False`` skips both (to inspect a damaged file).
+
+        Raises
+        ------
+        InputError
+            naming the file, the column and the offending value and row
+        """
         import pyarrow.parquet as pq
 
+        from vimpact.sweep import store
         from vimpact.sweep.store import COMMON_METADATA
 
         p = Path(path)
         if p.is_dir():
             if not (p / COMMON_METADATA).is_file():
-                raise ValueError(
+                raise InputError(
                     f"table = {str(path)!r} is not allowed: a directory without "
                     f"{COMMON_METADATA} (an unfinished sweep dataset: finish it with "
                     "`vimpact sweep SPEC --resume`, or --combine after shards)")
         elif not p.is_file():
-            raise ValueError(f"table = {str(path)!r} is not allowed: no such file "
+            raise InputError(f"table = {str(path)!r} is not allowed: no such file "
                              "(a Parquet restitution table written by `vimpact sweep`)")
+        integrity = getattr(store, "verify_table", None)
+        if validate and integrity is not None:
+            integrity(p)
         try:
             arrow = pq.read_table(p)
             raw = (pq.read_schema(p / COMMON_METADATA) if p.is_dir() else arrow.schema).metadata
         except Exception as exc:  # pyarrow raises several types for a bad file
             why = (str(exc).splitlines() or [""])[0]
-            raise ValueError(f"table = {str(path)!r} is not allowed: not a readable Parquet "
+            raise InputError(f"table = {str(path)!r} is not allowed: not a readable Parquet "
                              f"file ({type(exc).__name__}: {why})") from None
         meta = {k.decode(): v.decode() for k, v in (raw or {}).items()
                 if k.decode().startswith(_META_PREFIX)}
         if p.is_dir():  # the parts' schemas carry per-chunk bookkeeping
             arrow = arrow.replace_schema_metadata(None)
-        return cls(arrow.to_pandas(), meta, path=p)
+        if validate and _META_PREFIX + "model" not in meta:
+            validate_table(arrow.slice(0, 0).to_pandas(), meta, p)  # foreign: before the columns
+        table = cls(arrow.to_pandas(), meta, path=p)
+        if validate:
+            table.validate()
+        return table
+
+    def validate(self) -> "RestitutionTable":
+        """Check the rows and metadata (:func:`validate_table`); return the table.
+
+        Raises
+        ------
+        InputError
+            naming the file, the column and the offending value and row
+        """
+        validate_table(self.data, self.metadata, self.path)
+        return self
 
     def save(self, path) -> Path:
         """Write the table as Parquet with its ``vimpact.*`` metadata (what :meth:`open` reads)."""
@@ -308,6 +488,7 @@ class RestitutionTable:
 
         arrow = pa.Table.from_pandas(self.data, preserve_index=False)
         meta = dict(arrow.schema.metadata or {})
+        meta[(_META_PREFIX + "model").encode()] = self.model.encode()  # what open() requires
         meta.update({k.encode(): v.encode() for k, v in self.metadata.items()})
         pq.write_table(arrow.replace_schema_metadata(meta), path)
         return Path(path)
@@ -364,19 +545,15 @@ class RestitutionTable:
         numerics, version (JSON-serializable; ``str(table)`` is the readable form)."""
         ok = self.ok
         params = ["Q1"] + (["Q2"] if self.model == "standard_solid" else []) + ["nu"]
-        if "theta_ratio" in self.data.columns:
-            params.append("theta_ratio")
+        params += [c for c in ("theta_ratio", "psi", "mu") if c in self.data.columns]
         ranges = {}
         for p in params:
             v = ok[p].to_numpy(float) if p in ok.columns else np.array([])
-            v = v[np.isfinite(v)]
+            v = v[~np.isnan(v)] if p == "mu" else v[np.isfinite(v)]  # mu = inf: full stick
             ranges[p] = [float(v.min()), float(v.max())] if len(v) else None
-        thetas = self._theta_values() if "theta_ratio" in self.data.columns else np.array([])
         try:
-            grid = self._grid(float(thetas[0]) if len(thetas) > 1 else None)
-            grid_info, failed = grid.shape, grid.failed
-            note = (f"per theta_ratio ({len(thetas)} values; lookup takes one of them)"
-                    if len(thetas) > 1 else None)
+            grid = self._lookup_grid()
+            grid_info, failed, note = grid.shape, grid.failed, None
         except ValueError as exc:
             grid_info, failed, note = None, None, str(exc)
         spec = self.meta("spec")
@@ -416,53 +593,84 @@ class RestitutionTable:
         """The theta_ratio slice to use (None: the table has one value / no column)."""
         if "theta_ratio" not in self.data.columns:
             if theta_ratio is not None and not _same(theta_ratio, DEFAULT_THETA_RATIO):
-                raise ValueError(
+                raise InputError(
                     f"theta_ratio = {theta_ratio!r} is not allowed: the table has no theta_ratio "
                     f"column, so it is for Theta / (m R^2) = {DEFAULT_THETA_RATIO} (a solid sphere)")
             return None
         values = self._theta_values()
         if theta_ratio is None:
             if len(values) > 1:
-                raise ValueError(
+                raise InputError(
                     "theta_ratio is missing: the table holds several Theta / (m R^2) = "
                     + ", ".join(_fmt(v) for v in values) + "; give one of them")
             return None
         match = values[_same(values, theta_ratio)]
         if not len(match):
-            raise ValueError(
+            raise InputError(
                 f"theta_ratio = {theta_ratio!r} is not allowed: the table holds Theta / (m R^2) = "
                 + ", ".join(_fmt(v) for v in values) + " (no interpolation in theta_ratio)")
         return None if len(values) == 1 else float(match[0])
 
-    def _grid(self, theta: float | None) -> _Grid:
-        if theta in self._grids:
-            return self._grids[theta]
+    def _psi_values(self) -> np.ndarray:
+        """The distinct friction incidences ``psi`` of the table (empty: no psi column)."""
+        if "psi" not in self.data.columns:
+            return np.array([])
+        v = self.data["psi"].to_numpy(float)
+        return _cluster(v[np.isfinite(v)])[0] if np.isfinite(v).any() else np.array([])
+
+    def _base_axes(self) -> list[str]:
         model = self.model
         if model not in LOOKUP_MODELS:
-            raise ValueError(f"lookup needs a kelvin_voigt or standard_solid table, "
+            raise InputError(f"lookup needs a kelvin_voigt or standard_solid table, "
                              f"this one is {model!r}")
-        axes = ["Q1", "Q2", "nu"] if model == "standard_solid" else ["Q1", "nu"]
-        hint = SPEC_HINTS.get(model, "a grid sweep spec")
-        if self.meta("mode") == "random":  # the sweep records how the rows were made
-            raise ValueError(
-                "lookup needs a grid table (one row at every combination of the distinct "
-                f"{', '.join(axes)} values): this one holds random draws (vimpact.mode = "
-                f"random); make a grid with `vimpact sweep {hint}`")
+        return ["Q1", "Q2", "nu"] if model == "standard_solid" else ["Q1", "nu"]
+
+    def _grid(self, theta: float | None) -> _Grid:
+        """The grid at one ``theta_ratio`` (None: the table's only one): axes ``Q1``,
+        (``Q2``), ``nu`` and ``psi`` if the table has a psi column."""
+        if theta in self._grids:
+            return self._grids[theta]
+        axes = self._base_axes() + (["psi"] if len(self._psi_values()) else [])
         rows = self.data
         if theta is not None:
             rows = rows[_same(rows["theta_ratio"].to_numpy(float), theta)]
+        grid = self._build_grid(axes, rows)
+        self._grids[theta] = grid
+        return grid
+
+    def _lookup_grid(self) -> _Grid:
+        """The grid over every lookup axis: ``Q1``, (``Q2``), ``nu``, ``theta_ratio`` (when
+        the table holds several values), ``psi`` (when it has a psi column)."""
+        key = "all axes"
+        if key in self._grids:
+            return self._grids[key]
+        thetas = self._theta_values() if "theta_ratio" in self.data.columns else np.array([])
+        axes = (self._base_axes() + (["theta_ratio"] if len(thetas) > 1 else [])
+                + (["psi"] if len(self._psi_values()) else []))
+        grid = self._build_grid(axes, self.data)
+        self._grids[key] = grid
+        return grid
+
+    def _build_grid(self, axes: list[str], rows: pd.DataFrame) -> _Grid:
+        model = self.model
+        hint = SPEC_HINTS.get(model, "a grid sweep spec")
+        if self.meta("mode") == "random":  # the sweep records how the rows were made
+            raise InputError(
+                "lookup needs a grid table (one row at every combination of the distinct "
+                f"{', '.join(axes)} values): this one holds random draws (vimpact.mode = "
+                f"random); make a grid with `vimpact sweep {hint}`")
         coords = np.column_stack([rows[a].to_numpy(float) for a in axes])
         keep = np.all(np.isfinite(coords), axis=1)
         rows, coords = rows[keep], coords[keep]
         if not len(rows):
-            raise ValueError("lookup needs a grid table, and this one has no rows with finite "
+            raise InputError("lookup needs a grid table, and this one has no rows with finite "
                              + ", ".join(axes))
         nodes, index = zip(*(_cluster(coords[:, k]) for k in range(len(axes))))
         shape = tuple(len(n) for n in nodes)
         flat = np.ravel_multi_index(tuple(index), shape)
         covered = np.unique(flat).size
         if covered < math.prod(shape):
-            raise ValueError(
+            raise InputError(
                 f"lookup needs a grid table (one row at every combination of the distinct "
                 f"{', '.join(axes)} values): this table has {len(rows)} rows at {covered} distinct "
                 f"points but {' x '.join(f'{n} {a}' for a, n in zip(axes, shape))} distinct values "
@@ -483,22 +691,22 @@ class RestitutionTable:
                 k = int(np.flatnonzero(clash)[0])
                 where = ", ".join(f"{a} = {_fmt(n[i])}" for a, n, i in
                                   zip(axes, nodes, np.unravel_index(k, shape)))
-                raise ValueError(f"lookup needs one result per grid point, but the table has "
+                raise InputError(f"lookup needs one result per grid point, but the table has "
                                  f"{count[k]} rows with different {name} at {where}")
             with np.errstate(invalid="ignore", divide="ignore"):
                 values[name] = np.where(count > 0, total / np.maximum(count, 1), np.nan).reshape(shape)
         failed = int(np.sum(count == 0))
-        grid = _Grid(axes, list(nodes), values, failed)
-        self._grids[theta] = grid
-        return grid
+        return _Grid(axes, list(nodes), values, failed)
 
-    def _hermite_grid(self, theta: float | None):
-        """The cubic interpolant of the grid for ``theta`` (slopes computed once)."""
+    def _hermite_grid(self, theta: float | None, grid: _Grid | None = None):
+        """The cubic interpolant of the grid for ``theta`` (or of ``grid``, cached under
+        ``theta``; slopes computed once)."""
         if theta not in self._hermite:
             from vimpact.lookup.interpolate import HermiteGrid
 
-            grid = self._grid(theta)
-            self._hermite[theta] = HermiteGrid(grid.axes, grid.nodes, grid.values)
+            grid = self._grid(theta) if grid is None else grid
+            self._hermite[theta] = HermiteGrid(grid.axes, grid.nodes, grid.values,
+                                               log_axes=LOG_AXES)
         return self._hermite[theta]
 
     @property
@@ -530,18 +738,19 @@ class RestitutionTable:
         return out
 
     def lookup(self, Q1, nu, Q2=None, extrapolate: bool = False, theta_ratio=None,
-               method: str = "cubic") -> dict:
-        """Interpolate ``e_z``, ``e_x``, ``beta_x`` at ``Q1``, ``nu`` (and ``Q2``).
+               method: str = "cubic", psi=None) -> dict:
+        """Interpolate ``e_z``, ``e_x``, ``beta_x`` at ``Q1``, ``nu`` (``Q2``, ``theta_ratio``,
+        ``psi``).
 
         ``method="cubic"`` (default): tensor-product cubic Hermite in ``log Q1``,
-        ``log Q2`` and ``nu``, shape-preserving where the data is monotone
-        (:mod:`vimpact.lookup.interpolate`); ``"linear"``: multilinear (linear in
-        ``log Q1``, ``log Q2`` and ``nu``). At a grid point either returns that
-        row's values. ``e_x`` is ``|beta_x|`` of the interpolated ``beta_x``
-        (exact at grid points and right where ``beta_x`` changes sign between
-        them). Vectorized, slopes computed once per table: 1e6 points take about
-        0.5 s (Q1 x nu) and 2 s (Q1 x Q2 x nu) of one core, measured by
-        ``python -m benchmarks.lookup``.
+        ``log Q2``, ``nu``, ``log theta_ratio`` and ``psi`` (the axes the table has),
+        shape-preserving where the data is monotone (:mod:`vimpact.lookup.interpolate`,
+        evaluated by the numba kernel :func:`vimpact.kernels.hermite.hermite_eval`);
+        ``"linear"``: multilinear on the same scales. At a grid point either returns
+        that row's values. ``e_x`` is ``|beta_x|`` of the interpolated ``beta_x``
+        (exact at grid points and right where ``beta_x`` changes sign between them).
+        Slopes are computed once per table; 1e6 points take a fraction of a second of
+        one core (``python -m benchmarks.lookup`` measures it).
 
         Parameters
         ----------
@@ -554,64 +763,100 @@ class RestitutionTable:
             not allowed for a Kelvin-Voigt one
         extrapolate : bool
             outside the covered range extrapolate linearly from the edge
-            (cubic: with the end node's slope; results clipped to the physical bounds ``0 <= e_z, e_x <= 1``,
-            ``|beta_x| <= 1``) instead of raising
-        theta_ratio : float, optional
-            ``Theta / (m R^2)``; needed only when the table holds several
+            (cubic: with the end node's slope; results clipped to the physical bounds
+            ``0 <= e_z, e_x <= 1``, ``|beta_x| <= 1``) instead of raising
+        theta_ratio : float or array_like, optional
+            ``Theta / (m R^2)``, dimensionless, > 0: needed when the table holds several
+            values, and then interpolated (cubic in ``log theta_ratio``, see
+            :data:`LOG_AXES`); with one value (or no column: 0.4) only that value
         method : ``"cubic"`` (default) or ``"linear"``
+        psi : float or array_like, optional
+            friction incidence ``2 (1 - nu) / (mu (2 - nu)) v_c0 / v_z0``, dimensionless,
+            >= 0 (:func:`incidence`): an axis of a table with a ``psi`` column (needed
+            when it holds several values), interpolated linearly in ``psi``; not allowed
+            for a table without one (full stick)
 
         Returns
         -------
         dict
-            ``Q1``, (``Q2``), ``nu`` (broadcast inputs) and ``e_z``, ``e_x``,
-            ``beta_x`` (dimensionless): floats for scalar inputs, arrays of the
-            broadcast shape otherwise. NaN where the interpolation needs a grid
-            point whose impact failed. ``error_bound``: output -> the largest
-            interpolation error measured between the nodes for this method
-            (:attr:`interpolation_error`), None if the table was not verified;
-            it holds inside the covered range, not for extrapolated values.
+            ``Q1``, (``Q2``), ``nu``, (``theta_ratio``, ``psi`` when they are axes)
+            (broadcast inputs) and ``e_z``, ``e_x``, ``beta_x`` (dimensionless): floats
+            for scalar inputs, arrays of the broadcast shape otherwise. NaN where the
+            interpolation needs a grid point whose impact failed. ``error_bound``:
+            output -> the largest interpolation error measured between the nodes for
+            this method (:attr:`interpolation_error`), None if the table was not
+            verified; it holds inside the covered range, not for extrapolated values.
 
         Raises
         ------
-        ValueError
+        InputError
             outside the covered range (naming the parameter, value and range),
             for a table that is not a grid, or for ``Q2`` given to a
-            Kelvin-Voigt table / missing for a standard-solid one.
+            Kelvin-Voigt table / missing for a standard-solid one, ``psi`` given to a
+            table without a psi axis / missing for one with several.
         """
         model = self.model
         if method not in LOOKUP_METHODS:
-            raise ValueError(f"method = {method!r} is not allowed: must be one of "
+            raise InputError(f"method = {method!r} is not allowed: must be one of "
                              + ", ".join(LOOKUP_METHODS))
         if model == "kelvin_voigt" and Q2 is not None:
-            raise ValueError(f"Q2 = {Q2!r} is not allowed: this is a kelvin_voigt table "
+            raise InputError(f"Q2 = {Q2!r} is not allowed: this is a kelvin_voigt table "
                              "(e_z, e_x depend on Q1 and nu only); omit Q2 or use a "
                              "standard_solid table")
         if model == "standard_solid" and Q2 is None:
-            raise ValueError("Q2 is missing: this is a standard_solid table, lookup needs "
+            raise InputError("Q2 is missing: this is a standard_solid table, lookup needs "
                              "Q2 = G1/G2 as well as Q1 and nu")
+        psis = self._psi_values()
+        if psi is not None and not len(psis):
+            raise InputError(f"psi = {psi!r} is not allowed: the table has no psi column (it is "
+                             "for full stick, mu = inf); omit psi or use a table swept over psi")
+        if psi is None and len(psis) > 1:
+            raise InputError("psi is missing: the table holds several friction incidences psi = "
+                             + _fmt(psis[0]) + " .. " + _fmt(psis[-1]) + "; give psi (>= 0, "
+                             "2 (1 - nu) / (mu (2 - nu)) v_c0 / v_z0)")
+        thetas = self._theta_values() if "theta_ratio" in self.data.columns else np.array([])
+        theta_axis = len(thetas) > 1
+        if not theta_axis:
+            self._resolve_theta(theta_ratio)  # one value: only it (raises otherwise)
+        elif theta_ratio is None:
+            self._resolve_theta(None)  # raises: several values, give one
         named = {"Q1": Q1, "nu": nu} if Q2 is None else {"Q1": Q1, "Q2": Q2, "nu": nu}
+        if theta_axis:
+            named["theta_ratio"] = theta_ratio
+        if len(psis):
+            named["psi"] = psis[0] if psi is None else psi
         arrays = {}
         for name, value in named.items():
             try:
                 arr = np.asarray(value, dtype=float)
             except (TypeError, ValueError):
-                raise ValueError(f"{name} = {value!r} is not allowed: must be a number or "
+                raise InputError(f"{name} = {value!r} is not allowed: must be a number or "
                                  "an array of numbers") from None
             if not np.all(np.isfinite(arr)):
                 bad = float(arr[~np.isfinite(arr)].flat[0])
-                raise ValueError(f"{name} = {bad!r} is not allowed: must be finite")
+                raise InputError(f"{name} = {bad!r} is not allowed: must be finite")
+            if name in ("psi", "theta_ratio") and np.any(arr < 0.0 if name == "psi" else arr <= 0.0):
+                bad = float(arr[arr < 0.0 if name == "psi" else arr <= 0.0].flat[0])
+                raise InputError(f"{name} = {bad!r} is not allowed: must be "
+                                 + (">= 0" if name == "psi" else "> 0"))
             arrays[name] = arr
         try:
             bcast = np.broadcast_arrays(*arrays.values())
         except ValueError:
-            raise ValueError("Q1, nu" + (", Q2" if Q2 is not None else "") + " have shapes "
+            raise InputError(", ".join(arrays) + " have shapes "
                              + ", ".join(str(a.shape) for a in arrays.values())
                              + " that do not broadcast together") from None
         arrays = dict(zip(arrays, bcast))
-        theta = self._resolve_theta(theta_ratio)
-        grid = self._grid(theta)
+        # one theta_ratio node: the slice at it (a table need not be a grid across thetas)
+        theta = None
+        if theta_axis and np.ndim(theta_ratio) == 0 and _same(thetas, theta_ratio).any():
+            theta = float(thetas[_same(thetas, theta_ratio)][0])
+        if theta_axis and theta is None:
+            grid, key = self._lookup_grid(), "all axes"
+        else:
+            grid, key = self._grid(theta), theta
         if method == "cubic":
-            out = self._hermite_grid(theta)([arrays[a] for a in grid.axes], extrapolate)
+            out = self._hermite_grid(key, grid)([arrays[a] for a in grid.axes], extrapolate)
         else:
             out = grid.interpolate([arrays[a] for a in grid.axes], extrapolate)
         if extrapolate:
@@ -631,7 +876,9 @@ class RestitutionTable:
 
     def to_xarray(self, theta_ratio=None):
         """The grid as an :class:`xarray.Dataset`: data variables ``e_z``, ``e_x``,
-        ``beta_x`` (dimensionless) over the labelled axes ``Q1``, (``Q2``), ``nu``.
+        ``beta_x`` (dimensionless) over the labelled axes ``Q1``, (``Q2``), ``nu``,
+        (``theta_ratio`` when the table holds several, ``psi`` when it has a psi
+        column); ``theta_ratio`` (one of the table's values) selects that slice.
 
         Units and descriptions are attributes of each variable and axis; the
         dataset's attributes hold the model, numerics, interpolation error and
@@ -646,10 +893,13 @@ class RestitutionTable:
             raise InputError("to_xarray = xarray is not allowed here: xarray is not installed "
                              "(pip install xarray); RestitutionTable.data is the same table "
                              "as a pandas DataFrame") from None
-        grid = self._grid(self._resolve_theta(theta_ratio))
+        theta = self._resolve_theta(theta_ratio)
+        grid = self._lookup_grid() if theta is None else self._grid(theta)
         units = self.units
         described = {"Q1": "damping parameter sqrt(15/32) (eta/G_inf)/T",
                      "Q2": "G1/G2 of the standard solid", "nu": "Poisson ratio",
+                     "theta_ratio": "moment of inertia ratio Theta / (m R^2)",
+                     "psi": "friction incidence 2 (1 - nu) / (mu (2 - nu)) v_c0 / v_z0",
                      "e_z": "normal coefficient of restitution",
                      "e_x": "tangential coefficient of restitution |beta_x|",
                      "beta_x": "tangential coefficient of restitution (signed)"}
@@ -663,12 +913,15 @@ class RestitutionTable:
                  "interpolation_error": json.dumps(self.interpolation_error),
                  "vimpact_version": str(self.version),
                  "source": "" if self.path is None else str(self.path)}
+        if "mu" in self.data.columns:  # psi tables: the mu the rows were simulated with
+            attrs["mu"] = json.dumps(sorted({float(x) for x in self.data["mu"].dropna()}))
         return xr.Dataset(data_vars, coords=coords, attrs=attrs)
 
     # ---- physical curves -------------------------------------------------
     def restitution_curve(self, material, R: float, m: float, v_z0, theta_ratio=None,
-                          extrapolate: bool = False,
-                          allow_large_contact: bool = False) -> pd.DataFrame:
+                          extrapolate: bool = False, allow_large_contact: bool = False,
+                          angle_deg: float | None = None,
+                          mu: float | None = None) -> pd.DataFrame:
         """``e_z``, ``e_x``, ``beta_x`` against impact speed for one material and sphere.
 
         ``Q1`` depends on the speed through the Hertz time ``T`` (``Q1`` grows
@@ -685,42 +938,73 @@ class RestitutionTable:
         extrapolate : see :meth:`lookup`
         allow_large_contact : accept speeds whose Hertz contact radius (an
             upper bound of the contact half-width) exceeds ``0.2 R``
+        angle_deg : impact angle from the normal, degrees, in [0, 90): with ``mu``,
+            required for a table with a ``psi`` axis (friction), which it looks up at
+            ``psi = 2 (1 - nu) / (mu (2 - nu)) tan(angle)`` (:func:`incidence`, no
+            initial spin); the same at every speed
+        mu : Coulomb friction coefficient, > 0 (``inf``: full stick, ``psi = 0``); only for
+            a table with a ``psi`` axis (a table without one is for full stick)
 
         Returns
         -------
-        DataFrame with columns ``v_z0_m_s``, ``Q1``, (``Q2``), ``e_z``,
-        ``e_x``, ``beta_x``; ``attrs`` holds the units and the inputs.
+        DataFrame with columns ``v_z0_m_s``, ``Q1``, (``Q2``), (``psi``), ``e_z``,
+        ``e_x``, ``beta_x`` (at most :data:`MAX_CURVE_POINTS` speeds); ``attrs`` holds
+        the units and the inputs.
         """
         from vimpact.model.material import Material
 
         require("material", material, isinstance(material, Material), "a vimpact.Material")
         if material.model != self.model:
-            raise ValueError(f"material model {material.model!r} does not match the table's "
+            raise InputError(f"material model {material.model!r} does not match the table's "
                              f"model {self.model!r}")
         R, m = positive("R", R), positive("m", m)
         speeds = np.atleast_1d(np.asarray(v_z0, dtype=float)).ravel()
         require("v_z0", v_z0, speeds.size > 0, "at least one speed (m/s)")
+        if speeds.size > MAX_CURVE_POINTS:
+            raise InputError(f"v_z0 = {speeds.size} speeds is not allowed: at most "
+                             f"{MAX_CURVE_POINTS} points per curve")
+        psi = None
+        if len(self._psi_values()):
+            if angle_deg is None or mu is None:
+                missing = " and ".join(n for n, x in (("angle_deg", angle_deg), ("mu", mu))
+                                       if x is None)
+                raise InputError(f"{missing} missing: the table has a friction incidence axis "
+                                 "psi, so the curve needs the impact angle from the normal "
+                                 "(degrees) and the friction coefficient mu")
+            psi = incidence(angle_deg, mu, material.nu)
+        else:
+            if mu is not None and not math.isinf(float(mu)):
+                raise InputError(f"mu = {mu!r} is not allowed: the table has no psi column (it "
+                                 "is for full stick, mu = inf); use a table swept over psi")
+            if angle_deg is not None:
+                incidence(angle_deg, math.inf, material.nu)  # range check only: under full
+                # stick beta_x does not depend on the angle
         scenes = [Scene(material, R=R, m=m, v_z0=float(v), allow_large_contact=True) for v in speeds]
         if not allow_large_contact:
             big = [s for s in scenes if s.hertz.a_H > HALF_SPACE_LIMIT * R]
             if big:
                 s = big[0]
-                raise ValueError(
+                raise InputError(
                     f"v_z0 = {s.v_z0:.6g} m/s is not allowed: its Hertz contact radius "
                     f"{s.hertz.a_H:.4g} m exceeds 0.2 R = {HALF_SPACE_LIMIT * R:.4g} m (outside "
                     "the half-space model; allow_large_contact=True / --allow-large-contact "
                     "accepts it)")
         q1 = np.array([s.Q1 for s in scenes])
         q2 = np.array([s.Q2 for s in scenes]) if self.model == "standard_solid" else None
-        res = self.lookup(q1, material.nu, q2, extrapolate=extrapolate, theta_ratio=theta_ratio)
+        res = self.lookup(q1, material.nu, q2, extrapolate=extrapolate, theta_ratio=theta_ratio,
+                          psi=None if psi is None else np.full(len(q1), psi))
         columns = {"v_z0_m_s": speeds, "Q1": q1}
         if q2 is not None:
             columns["Q2"] = q2
+        if psi is not None:
+            columns["psi"] = np.full(len(q1), psi)
         columns.update({k: res[k] for k in OUTPUTS})
         df = pd.DataFrame(columns)
         df.attrs.update({
             "units": {"v_z0_m_s": "m/s", **{k: "1" for k in columns if k != "v_z0_m_s"}},
             "model": material.model, "nu": material.nu, "R_m": R, "m_kg": m,
+            "angle_deg": None if angle_deg is None else float(angle_deg),
+            "mu": None if mu is None else float(mu),
             "table": None if self.path is None else str(self.path),
         })
         return df
