@@ -322,13 +322,13 @@ def validate_table(data: pd.DataFrame, metadata: dict, path=None) -> None:
         bad = ok & ~np.isfinite(v)
         if bad.any():
             i = np.flatnonzero(bad)
-            raise InputError(f"{where} is not allowed: column {name} = {v[i[0]]!r} at "
+            raise InputError(f"{where} is not allowed: column {name} = {_fmt(v[i[0]])} at "
                              f"{_rows_text(i)} with status ok (a data row needs a finite "
                              f"{name})")
         bad = ok & ((v < lo) | (v > hi))
         if bad.any():
             i = np.flatnonzero(bad)
-            raise InputError(f"{where} is not allowed: column {name} = {v[i[0]]!r} at "
+            raise InputError(f"{where} is not allowed: column {name} = {_fmt(v[i[0]])} at "
                              f"{_rows_text(i)} is outside its physical range ({allowed})")
     kv = (data["model"] == "kelvin_voigt").to_numpy() if "model" in data.columns else \
         np.zeros(len(data), dtype=bool)
@@ -351,7 +351,7 @@ def validate_table(data: pd.DataFrame, metadata: dict, path=None) -> None:
             bad = (~np.isnan(v) & ~inside(v)) | (np.isinf(v) & (name != "mu"))
         if bad.any():
             i = np.flatnonzero(bad)
-            raise InputError(f"{where} is not allowed: column {name} = {v[i[0]]!r} at "
+            raise InputError(f"{where} is not allowed: column {name} = {_fmt(v[i[0]])} at "
                              f"{_rows_text(i)} is outside its domain ({name} {allowed})")
     keys = [c for c in ("Q1", "Q2", "nu", "theta_ratio", "psi", "mu", "model")
             if c in data.columns]
@@ -359,8 +359,8 @@ def validate_table(data: pd.DataFrame, metadata: dict, path=None) -> None:
     if dup.any():
         i = np.flatnonzero(dup)
         first = data.iloc[i[0]]
-        text = data.iloc[i][keys].astype(str).agg("|".join, axis=1).to_numpy()
-        same = i[text == text[0]]
+        hashed = pd.util.hash_pandas_object(data.iloc[i][keys], index=False).to_numpy()
+        same = i[hashed == hashed[0]]
         at = ", ".join(f"{k} = {first[k]:.6g}" if isinstance(first[k], (float, np.floating))
                        else f"{k} = {first[k]}" for k in keys)
         raise InputError(f"{where} is not allowed: duplicated node in columns "
