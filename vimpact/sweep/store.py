@@ -23,6 +23,17 @@ package and schema version), its chunk and row range, and a small summary
 (rows per status, rows and first row per kernel path) that the combination
 merges without reading the data again.
 
+Integrity: every part and every table is written with Parquet page checksums
+(CRC-32 of each page) and a content hash ``vimpact.content_sha256``
+(:class:`ContentHash`: SHA-256 of the column values in a canonical form,
+independent of the Parquet encoding). A part is trusted only after
+:func:`verify_part` has read it back (page checksums checked, hash
+recomputed): ``--resume`` moves a part that fails to ``<parts>/_corrupt/`` (one
+line on stderr names it and the reason) and computes it again; the combination
+verifies every part, then the table it wrote (:func:`verify_table`), before it
+removes any part. A table without a stored hash (written before it existed) is
+accepted with the hash check skipped.
+
 Metadata: the Parquet key-value metadata ``vimpact.<key>``; one codec
 (:func:`encode_metadata`, :func:`decode_metadata`) decides which keys are JSON
 (:data:`JSON_KEYS`) and which integers (:data:`INT_KEYS`); the sweep and
@@ -31,10 +42,14 @@ Metadata: the Parquet key-value metadata ``vimpact.<key>``; one codec
 
 from __future__ import annotations
 
+import hashlib
 import json
 import os
 import socket
+import sys
 from pathlib import Path
+
+from vimpact.model.validation import InputError
 
 #: Prefix of every key-value metadata key vimpact writes.
 META_PREFIX = "vimpact."
@@ -45,6 +60,12 @@ INT_KEYS = ("schema_version", "seed", "rows", "chunk", "row_start", "row_stop", 
             "chunk_size")
 #: Name of the dataset file that holds the schema and the sweep metadata.
 COMMON_METADATA = "_common_metadata"
+#: Metadata key (without the prefix) of the content hash (:class:`ContentHash`).
+CONTENT_HASH_KEY = "content_sha256"
+#: First line hashed by :class:`ContentHash`: names the definition (change it with it).
+CONTENT_HASH_VERSION = "vimpact content sha256 v1"
+#: Subdirectory of the parts directory that damaged parts are moved to.
+CORRUPT_DIR = "_corrupt"
 
 
 # ---- metadata codec --------------------------------------------------------------
@@ -120,6 +141,318 @@ def summary(path) -> dict[str, int]:
     return {c["values"]: int(c["counts"]) for c in sorted(counts, key=lambda c: c["values"])}
 
 
+# ---- content hash ----------------------------------------------------------------
+
+class ContentHash:
+    """SHA-256 of a table's values in a canonical form, independent of the Parquet
+    encoding (compression, dictionary or plain pages, row groups, Arrow chunks,
+    ``string`` or ``large_string``, nullability flags).
+
+    Definition (version :data:`CONTENT_HASH_VERSION`). Every column has three byte
+    streams over its rows in row order:
+
+    - validity: one byte per row, ``1`` a value, ``0`` a null;
+    - values: fixed-width types (integers, floats, booleans as one byte) the
+      value's little-endian bytes as stored (NaN payloads included), ``0`` for a
+      null; strings and binaries the byte length as little-endian ``int64``, ``0``
+      for a null; a column of Arrow type ``null`` eight zero bytes per row (the
+      same as an all-null ``int64``, ``float64`` or string column);
+    - data: strings and binaries the concatenated bytes of the values (UTF-8);
+      empty for the other types.
+
+    The hash is SHA-256 over the UTF-8 text ``"vimpact content sha256 v1\\n"``,
+    ``"rows <n>\\n"``, then for each column in table order ``"column <name>\\n"``
+    followed by the three 32-byte SHA-256 digests of its streams. Feeding the
+    rows in pieces (:meth:`update` once per part or row group) gives the hash of
+    the whole, so a table is hashed with memory bounded by its largest piece.
+    Stored as the metadata ``vimpact.content_sha256`` (64 hex digits).
+    """
+
+    def __init__(self, names=None):
+        self.names: list[str] | None = list(names) if names is not None else None
+        self.rows = 0
+        self._streams: list[tuple] = []
+
+    def update(self, table) -> "ContentHash":
+        """Add the rows of the ``pyarrow`` table (or record batch) ``table``: same
+        column names, in the same order, as the rows before."""
+        names = list(table.column_names)
+        if self.names is None:
+            self.names = names
+        if names != self.names:
+            raise ValueError(f"content hash: columns {names} differ from {self.names}")
+        if not self._streams:
+            self._streams = [(hashlib.sha256(), hashlib.sha256(), hashlib.sha256())
+                             for _ in names]
+        for column, streams in zip(table.columns, self._streams):
+            for stream, piece in zip(streams, _canonical(column)):
+                stream.update(piece)
+        self.rows += table.num_rows
+        return self
+
+    def hexdigest(self) -> str:
+        """The hash (64 hex digits) of the rows added so far."""
+        h = hashlib.sha256(f"{CONTENT_HASH_VERSION}\nrows {self.rows}\n".encode())
+        names = self.names or []
+        streams = self._streams or [(hashlib.sha256(),) * 3 for _ in names]
+        for name, (valid, values, data) in zip(names, streams):
+            h.update(f"column {name}\n".encode())
+            for stream in (valid, values, data):
+                h.update(stream.digest())
+        return h.hexdigest()
+
+
+def content_hash(table) -> str:
+    """The :class:`ContentHash` of one ``pyarrow`` table (64 hex digits)."""
+    return ContentHash().update(table).hexdigest()
+
+
+def _canonical(column) -> tuple[bytes, bytes, bytes]:
+    """The validity, values and data bytes of one column (see :class:`ContentHash`)."""
+    import numpy as np
+    import pyarrow as pa
+    import pyarrow.compute as pc
+
+    if isinstance(column, pa.ChunkedArray):
+        column = (column.combine_chunks() if column.num_chunks
+                  else pa.array([], type=column.type))
+    if pa.types.is_dictionary(column.type):
+        column = column.dictionary_decode()
+    n = len(column)
+    kind = column.type
+    if pa.types.is_null(kind):
+        return bytes(n), bytes(8 * n), b""
+    valid = np.asarray(column.is_valid().to_numpy(zero_copy_only=False), dtype=np.uint8)
+    if (pa.types.is_string(kind) or pa.types.is_large_string(kind) or pa.types.is_binary(kind)
+            or pa.types.is_large_binary(kind) or pa.types.is_string_view(kind)
+            or pa.types.is_binary_view(kind)):
+        filled = pc.fill_null(column, "" if "string" in str(kind) else b"")
+        flat = filled.cast(pa.large_binary())
+        offsets_buf, data_buf = flat.buffers()[1], flat.buffers()[2]
+        offsets = np.frombuffer(offsets_buf, dtype="<i8")[flat.offset:flat.offset + n + 1]
+        lengths = np.diff(offsets).astype("<i8")
+        data = (data_buf.to_pybytes()[offsets[0]:offsets[-1]] if n and data_buf is not None
+                else b"")
+        return valid.tobytes(), lengths.tobytes(), data
+    if pa.types.is_boolean(kind):
+        values = np.asarray(pc.fill_null(column, False).to_numpy(zero_copy_only=False),
+                            dtype=np.uint8)
+        return valid.tobytes(), values.tobytes(), b""
+    if pa.types.is_integer(kind) or pa.types.is_floating(kind):
+        values = pc.fill_null(column, 0).to_numpy(zero_copy_only=False)
+        values = values.astype(values.dtype.newbyteorder("<"), copy=False)
+        return valid.tobytes(), values.tobytes(), b""
+    raise ValueError(f"content hash: column type {kind} is not supported")
+
+
+# ---- verification ------------------------------------------------------------------
+
+class _Damaged(Exception):
+    """A file that fails verification; the message says what failed (one line)."""
+
+
+def _first_line(exc: BaseException) -> str:
+    text = (str(exc).strip().splitlines() or [""])[0]
+    return f"{type(exc).__name__}: {text}" if text else type(exc).__name__
+
+
+def _open_checked(path: Path):
+    """``pyarrow.parquet.ParquetFile`` of ``path`` with page checksum verification,
+    or :class:`_Damaged` (missing, truncated, not Parquet, footer unreadable)."""
+    import pyarrow.parquet as pq
+    path = Path(path)
+    try:
+        size = path.stat().st_size
+        with open(path, "rb") as f:
+            head = f.read(4)
+            f.seek(max(0, size - 4))
+            tail = f.read(4)
+    except OSError as exc:
+        raise _Damaged(f"unreadable ({_first_line(exc)})") from None
+    if size == 0:
+        raise _Damaged("empty file (0 bytes)")
+    if head != b"PAR1":
+        raise _Damaged("not a Parquet file (no PAR1 magic at the start)")
+    if tail != b"PAR1":
+        raise _Damaged(f"truncated ({size} bytes, no Parquet footer at the end)")
+    try:
+        return pq.ParquetFile(path, page_checksum_verification=True)
+    except Exception as exc:  # noqa: BLE001 - pyarrow raises several types for a bad footer
+        raise _Damaged(f"footer unreadable ({_first_line(exc)})") from None
+
+
+def _scan(path: Path, hasher: ContentHash | None = None) -> tuple[dict, str, int]:
+    """Read every row group of the Parquet file ``path`` with page checksums checked.
+
+    Returns the decoded ``vimpact.*`` metadata, the :class:`ContentHash` of the
+    data and the number of rows; ``hasher`` (optional) receives the rows too.
+    Raises :class:`_Damaged` for a file that cannot be read back or whose stored
+    hash (if any) differs from its data."""
+    pf = _open_checked(path)
+    try:
+        meta = decode_metadata(pf.schema_arrow.metadata)
+    except Exception as exc:  # noqa: BLE001
+        raise _Damaged(f"schema unreadable ({_first_line(exc)})") from None
+    own = ContentHash(pf.schema_arrow.names)
+    for group in range(pf.metadata.num_row_groups):
+        try:
+            table = pf.read_row_group(group)
+        except Exception as exc:  # noqa: BLE001 - CRC, decompression, thrift errors
+            why = _first_line(exc)
+            what = "page checksum failed" if "checksum" in why.lower() else "data unreadable"
+            raise _Damaged(f"{what} in row group {group} ({why})") from None
+        own.update(table)
+        if hasher is not None:
+            hasher.update(table)
+    digest = own.hexdigest()
+    stored = meta.get(CONTENT_HASH_KEY)
+    if stored is not None and stored != digest:
+        raise _Damaged(f"content hash mismatch (stored {str(stored)[:12]}..., "
+                       f"data {digest[:12]}...)")
+    return meta, digest, own.rows
+
+
+def _check_part(path: Path, spec, hasher: ContentHash | None = None) -> tuple[str, str | None]:
+    """``("ok", None)``, ``("foreign", why)`` for a part of another sweep (its own
+    vimpact metadata, another sweep hash) or ``("bad", why)``."""
+    path = Path(path)
+    try:
+        pf = _open_checked(path)
+        meta = decode_metadata(pf.schema_arrow.metadata)
+    except _Damaged as exc:
+        return "bad", str(exc)
+    except Exception as exc:  # noqa: BLE001
+        return "bad", f"schema unreadable ({_first_line(exc)})"
+    got = meta.get("sweep_hash")
+    if not got:
+        return "bad", "not a part of a vimpact sweep (no vimpact.sweep_hash metadata)"
+    if got != spec.sweep_hash:
+        return "foreign", (f"belongs to another sweep (a different spec, numerics or vimpact "
+                           f"version: hash {str(got)[:12]} != {spec.sweep_hash[:12]})")
+    chunk = meta.get("chunk")
+    if not isinstance(chunk, int) or not 0 <= chunk < spec.n_chunks \
+            or path.name != part_path(path.parent, chunk, spec.n_chunks).name:
+        return "bad", f"holds chunk {chunk}, not the chunk its name says"
+    start, stop = spec.chunk_rows(chunk)
+    if (meta.get("row_start"), meta.get("row_stop"), meta.get("n_chunks")) \
+            != (start, stop, spec.n_chunks):
+        return "bad", (f"row range {meta.get('row_start')}..{meta.get('row_stop')} is not "
+                       f"chunk {chunk}'s {start}..{stop}")
+    if CONTENT_HASH_KEY not in meta:
+        return "bad", "no content hash (written before parts were verified)"
+    if list(pf.schema_arrow.names) != list(spec.columns()):
+        return "bad", "its columns are not this sweep's"
+    if rows_in_footer(pf) != stop - start:
+        return "bad", f"holds {rows_in_footer(pf)} rows, chunk {chunk} has {stop - start}"
+    try:
+        _, _, rows = _scan(path, hasher)
+    except _Damaged as exc:
+        return "bad", str(exc)
+    if rows != stop - start:
+        return "bad", f"holds {rows} rows, chunk {chunk} has {stop - start}"
+    return "ok", None
+
+
+def rows_in_footer(pf) -> int:
+    """Number of rows a ``pyarrow.parquet.ParquetFile``'s footer declares."""
+    return int(pf.metadata.num_rows)
+
+
+def verify_part(path, spec) -> str | None:
+    """Why the part file ``path`` cannot be used by the sweep ``spec``, or ``None``.
+
+    Checks, in order: readable Parquet with its footer (not truncated); vimpact
+    sweep metadata with this sweep's hash; the chunk and row range its name says;
+    a stored content hash; this sweep's columns; every page read back with its
+    checksum verified; the content hash recomputed from the data equal to the
+    stored one; the chunk's number of rows. Returns a one-line reason such as
+    ``"page checksum failed in row group 0 (...)"`` or ``"truncated (...)"``.
+    """
+    return _check_part(Path(path), spec)[1]
+
+
+def verify_table(path) -> str:
+    """Check that the table at ``path`` (a Parquet file, or a dataset directory) reads
+    back as it was written; raise :class:`~vimpact.model.validation.InputError` naming
+    the file and what failed otherwise.
+
+    Checks: the file exists, is Parquet and not truncated (footer present); it has
+    ``vimpact.*`` metadata (else: foreign); every page reads back, with its CRC-32
+    verified where the writer stored one (vimpact writes them since
+    ``vimpact.content_sha256`` exists); the :class:`ContentHash` recomputed from the
+    data equals ``vimpact.content_sha256``. A dataset: ``_common_metadata``
+    present, no file other than its parts, every part checked so, their rows
+    adding up to ``vimpact.rows``, and the hash over the parts in order equal to
+    the one in ``_common_metadata``.
+
+    A table without a stored content hash (written before vimpact stored one, e.g.
+    a shipped table not yet regenerated) is accepted with the hash check skipped;
+    the returned text says so. Memory: one row group (part) at a time.
+
+    Returns
+    -------
+    str
+        What was checked, e.g. ``"ok: 612 rows, 1 row group(s), content hash
+        verified"`` or ``"... no content hash stored (an older table): hash check
+        skipped"``.
+    """
+    path = Path(path)
+    where = f"table = {str(path)!r} is not allowed"
+    if not path.exists():
+        raise InputError(f"{where}: no such file or directory")
+    try:
+        if path.is_dir():
+            rows, groups, stored = _verify_dataset(path)
+        else:
+            meta, _, rows = _scan(path)
+            if not meta:
+                raise _Damaged("not a vimpact table (no vimpact.* metadata)")
+            groups = _open_checked(path).metadata.num_row_groups
+            stored = CONTENT_HASH_KEY in meta
+    except _Damaged as exc:
+        raise InputError(f"{where}: it fails the integrity check: {exc}") from None
+    text = f"ok: {rows} rows, {groups} row group(s), page checksums checked where stored, "
+    return text + ("content hash verified" if stored else
+                   "no content hash stored (an older table): hash check skipped")
+
+
+def _verify_dataset(path: Path) -> tuple[int, int, bool]:
+    common = path / COMMON_METADATA
+    if not common.is_file():
+        raise _Damaged(f"an unfinished sweep dataset (no {COMMON_METADATA})")
+    try:
+        import pyarrow.parquet as pq
+        meta = decode_metadata(pq.read_schema(common).metadata)
+    except Exception as exc:  # noqa: BLE001
+        raise _Damaged(f"{COMMON_METADATA} unreadable ({_first_line(exc)})") from None
+    if not meta:
+        raise _Damaged(f"not a vimpact table (no vimpact.* metadata in {COMMON_METADATA})")
+    parts = []
+    for entry in sorted(path.iterdir()):
+        if entry.name.startswith((".", "_")):
+            continue  # not read as data (pyarrow ignores these names too)
+        if not (entry.is_file() and entry.name.startswith("part-")
+                and entry.name.endswith(".parquet")):
+            raise _Damaged(f"{entry.name} is not one of its parts (move it out of the "
+                           "dataset directory)")
+        parts.append(entry)
+    whole = ContentHash()
+    for part in parts:
+        try:
+            _scan(part, whole)
+        except _Damaged as exc:
+            raise _Damaged(f"part {part.name}: {exc}") from None
+        except ValueError as exc:  # other columns than the parts before
+            raise _Damaged(f"part {part.name}: {exc}") from None
+    if isinstance(meta.get("rows"), int) and meta["rows"] != whole.rows:
+        raise _Damaged(f"its parts hold {whole.rows} rows, its metadata says {meta['rows']}")
+    stored = meta.get(CONTENT_HASH_KEY)
+    if stored is not None and stored != whole.hexdigest():
+        raise _Damaged(f"content hash over the parts mismatch (stored {str(stored)[:12]}..., "
+                       f"data {whole.hexdigest()[:12]}...)")
+    return whole.rows, len(parts), stored is not None
+
+
 # ---- atomic files ----------------------------------------------------------------
 
 def fsync_dir(path: Path) -> None:
@@ -136,28 +469,51 @@ def fsync_dir(path: Path) -> None:
         os.close(fd)
 
 
-def write_atomic(table, path: Path, *, schema_only: bool = False, more=()) -> None:
+def write_atomic(table, path: Path, *, schema_only: bool = False, more=(),
+                 content_sha256: str | None = None) -> None:
     """Write the ``pyarrow`` ``table`` (or only its schema) to ``path``: a temporary
     file in the same directory, fsync, ``os.replace``, fsync of the directory.
-    ``more``: further tables (same schema) appended one row group each, read one
-    at a time, so that memory stays bounded by the largest of them."""
+
+    Data is written with Parquet page checksums and the metadata
+    ``vimpact.content_sha256`` (:class:`ContentHash`), computed here from
+    ``table``, or given as ``content_sha256`` (required with ``more``: the hash of
+    all rows, which the caller computed while verifying them). ``more``: further
+    tables (same schema) appended one row group each, read one at a time, so that
+    memory stays bounded by the largest of them. ``schema_only``: the schema with
+    its metadata as it is (a dataset's ``_common_metadata``).
+
+    Raises ``OSError`` naming ``path`` when the write fails (e.g. ``ENOSPC``, disk
+    full); the temporary file is removed and an earlier ``path`` stays as it was.
+    """
     import pyarrow.parquet as pq
     path = Path(path)
+    if not schema_only:
+        if content_sha256 is None:
+            if more:
+                raise ValueError("write_atomic: give content_sha256 (the hash of all rows) "
+                                 "with more")
+            content_sha256 = content_hash(table)
+        meta = dict(table.schema.metadata or {})
+        meta[(META_PREFIX + CONTENT_HASH_KEY).encode()] = content_sha256.encode()
+        table = table.replace_schema_metadata(meta)
     tmp = path.with_name(f".{path.name}.{socket.gethostname()}.{os.getpid()}.tmp")
     try:
         with open(tmp, "wb") as f:
             if schema_only:
                 pq.write_metadata(table.schema, f)
             elif more:
-                with pq.ParquetWriter(f, table.schema) as writer:
+                with pq.ParquetWriter(f, table.schema, write_page_checksum=True) as writer:
                     writer.write_table(table)
                     for other in more:
                         writer.write_table(other.replace_schema_metadata(table.schema.metadata))
             else:
-                pq.write_table(table, f)
+                pq.write_table(table, f, write_page_checksum=True)
             f.flush()
             os.fsync(f.fileno())
         os.replace(tmp, path)
+    except OSError as exc:
+        raise OSError(exc.errno, f"{exc.strerror or _first_line(exc)} while writing "
+                      f"{path}") from exc
     finally:
         if tmp.exists():
             tmp.unlink()
@@ -189,49 +545,95 @@ def part_path(parts: Path, chunk: int, n_chunks: int) -> Path:
 
 
 def existing_parts(spec, parts: Path) -> dict[int, Path]:
-    """Finished chunks in ``parts`` (removing temporaries of writes cut short);
-    refuses parts of another sweep."""
-    import pyarrow.parquet as pq
+    """Finished chunks in ``parts``, each verified (:func:`verify_part`), after removing
+    temporaries of writes cut short.
+
+    A part that fails (damaged, truncated, not a vimpact part, the wrong chunk) is
+    treated as missing: it is moved to ``<parts>/_corrupt/`` (never deleted) with
+    one line on stderr naming it and the reason, and ``--resume`` computes it
+    again. Parts of another sweep (their own vimpact metadata with another sweep
+    hash) are refused (``ValueError``): the output is probably the wrong one. In a
+    dataset directory a file that is not one of its parts is refused too (it
+    would be read as table rows).
+    """
+    return _existing_parts(spec, parts)
+
+
+def _existing_parts(spec, parts: Path, hasher: ContentHash | None = None) -> dict[int, Path]:
+    """:func:`existing_parts`; ``hasher`` receives the rows of the good parts in chunk
+    order (the content hash of the table when no chunk is missing)."""
     found: dict[int, Path] = {}
     if not parts.is_dir():
         return found
     remove_temporaries(parts)
+    if spec.table_layout == "dataset":
+        for entry in sorted(parts.iterdir()):
+            if entry.name.startswith((".", "_")) or (
+                    entry.is_file() and entry.name.startswith("part-")
+                    and entry.name.endswith(".parquet")):
+                continue
+            raise ValueError(f"{entry} is in the way: it is not a part of this sweep and "
+                             f"would be read as rows of the dataset {parts}; move it away")
     for path in sorted(parts.glob("part-*.parquet")):
-        try:
-            meta = decode_metadata(pq.read_schema(path).metadata)
-        except Exception:  # noqa: BLE001 - an unreadable part is computed again
-            import sys
-            print(f"vimpact sweep: {path} is unreadable; computing it again", file=sys.stderr)
-            path.unlink()
+        kind, why = _check_part(path, spec, hasher)
+        if kind == "foreign":
+            raise ValueError(f"{path} {why}; remove {parts} to start over")
+        if kind == "bad":
+            aside = move_aside(path)
+            print(f"vimpact sweep: {path.name} {_as_phrase(why)}; moved to {aside}, "
+                  "computing it again", file=sys.stderr)
             continue
-        got = meta.get("sweep_hash", "")
-        if got != spec.sweep_hash:
-            raise ValueError(
-                f"{path} belongs to another sweep (a different spec, numerics or vimpact "
-                f"version: hash {got[:12] or 'missing'} != {spec.sweep_hash[:12]}); "
-                f"remove {parts} to start over")
-        chunk = meta.get("chunk")
-        if not isinstance(chunk, int) or not 0 <= chunk < spec.n_chunks \
-                or path != part_path(parts, chunk, spec.n_chunks):
-            raise ValueError(f"{path} does not fit this sweep (chunk {chunk}); "
-                             f"remove {parts} to start over")
-        found[chunk] = path
+        found[int(path.name[len("part-"):-len(".parquet")])] = path
     return found
 
 
+def _as_phrase(why: str) -> str:
+    """``"is truncated (...)"``, ``"fails: content hash mismatch (...)"``: a reason as the
+    rest of a sentence whose subject is the file."""
+    starts = ("truncated", "empty", "not ", "unreadable")
+    return ("is " if why.startswith(starts) else "fails: ") + why
+
+
+def move_aside(path: Path) -> Path:
+    """Move a damaged file to ``<its directory>/_corrupt/`` (a new name if one is there
+    already) and return where it went; nothing is deleted."""
+    path = Path(path)
+    target_dir = path.parent / CORRUPT_DIR
+    target_dir.mkdir(exist_ok=True)
+    target = target_dir / path.name
+    k = 1
+    while target.exists():
+        target = target_dir / f"{path.stem}.{k}{path.suffix}"
+        k += 1
+    os.replace(path, target)
+    fsync_dir(path.parent)
+    return target
+
+
 def write_part(spec, table, parts: Path, chunk: int, summary_: dict) -> Path:
-    """Write the table of ``chunk`` atomically with the sweep metadata, its row range
-    and its summary (``counts``, ``paths``)."""
+    """Write the table of ``chunk`` atomically with the sweep metadata, its row range,
+    its summary (``counts``, ``paths``), page checksums and its content hash.
+
+    A failed write (e.g. disk full) raises ``OSError`` saying that the finished
+    parts are kept and how to continue."""
     start, stop = spec.chunk_rows(chunk)
     meta = {**spec.metadata(), "chunk": chunk, "row_start": start, "row_stop": stop,
             "n_chunks": spec.n_chunks, **summary_}
     path = part_path(parts, chunk, spec.n_chunks)
-    write_atomic(table.replace_schema_metadata(encode_metadata(meta)), path)
+    try:
+        write_atomic(table.replace_schema_metadata(encode_metadata(meta)), path)
+    except OSError as exc:
+        raise OSError(exc.errno, f"{exc.strerror}; the finished chunks are kept in {parts}: "
+                      "make room and continue with --resume") from exc
     return path
 
 
 def is_complete(spec, out: Path) -> bool:
-    """``out`` is the finished table of ``spec`` (same sweep hash)."""
+    """``out`` is the finished table of ``spec`` (same sweep hash) and passes
+    :func:`verify_table`. A finished table that fails is not complete: one line on
+    stderr says why; a file is moved to ``<out>.corrupt`` (a dataset keeps its
+    place: :func:`existing_parts` moves its damaged parts aside), so that the run
+    writes it again."""
     import pyarrow.parquet as pq
     target = schema_path(out)
     if not target.is_file():
@@ -240,20 +642,35 @@ def is_complete(spec, out: Path) -> bool:
         meta = decode_metadata(pq.read_schema(target).metadata)
     except Exception:  # noqa: BLE001
         return False
-    return meta.get("sweep_hash") == spec.sweep_hash and "paths" in meta
+    if not (meta.get("sweep_hash") == spec.sweep_hash and "paths" in meta):
+        return False
+    try:
+        verify_table(out)
+    except InputError as exc:
+        note = ""
+        if Path(out).is_file():
+            aside = Path(out).with_name(Path(out).name + ".corrupt")
+            os.replace(out, aside)
+            note = f"; moved to {aside}"
+        print(f"vimpact sweep: {exc}{note}; computing it again", file=sys.stderr)
+        return False
+    return True
 
 
 def combine(spec, parts: Path, out: Path, explain_paths) -> None:
-    """Finish the table from the parts: check that every chunk is there and that they
-    add up to rows ``0 .. rows-1``; merge the part summaries into the ``paths``
-    metadata (``explain_paths(first_rows) -> {path: reasons}``); then write ``OUT``
-    (file: the parts concatenated, parts removed) or ``OUT/_common_metadata``
-    (dataset)."""
-    import shutil
-
+    """Finish the table from the parts: verify every part (:func:`existing_parts`:
+    a damaged one is moved aside and reported missing), check that every chunk is
+    there and that they add up to rows ``0 .. rows-1``; merge the part summaries
+    into the ``paths`` metadata (``explain_paths(first_rows) -> {path: reasons}``);
+    then write ``OUT`` (file: the parts concatenated with page checksums and the
+    content hash of all rows) or ``OUT/_common_metadata`` (dataset, with the
+    content hash over its parts), verify what was written (:func:`verify_table`)
+    and only then remove the parts (file layout; damaged parts moved aside stay
+    in ``<parts>/_corrupt``)."""
     import pyarrow.parquet as pq
 
-    found = existing_parts(spec, parts)
+    whole = ContentHash()
+    found = _existing_parts(spec, parts, whole)
     missing = [c for c in range(spec.n_chunks) if c not in found]
     if missing:
         shown = ", ".join(map(str, missing[:10])) + (" ..." if len(missing) > 10 else "")
@@ -274,17 +691,45 @@ def combine(spec, parts: Path, out: Path, explain_paths) -> None:
             paths[name]["rows"] += entry["rows"]
     reasons = explain_paths({name: e["first_row"] for name, e in paths.items()})
     paths = {name: {**e, "reasons": reasons[name]} for name, e in paths.items()}
-    meta = encode_metadata({**spec.metadata(), "paths": paths})
+    digest = whole.hexdigest()
     if spec.table_layout == "dataset":
+        meta = encode_metadata({**spec.metadata(), "paths": paths, CONTENT_HASH_KEY: digest})
         write_atomic(spec.schema().empty_table().replace_schema_metadata(meta),
                      out / COMMON_METADATA, schema_only=True)
+        _verify_written(out, parts)
         return
+    meta = encode_metadata({**spec.metadata(), "paths": paths})
     # one row group per part, read one at a time: memory bounded by the chunk size
-    first = pq.read_table(found[0]).replace_schema_metadata(meta)
-    rest = (pq.read_table(found[c]) for c in range(1, spec.n_chunks))
+
+    def read(chunk):
+        return pq.read_table(found[chunk], page_checksum_verification=True)
+    first = read(0).replace_schema_metadata(meta)
+    rest = (read(c) for c in range(1, spec.n_chunks))
     out.parent.mkdir(parents=True, exist_ok=True)
-    write_atomic(first, out, more=rest)
-    shutil.rmtree(parts)
+    try:
+        write_atomic(first, out, more=rest, content_sha256=digest)
+    except OSError as exc:
+        raise OSError(exc.errno, f"{exc.strerror}; the finished chunks are kept in {parts}: "
+                      "make room and continue with --resume") from exc
+    _verify_written(out, parts)
+    for chunk in range(spec.n_chunks):
+        found[chunk].unlink()
+    remove_temporaries(parts)
+    try:
+        parts.rmdir()
+    except OSError:  # something else is there (damaged parts moved aside): kept
+        print(f"vimpact sweep: {parts} is kept: it holds files that are not finished parts "
+              f"({', '.join(sorted(p.name for p in parts.iterdir()))})", file=sys.stderr)
+    fsync_dir(parts.parent)
+
+
+def _verify_written(out: Path, parts: Path) -> None:
+    """:func:`verify_table` of a table just written; the parts are kept if it fails."""
+    try:
+        verify_table(out)
+    except InputError as exc:
+        raise ValueError(f"{exc}; it was just written from the parts in {parts}, which are "
+                         "kept: run again with --resume") from None
 
 
 # ---- the output: checks and lock ----------------------------------------------------
@@ -313,7 +758,9 @@ def check_output(out: Path, layout: str) -> None:
 
 class OutputLock:
     """An exclusive lock on ``OUT.lock`` (``fcntl.flock``, released by the kernel when the
-    process dies, even by kill -9): a second sweep into the same output is refused."""
+    process dies, even by kill -9): a second sweep into the same output is refused.
+    A lock file left by a killed sweep does not block (nobody holds its lock); a
+    lock taken on a file its holder removed meanwhile is taken again on the new one."""
 
     def __init__(self, out: Path):
         self.path = Path(out).with_name(Path(out).name + ".lock")
@@ -332,6 +779,13 @@ class OutputLock:
                 os.close(fd)
             raise ValueError(f"another sweep is writing {self.path.with_suffix('')} "
                              f"({holder}); wait for it, or stop it first") from None
+        try:
+            same = os.fstat(fd).st_ino == os.stat(self.path).st_ino
+        except FileNotFoundError:
+            same = False
+        if not same:  # the holder removed the file between our open and flock: try again
+            os.close(fd)
+            return self.__enter__()
         os.ftruncate(fd, 0)
         os.write(fd, f"pid {os.getpid()} on {socket.gethostname()}".encode())
         self.fd = fd
@@ -347,8 +801,9 @@ class OutputLock:
             self.fd = None
 
 
-__all__ = ["COMMON_METADATA", "INT_KEYS", "JSON_KEYS", "META_PREFIX", "OutputLock",
-           "check_output", "combine", "decode_metadata", "decode_value", "encode_metadata",
-           "encode_value", "existing_parts", "fsync_dir", "is_complete", "part_path",
-           "parts_dir", "read_metadata", "remove_temporaries", "summary", "write_atomic",
-           "write_part"]
+__all__ = ["COMMON_METADATA", "CONTENT_HASH_KEY", "CONTENT_HASH_VERSION", "CORRUPT_DIR",
+           "ContentHash", "INT_KEYS", "JSON_KEYS", "META_PREFIX", "OutputLock", "check_output",
+           "combine", "content_hash", "decode_metadata", "decode_value", "encode_metadata",
+           "encode_value", "existing_parts", "fsync_dir", "is_complete", "move_aside",
+           "part_path", "parts_dir", "read_metadata", "remove_temporaries", "rows_in_footer",
+           "summary", "verify_part", "verify_table", "write_atomic", "write_part"]
