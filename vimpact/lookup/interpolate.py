@@ -205,8 +205,6 @@ class HermiteGrid:
         """The grid as the arrays :func:`vimpact.kernels.hermite.hermite_eval` takes
         (everything but the points, ``extrapolate`` and ``out``)."""
         if self._kernel_args is None:
-            from vimpact.kernels.hermite import term_tables
-
             d = len(self.axes)
             is_log = np.array([a in self.log_axes for a in self.axes], dtype=np.bool_)
             coords = np.ascontiguousarray(np.concatenate(self.coords), dtype=np.float64)
@@ -215,11 +213,12 @@ class HermiteGrid:
             offset = np.array([sum(int(self.strides[k]) for k in range(d)
                                    if c >> k & 1 and self.shape[k] > 1)
                                for c in range(1 << d)], dtype=np.int64)
-            pair_corner, pair_mask = term_tables(d)
+            n_out = self.data.shape[2]
+            pad = np.zeros(self.data.shape[:2] + ((-n_out) % 4,))  # outputs in fours
+            data = np.ascontiguousarray(np.concatenate([self.data, pad], axis=2), dtype=np.float64)
+            bad = np.ascontiguousarray(self.bad, dtype=np.bool_)
             self._kernel_args = (is_log, coords, raw, start, self.strides.astype(np.int64),
-                                 offset, pair_corner, pair_mask,
-                                 np.ascontiguousarray(self.data, dtype=np.float64),
-                                 np.ascontiguousarray(self.bad, dtype=np.bool_))
+                                 offset, data, bad, np.ascontiguousarray(bad.any(axis=1)), n_out)
         return self._kernel_args
 
     # ---- range checks ---------------------------------------------------------
