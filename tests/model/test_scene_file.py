@@ -78,6 +78,15 @@ BODIES = {
                        "arms = [{G_Pa = 2e6, tau_s = 1e-3}, {G_Pa = 5e6, tau_s = 1e-5}]\n"),
     "prony_no_dashpot": ("prony", "G_Pa = 1e6\nnu = 0.45\nR_m = 0.01\nm_kg = 0.001\n"
                                   "v_z0_m_s = 2.0\narms = [{G_Pa = 2e6, tau_s = 1e-3}]\n"),
+    "kelvin_voigt_friction_angle": ("kelvin_voigt", "E_Pa = 2.5e9\neta_Pa_s = 2e3\nnu = 0.4\n"
+                                                    "R_m = 0.005\nm_kg = 0.0041\nv_z0_m_s = 1.3\n"
+                                                    "angle_deg = 37.5\nmu = 0.2\n"
+                                                    "omega0_rad_s = 12\n"),
+    "standard_solid_mu_inf": ("standard_solid", "G1_Pa = 1e7\nG2_Pa = 3e7\neta_Pa_s = 600\n"
+                                                "nu = 0.49\nR_m = 0.01\nm_kg = 0.004\n"
+                                                'v_z0_m_s = 1.0\nv_x0_m_s = 0.8\nmu = "inf"\n'),
+    "elastic_frictionless": ("elastic", "G_Pa = 8e8\nnu = 0.5\nR_m = 0.02\nm_kg = 0.05\n"
+                                        "v_z0_m_s = 3.0\nangle_deg = 0\nmu = 0\n"),
 }
 TOP = 'tangential_memory = "seed"\n[numerics]\npreset = "fast"\nsteps = 500\n'
 
@@ -126,7 +135,7 @@ def test_friction_coefficient_and_impact_angle():
 def test_friction_example():
     scene, _ = load_scene(SCENES / "steel_on_polymer_friction.toml")
     assert 0.0 < scene.mu < math.inf and scene.computes_tangential
-    # incidence of docs/physics.md (Maw, Barber and Fawcett): gross slip from the start
+    # incidence of docs/physics.md#coulomb-friction (Maw, Barber and Fawcett): gross slip from the start
     nu = scene.material.nu
     psi = 2 * (1 - nu) / (scene.mu * (2 - nu)) * scene.v_c0 / scene.v_z0
     assert psi > 4 * (1 - nu) * scene.contact_mass_factor / (2 - nu)  # psi > 4 chi

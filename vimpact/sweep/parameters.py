@@ -20,6 +20,7 @@ import numpy as np
 
 from vimpact.model.hertz import Q1_PER_TAU
 from vimpact.model.material import shear_modulus
+from vimpact.model.toml_input import tangential_speed
 
 #: The reference scene of :meth:`vimpact.Scene.from_dimensionless`: R = 1 m,
 #: m = 1 kg, v_z0 = v_x0 = 1 m/s, omega0 = 0, Hertz indentation d = 1e-4 m.
@@ -52,7 +53,47 @@ def chunk_parameters(spec, chunk: int) -> dict[str, np.ndarray]:
     for i, arm in enumerate(spec.arms, start=1):
         out[f"G_arm{i}_Pa"] = arm["G_Pa"].sample(rng, n)
         out[f"tau_arm{i}_s"] = arm["tau_s"].sample(rng, n)
+    if "angle_deg" in out:  # drawn instead of v_x0 (no draw of its own)
+        out["v_x0_m_s"] = tangential_speed(out["v_z0_m_s"], out["angle_deg"])
     return out
+
+
+def psi_reference(psi: np.ndarray, nu: np.ndarray, mu: float,
+                  v_z0: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
+    """Tangential speed and friction coefficient of the reference scene at incidence ``psi``.
+
+    With friction the result depends on ``psi = 2 (1 - nu) / (mu (2 - nu)) v_c0 / v_z0``
+    (and ``chi``, fixed by ``nu`` and ``theta_ratio``), not on ``mu`` and ``v_c0``
+    apart, so a grid row with ``psi > 0`` takes the given ``mu`` and
+    ``v_x0 = psi mu (2 - nu) / (2 (1 - nu)) v_z0`` (``nu <= 0.5``: no division by 0).
+    ``psi = 0`` is the limit ``mu -> inf`` at ``v_c0 != 0``: full stick, the stick
+    grid's row (``v_x0 = v_z0``, ``mu = inf``), not a normal impact.
+
+    Parameters
+    ----------
+    psi : incidence, dimensionless, >= 0
+    nu : Poisson ratio, dimensionless, in [0, 0.5]
+    mu : friction coefficient of the rows with ``psi > 0``, dimensionless, > 0
+    v_z0 : normal impact speed of the reference scene, m/s
+
+    Returns
+    -------
+    ``(v_x0, mu)``: m/s and dimensionless, one value per row.
+    """
+    psi = np.asarray(psi, dtype=float)
+    stick = psi == 0.0
+    v_x0 = np.where(stick, v_z0, psi * mu * (2.0 - nu) / (2.0 * (1.0 - nu)) * v_z0)
+    return v_x0, np.where(stick, np.inf, mu)
+
+
+def incidence(mu: np.ndarray, nu: np.ndarray, v_c0: np.ndarray, v_z0: np.ndarray) -> np.ndarray:
+    """``psi = 2 (1 - nu) / (mu (2 - nu)) v_c0 / v_z0`` (dimensionless) of physical rows:
+    0 for full stick (``mu = inf``) and for ``v_c0 = 0``; ``inf`` (signed) for ``mu = 0``
+    with ``v_c0 != 0`` (frictionless)."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        psi = 2.0 * (1.0 - nu) / (mu * (2.0 - nu)) * v_c0 / v_z0
+        frictionless = np.sign(v_c0) * np.inf
+    return np.where(v_c0 == 0.0, 0.0, np.where(mu == 0.0, frictionless, psi))
 
 
 def engine_columns(spec, p: dict[str, np.ndarray]) -> tuple[list[tuple[np.ndarray, dict]], dict]:
@@ -71,7 +112,8 @@ def engine_columns(spec, p: dict[str, np.ndarray]) -> tuple[list[tuple[np.ndarra
               "rotation": np.full(n, spec.rotation)}
     # no "model" column: the engine infers it from the rheology (it only decides how the
     # engine reports Q1, Q2, which the table takes from the spec for a grid)
-    inputs: dict[str, np.ndarray] = {}
+    # the row's rheology, for a string column "model" (Q2 = NaN: Kelvin-Voigt, not 0)
+    inputs: dict[str, np.ndarray] = {"model": np.full(n, spec.model, dtype=object)}
     if spec.mode == "grid":
         # Scene.from_dimensionless, vectorized with the same floating-point operations
         R, m, v_z0 = 1.0, 1.0, 1.0
@@ -81,6 +123,9 @@ def engine_columns(spec, p: dict[str, np.ndarray]) -> tuple[list[tuple[np.ndarra
         tau = Q1 / Q1_PER_TAU * _D_REF / v_z0
         eta = tau * G
         sphere = {k: np.full(n, v) for k, v in REFERENCE.items()}
+        if "psi" in p:
+            sphere["v_x0_m_s"], mu = psi_reference(p["psi"], nu, spec.grid_mu, v_z0)
+            common["mu"] = inputs["mu"] = mu
         cols = {"nu": nu, "G_inf_Pa": G, **sphere, "theta_ratio": p["theta_ratio"], **common}
         inputs.update(sphere)
         if spec.model == "standard_solid":
@@ -97,9 +142,14 @@ def engine_columns(spec, p: dict[str, np.ndarray]) -> tuple[list[tuple[np.ndarra
                 cols["eta0_Pa_s"] = eta
                 inputs["eta_Pa_s"] = eta
                 inputs["Q1"] = Q1
-            inputs["Q2"] = np.zeros(n)
+            # no Q2: G2 -> inf, the Kelvin-Voigt limit (Q2 = 0 would be log 0 on a log axis)
+            inputs["Q2"] = np.full(n, np.nan)
     else:
         sphere = {k: p[k] for k in ("R_m", "m_kg", "v_z0_m_s", "v_x0_m_s", "omega0_rad_s")}
+        if "mu" in p:
+            common["mu"] = p["mu"]
+            inputs["psi"] = incidence(p["mu"], nu, sphere["v_x0_m_s"]
+                                      + sphere["R_m"] * sphere["omega0_rad_s"], sphere["v_z0_m_s"])
         cols = {"nu": nu, **sphere, "theta_ratio": p["theta_ratio"], **common}
         inputs.update(sphere)
         if spec.model == "standard_solid":
@@ -135,4 +185,5 @@ def engine_columns(spec, p: dict[str, np.ndarray]) -> tuple[list[tuple[np.ndarra
     return batches, inputs
 
 
-__all__ = ["REFERENCE", "chunk_generator", "chunk_parameters", "engine_columns"]
+__all__ = ["REFERENCE", "chunk_generator", "chunk_parameters", "engine_columns", "incidence",
+           "psi_reference"]

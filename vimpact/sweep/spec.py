@@ -30,12 +30,20 @@ scene files live in :mod:`vimpact.model.toml_input`.
 ``[grid]``: parameter sets on a grid of the dimensionless parameters, simulated
 on the reference scene of :meth:`vimpact.Scene.from_dimensionless` (the grid is
 the product of all axes; ``Q1`` runs fastest, then ``Q2``, ``nu``,
-``theta_ratio``). Keys: ``tolerance`` (optional, not an axis: the interpolation
+``theta_ratio``, ``psi``). Keys: ``tolerance`` (optional, not an axis: the interpolation
 error the grid should meet between its nodes, a number in [1e-9, 1e-1]; stored
 as :attr:`SweepSpec.grid_tolerance` and in the metadata as ``grid_tolerance``,
 for a refinement of the grid to read), ``Q1`` (kelvin_voigt, standard_solid; >= 0), ``Q2``
 (standard_solid; > 0), ``nu`` (required; in [0, 0.5]), ``theta_ratio``
-(Theta / (m R^2), default 0.4). An axis is a number, a list of numbers, or a
+(Theta / (m R^2), default 0.4), ``psi`` (optional, >= 0: the incidence
+``2 (1 - nu) / (mu (2 - nu)) v_c0 / v_z0`` of docs/physics.md#coulomb-friction)
+with ``mu`` (not an axis: the friction coefficient, a number > 0, default 1;
+only with ``psi``). With friction the results depend on ``psi`` (with ``nu`` and
+``theta_ratio``) and not on ``mu`` and ``v_c0`` apart, so a row with ``psi > 0``
+is the reference scene with this ``mu`` and ``v_x0 = psi mu (2 - nu) / (2 (1 -
+nu)) v_z0``; a row with ``psi = 0`` is the full-stick limit (``mu = inf``,
+``v_x0 = v_z0``), the row of the same grid without ``psi``. Without ``psi`` the
+grid is full stick and has no ``mu`` and ``psi`` columns. An axis is a number, a list of numbers, or a
 table ``{ start, stop, per_decade }`` (log-spaced, both ends included) or
 ``{ start, stop, num, log = true|false }`` (``num`` points; ``log`` defaults
 to the rule below). With ``per_decade`` the number of intervals is
@@ -51,6 +59,13 @@ column, with its unit as suffix:
 - all models: ``nu``, ``R_m``, ``m_kg``, ``v_z0_m_s`` (required),
   ``v_x0_m_s`` (default 0), ``omega0_rad_s`` (default 0), ``theta_ratio``
   (default 0.4)
+- friction, all models: ``mu`` (Coulomb friction coefficient, >= 0; default
+  ``inf``, full stick; a fixed value or a choice may be ``inf`` or ``"inf"``)
+  and ``angle_deg`` (impact angle from the normal, degrees, in [0, 90):
+  ``v_x0 = v_z0 tan(angle)``, instead of ``v_x0_m_s``, never both). A spec
+  with ``mu`` has the columns ``mu`` and ``psi`` (the incidence of its row: 0
+  for ``mu = inf`` or ``v_c0 = 0``, ``inf`` for ``mu = 0``); one with
+  ``angle_deg`` the column ``angle_deg`` beside ``v_x0_m_s``
 - elastic: ``E_Pa`` or ``G_Pa``; kelvin_voigt: ``E_Pa`` or ``G_Pa``, and
   ``eta_Pa_s``; standard_solid: ``G1_Pa``, ``G2_Pa``, ``eta_Pa_s``;
   prony: ``G_Pa`` (relaxed modulus), ``eta_Pa_s`` (parallel dashpot,
@@ -70,9 +85,21 @@ Random draws per chunk (schema version 3): the rows of chunk ``c`` are drawn
 from ``numpy.random.default_rng(SeedSequence(seed, spawn_key=(c,)))``, each key
 for all rows of the chunk in a fixed order (material, sphere, ``nu``,
 ``theta_ratio``, arms), so any chunk can be computed anywhere and in any order
-with the same rows (:mod:`vimpact.sweep.parameters`). The draws therefore
-depend on ``seed`` and ``chunk_size``; tables of schema version 2 drew all rows
-from one ``default_rng(seed)`` and have other draws.
+with the same rows (:mod:`vimpact.sweep.parameters`); ``mu`` and ``angle_deg``
+are drawn after ``theta_ratio`` (a fixed value draws nothing, so a spec without
+them draws as before). The draws therefore depend on ``seed`` and
+``chunk_size``; tables of schema version 2 drew all rows from one
+``default_rng(seed)`` and have other draws.
+
+Columns (:data:`COLUMNS` has the unit and meaning of each; the table's metadata
+``units`` and ``columns`` too): ``row``, the physical inputs, ``Q1``, ``Q2``
+(``NaN`` on Kelvin-Voigt and elastic grid rows: no ``G2``, the limit
+``G2 -> inf``, never ``0``; random rows of these models still get ``0`` from the
+runner), ``nu``, ``theta_ratio`` (``psi`` with friction), the outputs
+(:data:`OUTPUTS`, in every table, the friction outputs ``mu_eff``,
+``rebound_angle_deg``, ``gross_slip_fraction``, ``friction_energy_J``
+included: in full stick they are the impulse ratio, the rebound angle, 0 and 0),
+then ``path``, ``status``, ``error``.
 
 Output paths: ``output`` in the spec is relative to the spec file's
 directory; ``out=`` / ``--out`` is relative to the current directory. The
@@ -99,14 +126,19 @@ import numpy as np
 from vimpact import __version__
 from vimpact.model.numerics import Numerics
 from vimpact.model.scene import Scene
-from vimpact.model.toml_input import (ARM_KEYS, MATERIAL_KEYS, PHYSICAL_DEFAULTS, SPHERE_KEYS,
-                                      SWEEP_TOP_KEYS, TomlSource, is_number, parse_header,
-                                      parse_numerics, physical_keys, read_toml, required_keys,
+from vimpact.model.toml_input import (ANGLE_RANGE_DEG, ARM_KEYS, FRICTION_KEYS, MATERIAL_KEYS,
+                                      PHYSICAL_DEFAULTS, SPHERE_KEYS, SWEEP_TOP_KEYS, TomlSource,
+                                      friction_coefficient, input_keys, is_number, parse_header,
+                                      parse_numerics, read_toml, required_keys,
                                       scene_from_values)
 
 #: Version of the table layout (columns, metadata keys and random draws): 3 since
-#: the draws are made per chunk from ``SeedSequence(seed, spawn_key=(chunk,))``.
-SCHEMA_VERSION = 3
+#: the draws are made per chunk from ``SeedSequence(seed, spawn_key=(chunk,))``; 4 since
+#: every table has the friction outputs (``mu_eff``, ``rebound_angle_deg``,
+#: ``gross_slip_fraction``, ``friction_energy_J``), a spec with friction the inputs
+#: ``mu`` and ``psi``, and Kelvin-Voigt and elastic grid rows ``Q2 = NaN`` (not 0).
+#: The random draws of version 3 are unchanged.
+SCHEMA_VERSION = 4
 
 #: Row statuses of a sweep table: those of :data:`vimpact.STATUSES` and two more.
 def _statuses() -> dict:
@@ -149,10 +181,17 @@ COLUMNS = {
     "v_z0_m_s": ("m/s", "normal impact speed (into the half-space)"),
     "v_x0_m_s": ("m/s", "tangential speed of the centre"),
     "omega0_rad_s": ("rad/s", "spin about the y axis"),
+    "angle_deg": ("deg", "impact angle from the normal as drawn: v_x0 = v_z0 tan(angle)"),
+    "mu": ("1", "Coulomb friction coefficient, static = kinetic (inf: full stick)"),
     "Q1": ("1", "damping parameter sqrt(15/32) (eta/G_inf) / T"),
-    "Q2": ("1", "stiffness ratio G1/G2 (standard solid; 0 for Kelvin-Voigt and elastic)"),
+    "Q2": ("1", "stiffness ratio G1/G2 (standard solid; inf without an arm, eta = 0). "
+                "Kelvin-Voigt and elastic rows have no G2: NaN, meaning G2 -> inf (the "
+                "Kelvin-Voigt limit of the standard solid), never 0 (which would read as "
+                "G1 = 0, a Maxwell fluid, and as log 0 on a log Q2 axis)"),
     "nu": ("1", "Poisson ratio"),
     "theta_ratio": ("1", "moment of inertia Theta / (m R^2)"),
+    "psi": ("1", "incidence of Maw, Barber and Fawcett 2 (1 - nu) / (mu (2 - nu)) v_c0 / v_z0 "
+                 "(0: full stick, mu = inf, or v_c0 = 0; inf: mu = 0 with v_c0 != 0)"),
     "e_z": ("1", "normal restitution |v_z,end| / v_z0"),
     "e_x": ("1", "tangential restitution |v_c,end| / |v_c0|"),
     "beta_x": ("1", "signed tangential restitution -v_c,end / v_c0"),
@@ -169,6 +208,14 @@ COLUMNS = {
     "v_z_end_m_s": ("m/s", "normal velocity at the end (negative: rebound)"),
     "v_x_end_m_s": ("m/s", "tangential velocity of the centre at the end"),
     "omega_end_rad_s": ("rad/s", "spin at the end"),
+    "mu_eff": ("1", "impulse ratio |int F_x dt| / int F_z dt (mu in gross slip; NaN when "
+                    "v_c0 = 0)"),
+    "rebound_angle_deg": ("deg", "angle of the centre's rebound velocity to the normal"),
+    "gross_slip_fraction": ("1", "fraction of the contact time in gross slip (every element "
+                                 "in contact slipping; 0 in full stick; NaN when v_c0 = 0)"),
+    "friction_energy_J": ("J", "energy dissipated by slip (0 in full stick)"),
+    "model": ("", "rheology of the row: elastic, kelvin_voigt, standard_solid or prony "
+                  "(a Kelvin-Voigt row has Q2 = NaN)"),
     "path": ("", "the kernel that ran the row (vimpact.engine.routing; why: the paths metadata)"),
     "status": ("", "outcome of the row, see the statuses metadata"),
     "error": ("", "why the row failed before or in the simulation (null otherwise)"),
@@ -180,25 +227,31 @@ RESULTS = {
     "t_contact_s": "t_contact", "u_max_m": "u_max", "a_max_m": "a_max",
     "t_hertz_s": "t_hertz", "d_hertz_m": "d_hertz", "a_hertz_m": "a_hertz",
     "v_z_end_m_s": "v_z_end", "v_x_end_m_s": "v_x_end", "omega_end_rad_s": "omega_end",
+    "mu_eff": "mu_eff", "rebound_angle_deg": "rebound_angle",
+    "gross_slip_fraction": "gross_slip_fraction", "friction_energy_J": "friction_energy",
 }
 RELATIVE = {"t_contact_rel": ("t_contact_s", "t_hertz_s"), "u_max_rel": ("u_max_m", "d_hertz_m"),
              "a_max_rel": ("a_max_m", "a_hertz_m")}
 OUTPUTS = ("e_z", "e_x", "beta_x", "energy_ratio", "t_contact_s", "u_max_m", "a_max_m",
             "t_hertz_s", "d_hertz_m", "a_hertz_m", "t_contact_rel", "u_max_rel", "a_max_rel",
-            "v_z_end_m_s", "v_x_end_m_s", "omega_end_rad_s")
+            "v_z_end_m_s", "v_x_end_m_s", "omega_end_rad_s", "mu_eff", "rebound_angle_deg",
+            "gross_slip_fraction", "friction_energy_J")
 #: Outputs that are NaN when v_c0 = 0 (no tangential force).
-TANGENTIAL_OUTPUTS = ("e_x", "beta_x")
+TANGENTIAL_OUTPUTS = ("e_x", "beta_x", "mu_eff", "gross_slip_fraction")
 #: String columns (null where not applicable: path of a row that never ran, error of a good row).
 LABELS = ("path", "status", "error")
 
 # ---- spec keys -------------------------------------------------------------
 
 _GRID_KEYS = {
-    "elastic": ("theta_ratio", "nu"),
-    "kelvin_voigt": ("theta_ratio", "nu", "Q1"),
-    "standard_solid": ("theta_ratio", "nu", "Q2", "Q1"),
-}  # outermost axis first: the last one runs fastest
+    "elastic": ("psi", "theta_ratio", "nu"),
+    "kelvin_voigt": ("psi", "theta_ratio", "nu", "Q1"),
+    "standard_solid": ("psi", "theta_ratio", "nu", "Q2", "Q1"),
+}  # outermost axis first: the last one runs fastest; psi only when given
+#: ``[grid] mu`` when a ``psi`` axis is given without it.
+DEFAULT_GRID_MU = 1.0
 _GRID_CHECKS = {
+    "psi": (lambda x: x >= 0.0, "a finite number >= 0"),
     "Q1": (lambda x: x >= 0.0, "a finite number >= 0"),
     "Q2": (lambda x: x > 0.0, "a finite number > 0"),
     "nu": (lambda x: 0.0 <= x <= 0.5, "in [0, 0.5]"),
@@ -255,6 +308,22 @@ def _draw(spec: TomlSource, key: str, value) -> Draw:
     if log and lo <= 0.0:
         raise spec.bad(key, value, "a range with lo > 0 for log = true")
     return Draw("log_uniform" if log else "uniform", (lo, hi))
+
+
+def _draw_mu(spec: TomlSource, key: str, value) -> Draw:
+    """A friction coefficient: like :func:`_draw`, every value >= 0; a fixed value or a
+    choice may be ``inf`` (TOML ``inf`` or ``"inf"``: full stick), a range is finite."""
+    if isinstance(value, str) or (is_number(value) and math.isinf(value)):
+        return Draw("fixed", (friction_coefficient(spec, key, value),))
+    if isinstance(value, dict) and "choice" in value and isinstance(value["choice"], list) \
+            and value["choice"]:
+        spec.unknown(value, ("choice",), key)
+        return Draw("choice", tuple(friction_coefficient(spec, f"{key}.choice", c)
+                                    for c in value["choice"]))
+    draw = _draw(spec, key, value)
+    if any(x < 0.0 for x in draw.values):
+        raise spec.bad(key, value, 'friction coefficients >= 0 (or "inf")')
+    return draw
 
 
 def _axis(spec: TomlSource, key: str, value) -> np.ndarray:
@@ -335,6 +404,8 @@ class SweepSpec:
     grid_tolerance : grid mode: ``[grid] tolerance``, the interpolation error the grid
         should meet between its nodes (dimensionless, in [1e-9, 1e-1]; ``None``: not
         asked). Not an axis: a refinement of the grid reads it
+    grid_mu : grid mode with a ``psi`` axis: the friction coefficient of the rows with
+        ``psi > 0`` (``[grid] mu``, default 1); ``None`` without ``psi``
     """
 
     path: Path
@@ -355,10 +426,17 @@ class SweepSpec:
     rotation: bool = True
     layout: str = "auto"
     grid_tolerance: float | None = None
+    grid_mu: float | None = None
 
     @property
     def n_chunks(self) -> int:
         return -(-self.rows // self.chunk_size)
+
+    @property
+    def has_friction(self) -> bool:
+        """The spec sets a friction coefficient: a grid with a ``psi`` axis, or a random
+        spec with ``mu``; its table has the columns ``mu`` and ``psi``."""
+        return "psi" in self.axes or "mu" in self.draws
 
     @property
     def table_layout(self) -> str:
@@ -408,9 +486,16 @@ class SweepSpec:
                 from vimpact.model.material import Material
                 scene = dataclasses.replace(
                     scene, material=Material.elastic(nu=p["nu"], G=scene.material.G_inf))
+            if "psi" in p:
+                from vimpact.sweep.parameters import psi_reference
+                v_x0, mu = psi_reference(np.array([p["psi"]]), np.array([p["nu"]]),
+                                         self.grid_mu, scene.v_z0)
+                scene = dataclasses.replace(scene, v_x0=float(v_x0[0]), mu=float(mu[0]))
             return dataclasses.replace(scene, allow_large_contact=True)
         arms = [(p[f"G_arm{k}_Pa"], p[f"tau_arm{k}_s"]) for k in range(1, len(self.arms) + 1)]
         values = {k: v for k, v in p.items() if "_arm" not in k}
+        if "angle_deg" in values:
+            values.pop("v_x0_m_s", None)  # made from the angle (chunk_parameters)
         return scene_from_values(self.model, values, arms,
                                  tangential_memory=self.tangential_memory,
                                  tangential=self.tangential, rotation=self.rotation,
@@ -428,12 +513,15 @@ class SweepSpec:
             material = list(MATERIAL_KEYS[self.model])
             for i in range(1, len(self.arms) + 1):
                 material += [f"G_arm{i}_Pa", f"tau_arm{i}_s"]
-        return material + list(SPHERE_KEYS)
+        extra = ["angle_deg"] if "angle_deg" in self.draws else []
+        return material + list(SPHERE_KEYS) + extra + (["mu"] if self.has_friction else [])
 
     def columns(self) -> list[str]:
         """All columns of the table, in order."""
         dimensionless = ["nu", "theta_ratio"] if self.model == "prony" else \
             ["Q1", "Q2", "nu", "theta_ratio"]
+        if self.has_friction:
+            dimensionless.append("psi")
         return (["row"] + self.input_columns() + dimensionless + list(OUTPUTS)
                 + ["path", "status", "error"])
 
@@ -523,26 +611,27 @@ def load_spec(path) -> SweepSpec:
     else:
         mode = "grid"
         seed = spec.integer("seed", data.get("seed", 0), 0)
-        axes, grid_tolerance = _grid(spec, model, data["grid"])
+        axes, grid_tolerance, grid_mu = _grid(spec, model, data["grid"])
         rows = math.prod(len(v) for v in axes.values())
         if rows > MAX_ROWS:
             raise spec.error("grid", f"{rows} rows; at most {MAX_ROWS} are allowed")
         draws, arms = {}, ()
     if mode == "random":
-        grid_tolerance = None
+        grid_tolerance = grid_mu = None
     return SweepSpec(path=path, text=text, model=model, mode=mode, seed=seed,
                      chunk_size=chunk_size, output=output, numerics=numerics,
                      tangential_memory=header.tangential_memory,
                      description=header.description, rows=rows, draws=draws, arms=arms,
                      axes=axes, tangential=header.tangential, rotation=header.rotation,
-                     layout=layout, grid_tolerance=grid_tolerance)
+                     layout=layout, grid_tolerance=grid_tolerance,
+                     grid_mu=grid_mu)
 
 
 def _random(spec: TomlSource, model: str, table) -> tuple[dict, tuple, int]:
     if not isinstance(table, dict):
         raise spec.bad("random", table, "a table")
     material = MATERIAL_KEYS[model]
-    allowed = ("rows",) + material + SPHERE_KEYS + ("nu", "theta_ratio") + \
+    allowed = ("rows",) + material + SPHERE_KEYS + ("nu", "theta_ratio") + FRICTION_KEYS + \
         (("arms",) if model == "prony" else ())
     spec.unknown(table, allowed, "random")
     if "rows" not in table:
@@ -556,10 +645,23 @@ def _random(spec: TomlSource, model: str, table) -> tuple[dict, tuple, int]:
     for key in required_keys(model):
         if key not in table:
             raise spec.error(f"random.{key}", "missing")
+    if "angle_deg" in table and "v_x0_m_s" in table:
+        raise spec.error("random.angle_deg/v_x0_m_s", "give at most one of angle_deg (impact "
+                         "angle from the normal, degrees) or v_x0_m_s (tangential speed, m/s)")
     draws = {}
-    for key in physical_keys(model):
-        if key in table:
+    for key in input_keys(model):
+        if key == "mu" and key in table:
+            draws[key] = _draw_mu(spec, "random.mu", table[key])
+        elif key == "angle_deg" and key in table:
+            draws[key] = _draw(spec, "random.angle_deg", table[key])
+            lo, hi = ANGLE_RANGE_DEG
+            if not all(lo <= x < hi for x in draws[key].values):
+                raise spec.bad("random.angle_deg", table[key],
+                               f"degrees from the normal in [{lo:g}, {hi:g})")
+        elif key in table:
             draws[key] = _draw(spec, f"random.{key}", table[key])
+        elif key == "v_x0_m_s" and "angle_deg" in table:
+            continue  # v_x0 = v_z0 tan(angle), made per chunk
         elif key in PHYSICAL_DEFAULTS or key == "eta_Pa_s":
             draws[key] = Draw("fixed", (PHYSICAL_DEFAULTS.get(key, 0.0),))
     arms = ()
@@ -579,22 +681,34 @@ def _random(spec: TomlSource, model: str, table) -> tuple[dict, tuple, int]:
     return draws, arms, rows
 
 
-def _grid(spec: TomlSource, model: str, table) -> tuple[dict[str, np.ndarray], float | None]:
-    """The axes (outermost first) and the optional ``tolerance`` of a ``[grid]`` table."""
+def _grid(spec: TomlSource, model: str, table) -> tuple[dict[str, np.ndarray], float | None,
+                                                       float | None]:
+    """The axes (outermost first), the optional ``tolerance`` and the friction coefficient
+    ``mu`` (``None`` without a ``psi`` axis) of a ``[grid]`` table."""
     if model not in _GRID_KEYS:
         raise spec.error("grid", f"model {model!r} has no dimensionless grid; use [random]")
     if not isinstance(table, dict):
         raise spec.bad("grid", table, "a table")
     keys = _GRID_KEYS[model]
-    spec.unknown(table, keys + ("tolerance",), "grid")
+    spec.unknown(table, keys + ("tolerance", "mu"), "grid")
     tolerance = None
     if "tolerance" in table:
         tolerance = spec.number("grid.tolerance", table["tolerance"],
                                 lambda x: GRID_TOLERANCE_RANGE[0] <= x <= GRID_TOLERANCE_RANGE[1],
                                 f"a number in [{GRID_TOLERANCE_RANGE[0]:g}, "
                                 f"{GRID_TOLERANCE_RANGE[1]:g}]")
+    mu = None
+    if "psi" in table:
+        mu = spec.number("grid.mu", table.get("mu", DEFAULT_GRID_MU), lambda x: x > 0.0,
+                         "a finite number > 0 (the friction coefficient of the rows with "
+                         "psi > 0)")
+    elif "mu" in table:
+        raise spec.error("grid.mu", "needs a psi axis (the grid's friction is given by psi "
+                         "and mu; without psi the grid is full stick)")
     axes = {}
     for key in keys:
+        if key == "psi" and key not in table:
+            continue
         if key not in table:
             if key == "theta_ratio":
                 axes[key] = np.array([0.4])
@@ -606,7 +720,7 @@ def _grid(spec: TomlSource, model: str, table) -> tuple[dict[str, np.ndarray], f
             if not (math.isfinite(x) and check(x)):
                 raise spec.bad(f"grid.{key}", float(x), allowed)
         axes[key] = values
-    return axes, tolerance
+    return axes, tolerance, mu
 
 
 __all__ = ["COLUMNS", "Draw", "FILE_LAYOUT_MAX_ROWS", "LAYOUTS", "MAX_ROWS", "OUTPUTS",
