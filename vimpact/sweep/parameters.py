@@ -7,9 +7,18 @@
   for all rows of the chunk in a fixed order (material, sphere, ``nu``,
   ``theta_ratio``, then ``G_Pa``, ``tau_s`` of every arm).
 
+A random ``angle_deg`` (impact angle from the normal) is drawn instead of
+``v_x0_m_s``; the chunk's ``v_x0_m_s = v_z0 tan(angle)`` is added to its
+parameters (it takes no draw).
+
 Memory is bounded by the chunk size. :func:`engine_columns` turns the
 parameters of a chunk into the scene columns of :func:`vimpact.simulate_batch`
-and the physical input columns of the table, with NumPy only.
+and the physical input columns of the table, with NumPy only. Friction: a grid
+row at incidence ``psi`` is the reference scene with ``v_x0`` and ``mu`` from
+:func:`psi_reference`; a random row with ``mu`` gets its ``psi`` from
+:func:`incidence`. Kelvin-Voigt and elastic grid rows get ``Q2 = NaN`` (no
+``G2``: the limit ``G2 -> inf``), and ``inputs["model"]`` holds each row's
+rheology (a string, for the table's ``model`` column).
 """
 
 from __future__ import annotations
