@@ -303,23 +303,41 @@ def interpolation_error(table, numerics=None, n: int = 200, seed: int = 0, theta
 
 def write_interpolation_error(table, result: dict, path=None):
     """Store ``result`` as the metadata entry ``vimpact.interpolation_error`` of ``table``
-    and write it to ``path`` (default: where the table was read). A Parquet file is
-    rewritten; for a partitioned dataset only its ``_common_metadata`` is."""
+    and write it to ``path`` (default: where the table was read).
+
+    A table read from a Parquet file is rewritten from that file's own data (read with
+    ``pyarrow``, not through pandas), atomically, so its rows, columns and types stay
+    exactly as the sweep wrote them and its content hash (``vimpact.content_sha256``)
+    stays true; for a partitioned dataset only its ``_common_metadata`` is rewritten. A
+    table held in memory is saved with :meth:`RestitutionTable.save` (without a content
+    hash of other data)."""
     from pathlib import Path
 
-    table.metadata["vimpact.interpolation_error"] = json.dumps(result)
+    import pyarrow.parquet as pq
+
+    from vimpact.sweep import store
+
+    text = json.dumps(result)
+    key = "vimpact.interpolation_error"
+    table.metadata[key] = text
     target = Path(path) if path is not None else table.path
     if target is None:
         raise InputError("path = None is not allowed for a table held in memory: give the "
                          "file to write")
     if target.is_dir():
-        import pyarrow.parquet as pq
-
-        from vimpact.sweep.store import COMMON_METADATA
-
-        schema = pq.read_schema(target / COMMON_METADATA)
+        schema = pq.read_schema(target / store.COMMON_METADATA)
         meta = dict(schema.metadata or {})
-        meta[b"vimpact.interpolation_error"] = json.dumps(result).encode()
-        pq.write_metadata(schema.with_metadata(meta), target / COMMON_METADATA)
+        meta[key.encode()] = text.encode()
+        store.write_atomic(schema.empty_table().replace_schema_metadata(meta),
+                           target / store.COMMON_METADATA, schema_only=True)
         return target
+    source = table.path
+    if source is not None and source.is_file():
+        arrow = pq.read_table(source)
+        meta = dict(arrow.schema.metadata or {})
+        meta[key.encode()] = text.encode()
+        target.parent.mkdir(parents=True, exist_ok=True)
+        store.write_atomic(arrow.replace_schema_metadata(meta), target)
+        return target
+    table.metadata.pop("vimpact.content_sha256", None)  # not a hash of this data
     return table.save(target)
