@@ -526,3 +526,60 @@ def test_cli_export(vimpact_main, kv_path, tmp_path, capsys):
     assert code == 2 and "model 'standard_solid', but the table is 'kelvin_voigt'" in err
     code, _, err = run(vimpact_main, args[:-1] + ["1"], capsys)
     assert code == 2 and "--n = 1" in err
+
+
+def test_cli_export_caps_n(vimpact_main, kv_path, tmp_path, capsys):
+    from vimpact.cli.table import MAX_CURVE_POINTS
+    from vimpact.lookup.table import MAX_CURVE_POINTS as TABLE_LIMIT
+
+    assert MAX_CURVE_POINTS == TABLE_LIMIT == 100_000
+    args = ["table", "export", str(kv_path), "--out", str(tmp_path / "c.csv"), "--E", "5e10",
+            "--nu", "0.5", "--eta", "1e5", "--R", "0.2", "--m", "10", "--vz0-min", "0.1",
+            "--vz0-max", "10", "--n", "100001"]
+    code, _, err = run(vimpact_main, args, capsys)
+    assert code == 2 and "--n = 100001 is not allowed: at most 100000 speeds" in err
+    assert not (tmp_path / "c.csv").exists()
+
+
+def test_cli_export_at_an_impact_angle_on_a_psi_table(vimpact_main, tmp_path, capsys):
+    """psi = 2 (1 - nu) / (mu (2 - nu)) tan(angle) (worked out here by hand), the same at
+    every speed; the curve is the table's lookup at that psi; stick tables refuse --mu."""
+    nu, mu, angle = 0.3, 0.1, 60.0
+    path = tmp_path / "psi.parquet"
+    gross_slip_psi_table(path, np.linspace(6.0, 24.0, 7), nu=nu)
+    material = Scene.from_dimensionless(0.3, nu).material  # Q1 = 0.3 at R = m = v = 1
+    args = ["table", "export", str(path), "--out", str(tmp_path / "c.csv"),
+            "--G", repr(material.G_inf), "--eta", repr(material.eta0), "--nu", str(nu),
+            "--R", "1", "--m", "1", "--vz0-min", "0.5", "--vz0-max", "2", "--n", "5"]
+    code, _, err = run(vimpact_main, args + ["--angle-deg", str(angle)], capsys)
+    assert code == 2 and "mu missing" in err
+    code, out, err = run(vimpact_main, args + ["--angle-deg", str(angle), "--mu", str(mu)],
+                         capsys)
+    assert code == 0, err
+    psi = 2 * 0.7 / (0.1 * 1.7) * 3 ** 0.5  # tan 60 deg = sqrt 3
+    curve = pd.read_csv(tmp_path / "c.csv")
+    assert list(curve.columns) == ["v_z0_m_s", "Q1", "psi", "e_z", "e_x", "beta_x"]
+    np.testing.assert_allclose(curve.psi, psi, rtol=1e-9)
+    assert f"psi {psi:.4g} at 60 deg" in out
+    look = RestitutionTable.open(path).lookup(curve.Q1.to_numpy(), nu, psi=psi)
+    np.testing.assert_allclose(curve.beta_x, look["beta_x"], rtol=1e-9, atol=1e-12)
+    assert np.all(curve.beta_x < 0)  # gross slip at this incidence reverses the contact point
+    with pytest.raises(InputError, match=r"angle_deg = 90.0 is not allowed.*\[0, 90\)"):
+        RestitutionTable.open(path).restitution_curve(material, 1.0, 1.0, [1.0], angle_deg=90.0,
+                                                      mu=mu)
+
+
+def test_cli_lookup_psi_and_theta_lists(vimpact_main, tmp_path, capsys):
+    path = tmp_path / "psi.parquet"
+    gross_slip_psi_table(path, np.linspace(6.0, 24.0, 4))
+    code, out, err = run(vimpact_main, ["table", "lookup", str(path), "--Q1", "0.1,0.2",
+                                        "--nu", "0.3", "--psi", "6,10", "--json"], capsys)
+    assert code == 0, err
+    rows = json.loads(out)["rows"]
+    assert [r["psi"] for r in rows] == [6.0, 10.0] and rows[0]["Q1"] == 0.1
+    direct = RestitutionTable.open(path).lookup([0.1, 0.2], 0.3, psi=[6.0, 10.0])
+    assert [r["beta_x"] for r in rows] == pytest.approx(direct["beta_x"], abs=1e-15)
+    code, _, err = run(vimpact_main, ["table", "lookup", str(path), "--Q1", "0.1", "--nu",
+                                      "0.3", "--psi", "6,10,12", "--theta-ratio", "0.4,0.4"],
+                       capsys)
+    assert code == 2 and "--theta-ratio has 2 values, --psi has 3 values" in err

@@ -19,6 +19,10 @@ from vimpact.cli.material_args import add_material_arguments, material_from_args
 
 __all__ = ["add_parser"]
 
+#: The most speeds of `table export --n`: :data:`vimpact.lookup.table.MAX_CURVE_POINTS`
+#: (not imported here, so that building the parser does not import pandas).
+MAX_CURVE_POINTS = 100_000
+
 
 def _number_list(text: str) -> list[float]:
     """``"0.1,0.2, 1e-3"`` -> ``[0.1, 0.2, 0.001]`` (argparse type)."""
@@ -48,9 +52,13 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         "table", help="inspect, interpolate and export restitution tables",
         description=(
             "Read a restitution table (Parquet, written by `vimpact sweep`): summarize it, "
-            "interpolate e_z, e_x, beta_x at given Q1 [Q2] nu (cubic Hermite in log Q1, log Q2 "
-            "and nu on the table's grid, or linear), measure the interpolation error against "
-            "direct simulation, or export e_z(v), e_x(v) for one material and sphere."))
+            "interpolate e_z, e_x, beta_x at given Q1 [Q2] nu [theta_ratio] [psi] (cubic "
+            "Hermite in log Q1, log Q2, nu, log theta_ratio and psi on the table's grid, or "
+            "linear), measure the interpolation error against direct simulation, or export "
+            "e_z(v), e_x(v) for one material and sphere. A table is validated when opened "
+            "(vimpact metadata, known statuses, finite outputs within [0, 1] (|beta_x| <= 1) "
+            "in ok rows, axes in their domains, no duplicated node): a table that fails is "
+            "refused with the file, column, value and row."))
     sub = table.add_subparsers(dest="table_command", required=True, metavar="ACTION")
 
     info = sub.add_parser("info", help="model, rows, statuses, covered ranges, grid, numerics",
@@ -64,12 +72,13 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         "lookup", help="interpolate e_z, e_x, beta_x at Q1 [Q2] nu",
         description=(
             "Interpolate e_z, e_x, beta_x (dimensionless) on a grid table: cubic Hermite in "
-            "log Q1 (and log Q2) and nu, shape-preserving where the data is monotone (or "
+            "log Q1 (and log Q2), nu, log theta_ratio (tables with several) and psi (tables "
+            "with a psi column), shape-preserving where the data is monotone (or "
             "--method linear). The measured interpolation error of the table (`vimpact table "
-            "verify --write`) is printed with the values. Each of --Q1, --Q2, --nu takes one value or a "
-            "comma-separated list; lists are paired element by element (a single value is "
-            "used for every element). Values outside the table's range are an error unless "
-            "--extrapolate is given."),
+            "verify --write`) is printed with the values. Each of --Q1, --Q2, --nu, "
+            "--theta-ratio, --psi takes one value or a comma-separated list; lists are paired "
+            "element by element (a single value is used for every element). Values outside "
+            "the table's range are an error unless --extrapolate is given."),
         epilog="Example: vimpact table lookup kv.parquet --Q1 0.01,0.1,1 --nu 0.5 --json")
     look.add_argument("table", metavar="TABLE", help="restitution table (.parquet)")
     look.add_argument("--Q1", type=_number_list, required=True, metavar="Q1[,Q1...]",
@@ -78,8 +87,12 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                       help="Poisson ratio, dimensionless")
     look.add_argument("--Q2", type=_number_list, metavar="Q2[,Q2...]",
                       help="G1/G2, dimensionless (standard-solid tables only)")
-    look.add_argument("--theta-ratio", type=float, metavar="RATIO",
-                      help="Theta / (m R^2), only for tables that hold several")
+    look.add_argument("--theta-ratio", type=_number_list, metavar="RATIO[,RATIO...]",
+                      help="Theta / (m R^2), dimensionless, > 0: for tables that hold several "
+                           "(interpolated in log theta_ratio)")
+    look.add_argument("--psi", type=_number_list, metavar="PSI[,PSI...]",
+                      help="friction incidence 2 (1 - nu) / (mu (2 - nu)) v_c0 / v_z0, "
+                           "dimensionless, >= 0: for tables with a psi column")
     look.add_argument("--extrapolate", action="store_true",
                       help="extrapolate linearly outside the covered range (clipped to "
                            "0 <= e <= 1) instead of failing")
@@ -116,8 +129,10 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
             "Restitution against impact speed for one material and sphere, from the table: "
             "each speed gives Q1 (through the Hertz time) and is looked up. The material model "
             "is inferred from the options (--E/--G with --eta -> kelvin_voigt; --G1 --G2 "
-            "--eta -> standard_solid) and must be the table's. Columns of the CSV: v_z0_m_s "
-            "(m/s), Q1, [Q2,] e_z, e_x, beta_x (dimensionless)."),
+            "--eta -> standard_solid) and must be the table's. A table with a friction "
+            "incidence axis psi needs --angle-deg and --mu: psi = 2 (1 - nu) / (mu (2 - nu)) "
+            "tan(angle) for a non-spinning sphere, the same at every speed. Columns of the "
+            "CSV: v_z0_m_s (m/s), Q1, [Q2,] [psi,] e_z, e_x, beta_x (dimensionless)."),
         epilog=("Example: vimpact table export kv.parquet --out curve.csv --E 5e10 --nu 0.5 "
                 "--eta 1e5 --R 0.2 --m 10 --vz0-min 0.1 --vz0-max 10 --n 50"))
     exp.add_argument("table", metavar="TABLE", help="restitution table (.parquet)")
@@ -133,9 +148,15 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
                    help="lowest normal impact speed, m/s (> 0)")
     g.add_argument("--vz0-max", type=float, required=True, metavar="M_S",
                    help="highest normal impact speed, m/s")
-    g.add_argument("--n", type=int, default=50, metavar="N", help="number of speeds (default 50)")
+    g.add_argument("--n", type=int, default=50, metavar="N",
+                   help=f"number of speeds (default 50, at most {MAX_CURVE_POINTS})")
     g.add_argument("--spacing", choices=("log", "linear"), default="log",
                    help="spacing of the speeds (default log)")
+    g = exp.add_argument_group("friction (tables with a psi axis)")
+    g.add_argument("--angle-deg", type=float, metavar="DEG",
+                   help="impact angle from the surface normal, degrees, in [0, 90)")
+    g.add_argument("--mu", type=float, metavar="MU",
+                   help="Coulomb friction coefficient, > 0 (inf: full stick)")
     g = exp.add_argument_group("options")
     g.add_argument("--extrapolate", action="store_true",
                    help="extrapolate outside the table's range instead of failing")
@@ -165,12 +186,19 @@ def _cmd_info(a) -> int:
 
 def _cmd_lookup(a) -> int:
     table = _open(a.table)
-    given = {"--Q1": a.Q1, "--nu": a.nu, **({"--Q2": a.Q2} if a.Q2 else {})}
+    given = {"--Q1": a.Q1, "--nu": a.nu, **({"--Q2": a.Q2} if a.Q2 else {}),
+             **({"--theta-ratio": a.theta_ratio} if a.theta_ratio else {}),
+             **({"--psi": a.psi} if a.psi else {})}
     if len({len(v) for v in given.values()} - {1}) > 1:
         raise ValueError(", ".join(f"{k} has {len(v)} values" for k, v in given.items())
                          + ": lists must have one length (or be a single value)")
-    res = table.lookup(np.array(a.Q1), np.array(a.nu), None if a.Q2 is None else np.array(a.Q2),
-                       extrapolate=a.extrapolate, theta_ratio=a.theta_ratio, method=a.method)
+    n = max(len(v) for v in given.values())
+
+    def column(values):
+        return None if values is None else np.broadcast_to(np.array(values, dtype=float), (n,))
+
+    res = table.lookup(column(a.Q1), column(a.nu), column(a.Q2), extrapolate=a.extrapolate,
+                       theta_ratio=column(a.theta_ratio), method=a.method, psi=column(a.psi))
     bound = res.pop("error_bound")
     names = list(res)
     rows = [{k: _json_value(float(res[k][i])) for k in names} for i in range(len(res["Q1"]))]
@@ -237,6 +265,9 @@ def _cmd_export(a) -> int:
     if not require_n:
         raise ValueError(f"--n = {a.n} is not allowed: must be an integer >= 2 "
                          "(1 only when --vz0-min equals --vz0-max)")
+    if a.n > MAX_CURVE_POINTS:
+        raise ValueError(f"--n = {a.n} is not allowed: at most {MAX_CURVE_POINTS} speeds "
+                         "per curve")
     if not (math.isfinite(a.vz0_min) and a.vz0_min > 0):
         raise ValueError(f"--vz0-min = {a.vz0_min!r} is not allowed: must be a finite speed > 0 (m/s)")
     if not (math.isfinite(a.vz0_max) and a.vz0_max >= a.vz0_min):
@@ -254,15 +285,20 @@ def _cmd_export(a) -> int:
         speeds = np.linspace(a.vz0_min, a.vz0_max, a.n)
     df = table.export_curve(a.out, material, a.R, a.m, speeds, theta_ratio=a.theta_ratio,
                             extrapolate=a.extrapolate,
-                            allow_large_contact=a.allow_large_contact)
+                            allow_large_contact=a.allow_large_contact,
+                            angle_deg=a.angle_deg, mu=a.mu)
     summary = {"out": a.out, "model": material.model, "rows": len(df),
+               **({"psi": float(df.psi.iloc[0]), "angle_deg": a.angle_deg, "mu": a.mu}
+                  if "psi" in df.columns else {}),
                "v_z0_m_s": [float(speeds[0]), float(speeds[-1])],
                "Q1": [float(df.Q1.min()), float(df.Q1.max())],
                "e_z": [_json_value(df.e_z.min()), _json_value(df.e_z.max())]}
     if a.json:
         print(json.dumps(summary))
     else:
+        at = (f", psi {df.psi.iloc[0]:.4g} at {a.angle_deg:g} deg, mu {a.mu:g}"
+              if "psi" in df.columns else "")
         print(f"wrote {len(df)} speeds {speeds[0]:.6g} .. {speeds[-1]:.6g} m/s "
               f"(Q1 {df.Q1.min():.4g} .. {df.Q1.max():.4g}, e_z {df.e_z.min():.4g} .. "
-              f"{df.e_z.max():.4g}) to {a.out}")
+              f"{df.e_z.max():.4g}{at}) to {a.out}")
     return 0
