@@ -112,3 +112,27 @@ def test_grid_tolerance_on_an_elastic_grid_is_refused(tmp_path):
     with pytest.raises(InputError, match="grid.tolerance = 1e-05 is not allowed for a "
                                          "elastic grid"):
         run_sweep(path, progress=False)
+
+
+@pytest.mark.slow
+def test_refined_dataset_keeps_only_its_parts(tmp_path):
+    """Dataset layout: the cache sits among the parts while the sweep runs and leaves
+    before _common_metadata is written (a dataset holds only its parts)."""
+    from vimpact.sweep.store import verify_table
+
+    path = tmp_path / "kv.toml"
+    path.write_text(KV.format(tol=TOL).replace('output = "kv.parquet"',
+                                               'output = "kv.parquet"\nlayout = "dataset"'))
+
+    def stop_after_first_chunk(done, total):
+        raise KeyboardInterrupt
+
+    with pytest.raises(SweepInterrupted):
+        run_sweep(path, progress=stop_after_first_chunk)
+    assert (tmp_path / "kv.parquet" / runner.GRID_CACHE).is_file()
+    out = run_sweep(path, resume=True, progress=False)
+    assert not (out / runner.GRID_CACHE).exists()
+    assert "content hash verified" in verify_table(out)
+    table = RestitutionTable.open(out)
+    assert json.loads(table.meta("grid_refinement"))["met"]
+    assert table.interpolation_error["outputs"]["beta_x"]["max"] <= TOL
