@@ -195,3 +195,131 @@ class _Limited(io.RawIOBase):
         if not self.closed:
             self.real.close()
         super().close()
+
+
+# ---- a survey: random bit flips over a whole part ------------------------------------
+
+def flip_survey(part: Path, spec, flips: int = 200, seed: int = 0) -> dict:
+    """Flip one random bit of a copy of the part file ``part`` (anywhere: pages,
+    headers, footer), ``flips`` times, and classify each outcome, with the checks of
+    :func:`vimpact.sweep.store.existing_parts` now and with the footer-only check
+    resume used before (schema readable, this sweep's hash and chunk):
+
+    ``now``: ``detected`` (moved aside and computed again), ``refused`` (looks like
+    another sweep's part), ``harmless`` (passes, data read back unchanged),
+    ``undetected`` (passes with changed data: must stay 0).
+    ``footer_only``: ``caught`` (footer unreadable or not this sweep's),
+    ``crash_later`` (passes, then reading the data raises), ``harmless``,
+    ``silently_wrong`` (passes with changed data); ``max_abs_e_z_change`` over those.
+    """
+    import shutil
+    import tempfile
+
+    import numpy as np
+    import pandas as pd
+
+    from vimpact.sweep import store
+
+    original = pq.read_table(part).to_pandas()
+    rng = random.Random(seed)
+    now = dict(detected=0, refused=0, harmless=0, undetected=0)
+    old = dict(caught=0, crash_later=0, harmless=0, silently_wrong=0)
+    worst = 0.0
+    with tempfile.TemporaryDirectory() as tmp:
+        copy = Path(tmp) / part.name
+        for _ in range(flips):
+            shutil.copyfile(part, copy)
+            flip_bit(copy, rng.randrange(copy.stat().st_size), rng.randrange(8))
+            kind, _why = store._check_part(copy, spec)
+            try:
+                back = pq.read_table(copy).to_pandas()
+                same = back.shape == original.shape and back.equals(original)
+            except Exception:  # noqa: BLE001
+                back, same = None, False
+            if kind == "ok":
+                now["harmless" if same else "undetected"] += 1
+            else:
+                now["detected" if kind == "bad" else "refused"] += 1
+            try:  # the check resume made before: the footer only
+                meta = store.decode_metadata(pq.read_schema(copy).metadata)
+                footer_ok = meta.get("sweep_hash") == spec.sweep_hash \
+                    and meta.get("chunk") == int(part.stem.split("-")[1])
+            except Exception:  # noqa: BLE001
+                footer_ok = False
+            if not footer_ok:
+                old["caught"] += 1
+            elif back is None:
+                old["crash_later"] += 1
+            elif same:
+                old["harmless"] += 1
+            else:
+                old["silently_wrong"] += 1
+                if back.shape == original.shape:
+                    d = np.abs(back["e_z"].to_numpy() - original["e_z"].to_numpy())
+                    worst = max(worst, float(np.nanmax(d)) if np.isfinite(d).any() else np.inf)
+    return {"flips": flips, "now": now, "footer_only": old, "max_abs_e_z_change": worst,
+            "pandas": pd.__version__}
+
+
+def overhead(rows: int = 200_000, repeats: int = 3) -> dict:
+    """CPU seconds (best of ``repeats``, side by side) of writing and reading a table of
+    ``rows`` rows shaped like a sweep's (1 int64, 30 float64, 3 string columns): plain
+    ``pyarrow.parquet`` vs :func:`vimpact.sweep.store.write_atomic` (page checksums,
+    content hash, fsync) and :func:`vimpact.sweep.store.verify_table` (every page
+    read with its CRC checked, hash recomputed)."""
+    import tempfile
+    import time
+
+    import numpy as np
+    import pyarrow as pa
+
+    from vimpact.sweep import store
+
+    rng = np.random.default_rng(0)
+    cols = {"row": pa.array(np.arange(rows, dtype=np.int64))}
+    cols.update({f"x{k}": pa.array(rng.random(rows)) for k in range(30)})
+    cols["path"] = pa.array(np.where(rng.random(rows) < 0.5, "continuum_kv", "elements"))
+    cols["status"] = pa.array(np.full(rows, "ok"))
+    cols["error"] = pa.nulls(rows, pa.string())
+    table = pa.table(cols).replace_schema_metadata({b"vimpact.model": b"kelvin_voigt"})
+
+    def best(fn):
+        times = []
+        for _ in range(repeats):
+            t0 = time.process_time()
+            fn()
+            times.append(time.process_time() - t0)
+        return min(times)
+    with tempfile.TemporaryDirectory() as tmp:
+        plain, checked = Path(tmp) / "plain.parquet", Path(tmp) / "checked.parquet"
+        out = {"rows": rows,
+               "write_plain_s": best(lambda: pq.write_table(table, plain)),
+               "write_checked_s": best(lambda: store.write_atomic(table, checked)),
+               "read_plain_s": best(lambda: pq.read_table(plain)),
+               "verify_s": best(lambda: store.verify_table(checked)),
+               "hash_only_s": best(lambda: store.content_hash(table)),
+               "bytes_plain": plain.stat().st_size, "bytes_checked": checked.stat().st_size}
+    out["write_ratio"] = out["write_checked_s"] / out["write_plain_s"]
+    out["verify_vs_read_ratio"] = out["verify_s"] / out["read_plain_s"]
+    return out
+
+
+if __name__ == "__main__":  # python -m tests.sweep.faults SPEC [FLIPS] | --overhead [ROWS]
+    import json
+    import sys
+    import tempfile
+
+    from vimpact.sweep import run_sweep
+    from vimpact.sweep.spec import load_spec
+
+    if sys.argv[1] == "--overhead":
+        print(json.dumps(overhead(int(sys.argv[2]) if len(sys.argv) > 2 else 200_000),
+                         indent=1))
+        sys.exit(0)
+    spec_path = Path(sys.argv[1])
+    flips = int(sys.argv[2]) if len(sys.argv) > 2 else 200
+    with tempfile.TemporaryDirectory() as tmp:
+        parts = run_sweep(spec_path, out=Path(tmp) / "survey.parquet", shard=(0, 1),
+                          progress=False)
+        first = sorted(parts.glob("part-*.parquet"))[0]
+        print(json.dumps(flip_survey(first, load_spec(spec_path), flips), indent=1))

@@ -579,7 +579,10 @@ def _existing_parts(spec, parts: Path, hasher: ContentHash | None = None) -> dic
         if kind == "foreign":
             raise ValueError(f"{path} {why}; remove {parts} to start over")
         if kind == "bad":
-            aside = move_aside(path)
+            try:
+                aside = move_aside(path)
+            except FileNotFoundError:  # another process (a shard) moved or replaced it
+                continue
             print(f"vimpact sweep: {path.name} {_as_phrase(why)}; moved to {aside}, "
                   "computing it again", file=sys.stderr)
             continue
