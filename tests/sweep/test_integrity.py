@@ -270,6 +270,19 @@ def test_verify_table_refuses_a_damaged_table(tmp_path, clean, fault):
     assert str(out) in message and what in message and "\n" not in message
 
 
+def test_table_info_refuses_a_damaged_table(tmp_path, clean, capsys):
+    """What the user runs: ``vimpact table info`` on the clean table, then on a flipped one."""
+    _, clean_bytes = clean
+    out = tmp_path / "t.parquet"
+    out.write_bytes(clean_bytes)
+    assert cli.main(["table", "info", str(out)]) == 0
+    capsys.readouterr()
+    faults.flip_in_data_page(out, "e_z", seed=1)
+    assert cli.main(["table", "info", str(out)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and str(out) in err[0] and "checksum" in err[0]
+
+
 def test_resume_rewrites_a_damaged_final_table(tmp_path, clean, capsys):
     spec, clean_bytes = clean
     out = tmp_path / "t.parquet"
