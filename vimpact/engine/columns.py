@@ -47,7 +47,8 @@ import numpy as np
 
 from vimpact.model.hertz import Q1_PER_TAU, hertz_scales
 from vimpact.model.material import MODELS
-from vimpact.model.scene import DEFAULT_THETA_RATIO, TANGENTIAL_EFFECTS, TANGENTIAL_MEMORY, Scene
+from vimpact.model.scene import (DEFAULT_THETA_RATIO, MAX_DASHPOT_TIME, TANGENTIAL_EFFECTS,
+                                 TANGENTIAL_MEMORY, Scene)
 from vimpact.model.validation import InputError, check_column, message
 
 #: numeric input columns: name -> (validation rule, default or None if required)
@@ -298,6 +299,15 @@ class SceneColumns:
                 f"the inputs of this row (G_inf = {self.G_inf[i]:.3g} Pa, R = {self.R[i]:.3g} m, "
                 f"m = {self.m[i]:.3g} kg, v_z0 = {self.v_z0[i]:.3g} m/s) give Hertz scales or "
                 "kernel inputs outside the floating-point range: not allowed")
+        with np.errstate(all="ignore"):
+            damped = ok & (tau0 > MAX_DASHPOT_TIME)
+        for i in np.flatnonzero(damped & self.valid):
+            self.reasons[i] = (
+                f"eta0_Pa_s = {self.eta0[i]:.3g} is not allowed in this row: the dashpot time "
+                f"eta0 / G_inf must be <= {MAX_DASHPOT_TIME:.0e} T = "
+                f"{MAX_DASHPOT_TIME * self.T[i]:.3g} s (Q1 <= "
+                f"{Q1_PER_TAU * MAX_DASHPOT_TIME:.2g}: beyond it the kernels' arithmetic "
+                "overflows, and the impact is fully damped, e_z < 1e-160)")
         bad = ~self.valid
         if bad.any():
             fields = {k: getattr(self, k) for k in _FIELDS}

@@ -25,6 +25,26 @@ DEFAULT_THETA_RATIO = 0.4
 #: The thesis's half-space limit: contact half-width at most this times R.
 HALF_SPACE_LIMIT = 0.2
 
+#: Largest parallel-dashpot time ``eta0 / G_inf`` in units of ``T`` (``Q1 <=
+#: sqrt(15/32) 1e100``): the kernels multiply it by velocities and forces that
+#: reach about its square, which overflows from about 1e150 (measured: the element
+#: path gives non-finite values from ``Q1 = 1e160``, the continuum path from
+#: ``1e190``). Nothing is lost: ``e_z ~ Q1^(-5/3) < 1e-160`` there.
+MAX_DASHPOT_TIME = 1e100
+
+
+class ScaleError(InputError):
+    """A scene whose Hertz scales or kernel-unit inputs leave the floating-point range.
+
+    Attributes
+    ----------
+    names : the inputs that set those scales, e.g. ``("G_inf", "R", "m", "v_z0", "Theta")``
+    """
+
+    def __init__(self, text: str, names: tuple[str, ...]):
+        super().__init__(text)
+        self.names = names
+
 
 @dataclass(frozen=True)
 class Scene:
@@ -94,10 +114,20 @@ class Scene:
                 and math.isfinite(1.0 / ratio) and math.isfinite(mat.dashpot_time / hz.T)
                 and all(math.isfinite(tau / hz.T) and math.isfinite(G / mat.G_inf)
                         for G, tau in mat.arms)):
-            raise InputError(
+            raise ScaleError(
                 f"the scene (G_inf = {mat.G_inf:.3g} Pa, R = {self.R:.3g} m, m = {self.m:.3g} kg, "
                 f"v_z0 = {self.v_z0:.3g} m/s, Theta = {self.Theta:.3g} kg m^2) is not allowed: "
-                "its Hertz scales or dimensionless inputs leave the floating-point range")
+                "its Hertz scales or dimensionless inputs leave the floating-point range",
+                ("G_inf", "R", "m", "v_z0", "Theta"))
+        if mat.dashpot_time / hz.T > MAX_DASHPOT_TIME:
+            raise ScaleError(
+                f"eta0 = {mat.eta0:.3g} Pa s is not allowed with G_inf = {mat.G_inf:.3g} Pa, "
+                f"R = {self.R:.3g} m, m = {self.m:.3g} kg, v_z0 = {self.v_z0:.3g} m/s: the "
+                f"dashpot time eta0 / G_inf must be <= {MAX_DASHPOT_TIME:.0e} T = "
+                f"{MAX_DASHPOT_TIME * hz.T:.3g} s (Q1 = {Q1_PER_TAU * mat.dashpot_time / hz.T:.3g}"
+                f" > {Q1_PER_TAU * MAX_DASHPOT_TIME:.2g}: beyond it the kernels' arithmetic "
+                "overflows, and the impact is fully damped, e_z < 1e-160)",
+                ("eta0", "G_inf", "R", "m", "v_z0"))
         object.__setattr__(self, "hertz", hz)
 
     @classmethod
@@ -116,6 +146,11 @@ class Scene:
         """
         Q1 = finite("Q1", Q1)
         require("Q1", Q1, Q1 >= 0.0, ">= 0")
+        if Q2 is None:  # a parallel dashpot: its kernel-unit time is bounded
+            require("Q1", Q1, Q1 <= Q1_PER_TAU * MAX_DASHPOT_TIME,
+                    f"<= {Q1_PER_TAU * MAX_DASHPOT_TIME:.2g} for a Kelvin-Voigt body (beyond it "
+                    "the kernels' arithmetic overflows; the impact is fully damped there, "
+                    "e_z < 1e-160)")
         nu = float(nu)
         R, m, v_z0 = 1.0, 1.0, 1.0
         d = 1e-4  # a_H = sqrt(R d) = 0.01 R
@@ -126,6 +161,9 @@ class Scene:
             material = Material.kelvin_voigt(nu=nu, G=G, eta=tau * G)
         else:
             Q2 = positive("Q2", Q2)
+            require("Q2", Q2, math.isfinite(G / Q2),
+                    f"large enough for the arm modulus G2 = G1 / Q2 (G1 = {G:.3g} Pa) to be a "
+                    "finite number")
             material = Material.standard_solid(nu=nu, G1=G, G2=G / Q2, eta=tau * G)
         return cls(material, R=R, m=m, v_z0=v_z0, v_x0=1.0, omega0=0.0,
                    Theta=positive("theta_ratio", theta_ratio) * m * R**2,
