@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from vimpact.engine.columns import SceneColumns
-from vimpact.engine.result import FINISHED, RESULT_FIELDS
+from vimpact.engine.result import FINISHED, RESULT_FIELDS, STATUSES
 from vimpact.kernels import layout
 from vimpact.model.numerics import MIN_CONTACT_STEPS
 from vimpact.model.scene import HALF_SPACE_LIMIT, TANGENTIAL_EFFECTS, TANGENTIAL_MEMORY
@@ -91,7 +91,9 @@ def unpack(cols: SceneColumns, out: np.ndarray, path_names: np.ndarray, explicit
                 tangential, out[:, layout.OUT_W_FRICTION] * cols.m * v_c0**2, 0.0),
         }
         gain = contact1 > contact0 * (1.0 + PASSIVITY_SLACK)
-        unresolved = out[:, layout.OUT_T_CONTACT] * steps_per_T < MIN_CONTACT_STEPS
+        contact_steps = out[:, layout.OUT_T_CONTACT] * steps_per_T
+        unresolved = contact_steps < MIN_CONTACT_STEPS
+        relative_gain = contact1 / contact0 - 1.0
     incremental = cols.memory == TANGENTIAL_MEMORY.index("incremental")
     status[ok & gain & incremental & ~explicit_euler] = "unstable"
     status[ok & gain & incremental & explicit_euler] = "energy_gain"
@@ -108,6 +110,7 @@ def unpack(cols: SceneColumns, out: np.ndarray, path_names: np.ndarray, explicit
         why[i] = refused[i][1]
     error = np.where(valid, why, cols.reasons)
     error = np.where(status == "non_finite", _nan_message(values, status, error), error)
+    _explain(status, error, contact_steps, relative_gain)
     with np.errstate(all="ignore"):
         result = {
             **values,
@@ -137,6 +140,23 @@ def guard(values: dict[str, np.ndarray], status: np.ndarray, tangential: np.ndar
     dead = ~np.isin(status, FINISHED)
     for v in values.values():
         v[dead] = np.nan
+
+
+def _explain(status: np.ndarray, error: np.ndarray, contact_steps: np.ndarray,
+             relative_gain: np.ndarray) -> None:
+    """A reason for every row whose status is not finished and has none yet: no row
+    ends without numbers and without saying why."""
+    for i in np.flatnonzero(~np.isin(status, FINISHED) & np.equal(error, None)):
+        if status[i] == "unresolved":
+            error[i] = (f"the contact lasted {contact_steps[i]:.3g} time steps on the element "
+                        f"path: at least {MIN_CONTACT_STEPS} are needed to resolve it (more "
+                        "steps per t_H, or the continuum path)")
+        elif status[i] == "unstable":
+            error[i] = (f"the contact energy rose by {relative_gain[i]:.2g} of its start "
+                        f"(allowed {PASSIVITY_SLACK:g}) in a passive scene: the step was too "
+                        "coarse (more steps or elements)")
+        else:
+            error[i] = STATUSES.get(status[i], status[i])
 
 
 def _nan_message(values: dict, status: np.ndarray, error: np.ndarray) -> np.ndarray:
