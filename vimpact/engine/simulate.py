@@ -79,7 +79,8 @@ def run_columns(cols: SceneColumns, numerics: Numerics, n_rec: int = 0, rec_ever
             for j in np.flatnonzero(costly):
                 refused[idx[j]] = ("too_costly",
                     f"this scene needs {per_t_H[j]:.3g} steps per Hertz time and "
-                    f"{arrays['n_elem'][j]} elements (refined for its stiffest mode): more than "
+                    f"{numerics.row_width / arrays['dxi'][j]:.3g} elements (refined for its "
+                    "stiffest mode): more than "
                     f"the limits {MAX_STEPS_PER_T_H:.0e} and {MAX_ELEMENTS_IN_ROW:.0e}")
             if not numerics.element_tolerance_reachable:
                 for j in np.flatnonzero(~costly):
@@ -210,8 +211,8 @@ def simulate(scene: Scene, numerics: Numerics | str | None = None, *,
     if res.status == "half_space" and not scene.allow_large_contact:
         raise HalfSpaceError(
             f"a_max = {res.a_max:.4g} m is not allowed: must be <= 0.2 R = "
-            f"{HALF_SPACE_LIMIT * scene.R:.4g} m (half-space model; allow_large_contact=True "
-            "or --allow-large-contact accepts it)")
+            f"{HALF_SPACE_LIMIT * scene.R:.4g} m (R = {scene.R:.4g} m; half-space model; "
+            "allow_large_contact=True or --allow-large-contact accepts it)")
     return res
 
 
