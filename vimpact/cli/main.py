@@ -38,13 +38,13 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def _negative_values(argv: list[str]) -> list[str]:
-    """``--E -1e9`` -> ``--E=-1e9``: argparse takes a token like ``-1e9`` for an
-    option; joined to its flag it is read as the value it is (and then refused
-    by the option's own check with a message that names it)."""
+    """``--E -1e9`` -> ``--E=-1e9``: argparse takes a token like ``-1e9`` (or
+    ``-inf``, ``-1/4``) for an option; joined to its flag it is read as the value
+    it is (and then refused by the option's own check with a message that names it)."""
     out: list[str] = []
     for token in argv:
         if (out and out[-1].startswith("--") and "=" not in out[-1] and token.startswith("-")
-                and _is_number(token)):
+                and (_is_number(token) or token[1:2].isdigit() or token[1:2] == ".")):
             out[-1] = f"{out[-1]}={token}"
         else:
             out.append(token)

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 from vimpact.model.material import Material
 
 
@@ -58,6 +60,10 @@ def material_from_args(a) -> Material:
             except ValueError:
                 raise ValueError(f"--prony = {text!r} is not allowed: must be "
                                  "'modulus:time' in Pa:s, e.g. 1e6:1e-3") from None
+            for value, what in ((G_i, "the modulus (Pa)"), (tau_i, "the relaxation time (s)")):
+                if not (math.isfinite(value) and value > 0.0):
+                    raise ValueError(f"--prony = {text!r} is not allowed: {what} must be a "
+                                     "finite number > 0")
             arms.append((G_i, tau_i))
         return Material.prony(nu=a.nu, G_inf=a.G, arms=arms, eta0=a.eta or 0.0)
     if prony:

@@ -7,6 +7,7 @@ import dataclasses
 import json
 import math
 import os
+import re
 from pathlib import Path
 
 from vimpact import __version__
@@ -14,7 +15,8 @@ from vimpact.cli.material_args import add_material_arguments, material_from_args
 from vimpact.engine.result import STATUSES, UNITS
 from vimpact.model.material import MODELS
 from vimpact.model.numerics import INTEGRATORS, PRESETS, Numerics
-from vimpact.model.scene import DEFAULT_THETA_RATIO, TANGENTIAL_EFFECTS, TANGENTIAL_MEMORY, Scene
+from vimpact.model.scene import (DEFAULT_THETA_RATIO, TANGENTIAL_EFFECTS, TANGENTIAL_MEMORY,
+                                 ScaleError, Scene)
 from vimpact.model.validation import InputError
 
 
@@ -76,8 +78,8 @@ def add_parser(sub) -> argparse.ArgumentParser:
                         "that runs (instead of a preset; between 1e-9 and 1e-2); refused where "
                         "the element path cannot reach it")
     g.add_argument("--integrator", choices=tuple(INTEGRATORS), help="override the integrator")
-    g.add_argument("--steps", type=int, help="override: time steps per Hertz contact time")
-    g.add_argument("--elements", type=int, help="override: elements per Hertz contact radius")
+    g.add_argument("--steps", type=_count, help="override: time steps per Hertz contact time")
+    g.add_argument("--elements", type=_count, help="override: elements per Hertz contact radius")
     g.add_argument("--rtol", type=float, help="override: tolerance of the continuum path")
     g.add_argument("--no-continuum", action="store_true",
                    help="always use the element kernel (no Kelvin-Voigt continuum path)")
@@ -94,28 +96,54 @@ def add_parser(sub) -> argparse.ArgumentParser:
     return sim
 
 
+def _count(text: str) -> int:
+    """An integer option; an integral float such as ``1e3`` is read as that integer (its
+    range is checked by :class:`Numerics`, with a message that names the option)."""
+    try:
+        return int(text)
+    except ValueError:
+        pass
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not value.is_integer():  # NaN, inf, 2.5, words: argparse names the option
+        raise argparse.ArgumentTypeError(f"{text!r} is not allowed: must be an integer")
+    return int(value)
+
+
 _PHYSICAL = ("E", "G", "eta", "G1", "G2", "prony", "R", "m", "Theta", "vz0", "model")
 _EFFECTS = {"tangential": "auto", "tangential_memory": "incremental"}
 #: Scene and Material parameter names -> the flag a user typed
 _FLAGS = {"v_z0": "--vz0", "v_x0": "--vx0", "omega0": "--omega0", "theta_ratio": "--theta-ratio",
           "tangential_memory": "--tangential-memory", "G_inf": "--G", "eta0": "--eta",
           "R": "--R", "m": "--m", "Theta": "--Theta", "mu": "--mu", "nu": "--nu", "Q1": "--Q1",
-          "Q2": "--Q2", "E": "--E", "G": "--G", "eta": "--eta", "G1": "--G1", "G2": "--G2"}
+          "Q2": "--Q2", "E": "--E", "G": "--G", "eta": "--eta", "G1": "--G1", "G2": "--G2",
+          "steps": "--steps", "elements": "--elements", "rtol": "--rtol",
+          "tolerance": "--tolerance", "integrator": "--integrator"}
+#: A parameter name where a message names one: at its start, or after "(", ", ", "; ".
+_NAMED = re.compile(r"(^|\(|, |; )(" + "|".join(sorted(map(re.escape, _FLAGS), key=len,
+                                                          reverse=True)) + r") = ")
+#: Options that set a scene's Hertz scales (named when those leave the float range).
+_SCALE_OPTIONS = ("E", "G", "G1", "G2", "eta", "prony", "R", "m", "Theta", "vz0", "theta_ratio")
 
 
 def _as_flags(exc: ValueError) -> InputError:
-    """The error of a Scene/Material parameter, named by its command-line flag."""
-    text = str(exc)
-    name = text.split(" = ", 1)[0]
-    if name in _FLAGS:
-        text = _FLAGS[name] + text[len(name):]
-    return InputError(text)
+    """The error of a Scene/Material/Numerics parameter, named by its command-line flag."""
+    return InputError(_NAMED.sub(lambda m: f"{m[1]}{_FLAGS[m[2]]} = ", str(exc)))
 
 
 def scene_from_args(a) -> Scene:
     """The scene described by parsed ``simulate`` options (errors name the flags)."""
     try:
         return _scene_from_args(a)
+    except ScaleError as exc:  # no one input is at fault: name the options that set the scales
+        typed = [f"--{n.replace('_', '-')} = {getattr(a, n)}" for n in _SCALE_OPTIONS
+                 if getattr(a, n, None) is not None]
+        if a.Q1 is not None or not typed:
+            raise _as_flags(exc) from None
+        reason = str(exc).split(" is not allowed: ", 1)[-1]
+        raise InputError(f"the scene {', '.join(typed)} is not allowed: {reason}") from None
     except InputError as exc:
         raise _as_flags(exc) from None
 
@@ -193,6 +221,14 @@ def _numerics(a, base: Numerics | None = None) -> Numerics:
     return numerics.with_(**changes)
 
 
+def numerics_from_args(a, base: Numerics | None = None) -> Numerics:
+    """:func:`_numerics` with errors that name the options (``--steps``, ``--rtol``, ...)."""
+    try:
+        return _numerics(a, base)
+    except InputError as exc:
+        raise _as_flags(exc) from None
+
+
 def _check_output(flag: str, path: str, suffixes: tuple[str, ...]) -> Path:
     """Refuse an output path before any work: wrong extension, a directory, a
     missing or unwritable folder."""
@@ -221,11 +257,14 @@ def run(a) -> int:
         scene, file_numerics = _scene_file(a)
     else:
         scene, file_numerics = scene_from_args(a), None
-    numerics = _numerics(a, file_numerics)
+    numerics = numerics_from_args(a, file_numerics)
     path = choose_path(scene, numerics)
     if a.explain and not a.json:
         print(path.explain())
-    res = simulate(scene, numerics, trajectory=bool(a.trajectory))
+    try:
+        res = simulate(scene, numerics, trajectory=bool(a.trajectory))
+    except InputError as exc:  # half-space exceeded, tolerance unreachable
+        raise _as_flags(exc) from None
     if a.trajectory:
         out = Path(a.trajectory)
         if out.suffix.lower() == ".csv":

@@ -8,6 +8,7 @@ leaves the finished chunks on disk, says how to resume and exits with 130.
 
 from __future__ import annotations
 
+import argparse
 import sys
 import time
 
@@ -15,8 +16,8 @@ import time
 def _shard(text: str) -> tuple[int, int]:
     try:
         index, count = (int(x) for x in text.split("/"))
-    except ValueError:
-        raise ValueError(f"--shard = {text!r} is not allowed: must be I/N, e.g. 0/4") from None
+    except ValueError:  # argparse prints "argument --shard: <this>"
+        raise argparse.ArgumentTypeError(f"{text!r} is not allowed: must be I/N, e.g. 0/4") from None
     return index, count
 
 
