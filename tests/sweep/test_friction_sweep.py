@@ -69,6 +69,17 @@ def test_example_spec_layout():
     assert {"mu", "psi", *FRICTION_OUTPUTS} <= set(cols)
     assert spec.units()["psi"] == "1" and spec.units()["friction_energy_J"] == "J"
     assert spec.units()["rebound_angle_deg"] == "deg"
+    # the scene that explains a row is the one the engine ran
+    p = spec.parameters()
+    batches, inputs = engine_columns(spec, p)
+    (rows, cols), = batches
+    for i in range(spec.rows):
+        scene = spec.scene(p, i)
+        assert (scene.v_x0, scene.mu) == (cols["v_x0_m_s"][i], cols["mu"][i])
+        assert scene.v_x0 == inputs["v_x0_m_s"][i] and scene.mu == inputs["mu"][i]
+        nu = p["nu"][i]
+        psi = 2 * (1 - nu) / (scene.mu * (2 - nu)) * scene.v_c0 / scene.v_z0
+        assert psi == pytest.approx(p["psi"][i], rel=1e-14, abs=0)
 
 
 def test_gross_slip_rows_follow_the_closed_form(example_tables):
