@@ -35,7 +35,7 @@ MAX_AXIS_NODES = 200
 
 def grid_table(model: str, axes: dict[str, np.ndarray], numerics, theta_ratio: float = 0.4,
                tangential: str = "auto", tangential_memory: str = "incremental",
-               rotation: bool = True):
+               rotation: bool = True, simulate=None):
     """Simulate every node of the grid ``axes`` and return it as a restitution table.
 
     Parameters
@@ -45,6 +45,8 @@ def grid_table(model: str, axes: dict[str, np.ndarray], numerics, theta_ratio: f
     axes : axis name -> node values (dimensionless)
     numerics : :class:`vimpact.Numerics` of every impact
     theta_ratio, tangential, tangential_memory, rotation : as for :class:`vimpact.Scene`
+    simulate : the direct simulation (default
+        :func:`vimpact.lookup.verify.simulate_dimensionless`)
 
     Returns
     -------
@@ -57,16 +59,51 @@ def grid_table(model: str, axes: dict[str, np.ndarray], numerics, theta_ratio: f
     names = list(axes)
     mesh = np.meshgrid(*(np.asarray(axes[a], float) for a in names), indexing="ij")
     cols = {a: m.ravel() for a, m in zip(names, mesh)}
-    sim = simulate_dimensionless(model, cols["Q1"], cols["nu"], cols.get("Q2"),
-                                 numerics=numerics, theta_ratio=theta_ratio,
-                                 tangential=tangential, tangential_memory=tangential_memory,
-                                 rotation=rotation)
+    sim = (simulate or simulate_dimensionless)(
+        model, cols["Q1"], cols["nu"], cols.get("Q2"), numerics=numerics,
+        theta_ratio=theta_ratio, tangential=tangential, tangential_memory=tangential_memory,
+        rotation=rotation)
     data = pd.DataFrame({**cols, **{k: sim[k].to_numpy(float) for k in ("e_z", "e_x", "beta_x")},
                          "status": sim["status"].to_numpy(dtype=object)})
     meta = {"model": model, "mode": "grid", "numerics": dataclasses.asdict(numerics),
             "tangential": tangential, "tangential_memory": tangential_memory,
             "rotation": rotation}
     return RestitutionTable(data, meta)
+
+
+class _SimulationMemory:
+    """:func:`vimpact.lookup.verify.simulate_dimensionless` that remembers: a point
+    (the same ``Q1``, ``Q2``, ``nu`` to the bit) simulated before in this refinement is
+    not simulated again. Rows are simulated independently of each other, so the
+    result is the same as without the memory. One instance per refinement (its
+    numerics and scene options do not change)."""
+
+    _COLUMNS = ("e_z", "beta_x", "e_x")
+
+    def __init__(self):
+        self.known: dict[tuple, tuple] = {}
+
+    def __call__(self, model, Q1, nu, Q2=None, **options) -> pd.DataFrame:
+        from vimpact.lookup.verify import simulate_dimensionless
+
+        nu = np.asarray(nu, dtype=float)
+        n = nu.size
+        q1 = np.broadcast_to(np.asarray(Q1, dtype=float), (n,))
+        q2 = np.full(n, -1.0) if Q2 is None else np.broadcast_to(np.asarray(Q2, dtype=float),
+                                                                 (n,))
+        keys = list(zip(q1.tolist(), q2.tolist(), nu.tolist()))
+        new = np.array([i for i, k in enumerate(keys) if k not in self.known], dtype=int)
+        if new.size:
+            sim = simulate_dimensionless(model, q1[new], nu[new],
+                                         None if Q2 is None else q2[new], **options)
+            values = np.column_stack([sim[c].to_numpy(float) for c in self._COLUMNS])
+            for i, row, status in zip(new, values, sim["status"].to_numpy(dtype=object)):
+                self.known[keys[i]] = (*row, status)
+        rows = [self.known[k] for k in keys]
+        out = pd.DataFrame({c: np.array([r[j] for r in rows], dtype=float)
+                            for j, c in enumerate(self._COLUMNS)})
+        out["status"] = np.array([r[-1] for r in rows], dtype=object)
+        return out
 
 
 def _mid(a: np.ndarray, log: bool) -> np.ndarray:
@@ -142,8 +179,9 @@ def refine_grid(model: str, axes: dict, tolerance: float, numerics=None, *,
             raise InputError(f"{a} = {v[v <= 0][0]!r} is not allowed: the {a} axis is "
                              f"logarithmic, give {a} > 0")
         nodes[a] = v
+    memory = _SimulationMemory()  # points of earlier rounds are not simulated again
     opts = dict(theta_ratio=theta_ratio, tangential=tangential,
-                tangential_memory=tangential_memory, rotation=rotation)
+                tangential_memory=tangential_memory, rotation=rotation, simulate=memory)
     rounds, stopped = [], "max_rounds"
     table = final = None
     # errors along the axes add up at points between nodes in every axis, but rarely
@@ -154,7 +192,8 @@ def refine_grid(model: str, axes: dict, tolerance: float, numerics=None, *,
     axis_tol = tolerance / 2.0
     while True:
         table = grid_table(model, nodes, numerics, **opts)
-        err = held_out_errors(table, numerics, n=0, method=method, kinds=("axis",))
+        err = held_out_errors(table, numerics, n=0, method=method, kinds=("axis",),
+                              simulate=memory)
         worst = np.nanmax(np.column_stack([err[f"{k}_err"].to_numpy() for k in outputs]), axis=1)
         failed = ~np.isfinite(worst)
         worst = np.where(failed, np.inf, worst)  # a failed check is not a pass
@@ -192,7 +231,7 @@ def refine_grid(model: str, axes: dict, tolerance: float, numerics=None, *,
                         if new else ", checking cell centres and random points"))
         if not new:
             final = interpolation_error(table, numerics, n=n_random, seed=seed, method=method,
-                                        kinds=("centre", "random"))
+                                        kinds=("centre", "random"), simulate=memory)
             entry["final_check"] = {k: final["outputs"][k]["max"] for k in outputs}
             if all(final["outputs"][k]["max"] is not None
                    and final["outputs"][k]["max"] <= tolerance for k in outputs):
@@ -217,7 +256,7 @@ def refine_grid(model: str, axes: dict, tolerance: float, numerics=None, *,
             nodes[a] = np.unique(np.concatenate([nodes[a], v]))
     if final is None or stopped != "met":
         final = interpolation_error(table, numerics, n=n_random, seed=seed, method=method,
-                                    kinds=("centre", "random"))
+                                    kinds=("centre", "random"), simulate=memory)
     final_ok = all(final["outputs"][k]["max"] is not None
                    and final["outputs"][k]["max"] <= tolerance for k in outputs)
     report = {"tolerance": float(tolerance), "outputs": list(outputs), "method": method,

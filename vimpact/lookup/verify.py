@@ -168,7 +168,7 @@ def _scene_options(table) -> dict:
 
 
 def held_out_errors(table, numerics=None, n: int = 200, seed: int = 0, theta_ratio=None,
-                    method: str = "cubic", kinds=KINDS) -> pd.DataFrame:
+                    method: str = "cubic", kinds=KINDS, simulate=None) -> pd.DataFrame:
     """Lookup minus direct simulation at held-out points, one row per point.
 
     Parameters
@@ -180,6 +180,8 @@ def held_out_errors(table, numerics=None, n: int = 200, seed: int = 0, theta_rat
     theta_ratio : the table's theta_ratio slice, if it holds several
     method : lookup method compared (``"cubic"`` or ``"linear"``)
     kinds : kinds of held-out points
+    simulate : the direct simulation (default :func:`simulate_dimensionless`; a
+        refinement passes one that remembers the points it simulated before)
 
     Returns
     -------
@@ -197,9 +199,10 @@ def held_out_errors(table, numerics=None, n: int = 200, seed: int = 0, theta_rat
             and len(table._theta_values()) else 0.4)
     else:
         t = theta
-    sim = simulate_dimensionless(table.model, pts["Q1"].to_numpy(), pts["nu"].to_numpy(),
-                                 pts["Q2"].to_numpy() if "Q2" in pts else None,
-                                 numerics=numerics, theta_ratio=t, **_scene_options(table))
+    sim = (simulate or simulate_dimensionless)(
+        table.model, pts["Q1"].to_numpy(), pts["nu"].to_numpy(),
+        pts["Q2"].to_numpy() if "Q2" in pts else None,
+        numerics=numerics, theta_ratio=t, **_scene_options(table))
     look = table.lookup(*(pts[a].to_numpy() for a in ("Q1", "nu")),
                         Q2=pts["Q2"].to_numpy() if "Q2" in pts else None,
                         theta_ratio=theta_ratio, method=method)
@@ -214,7 +217,7 @@ def held_out_errors(table, numerics=None, n: int = 200, seed: int = 0, theta_rat
     return out
 
 
-def _node_error(table, numerics, theta_ratio, n_nodes: int, seed: int) -> dict:
+def _node_error(table, numerics, theta_ratio, n_nodes: int, seed: int, simulate=None) -> dict:
     """Max |table - fresh simulation| on a sample of the table's own nodes."""
     rows = table.ok
     if "theta_ratio" in rows.columns and theta_ratio is not None:
@@ -225,9 +228,9 @@ def _node_error(table, numerics, theta_ratio, n_nodes: int, seed: int) -> dict:
     rows = rows.iloc[np.sort(pick)]
     t = float(rows["theta_ratio"].iloc[0]) if "theta_ratio" in rows.columns else 0.4
     Q2 = rows["Q2"].to_numpy(float) if table.model == "standard_solid" else None
-    sim = simulate_dimensionless(table.model, rows["Q1"].to_numpy(float),
-                                 rows["nu"].to_numpy(float), Q2, numerics=numerics,
-                                 theta_ratio=t, **_scene_options(table))
+    sim = (simulate or simulate_dimensionless)(
+        table.model, rows["Q1"].to_numpy(float), rows["nu"].to_numpy(float), Q2,
+        numerics=numerics, theta_ratio=t, **_scene_options(table))
     ok = (sim["status"] == "ok").to_numpy()
     return {name: float(np.nanmax(np.abs(sim[name].to_numpy(float)[ok]
                                          - rows[name].to_numpy(float)[ok]), initial=0.0))
@@ -235,7 +238,8 @@ def _node_error(table, numerics, theta_ratio, n_nodes: int, seed: int) -> dict:
 
 
 def interpolation_error(table, numerics=None, n: int = 200, seed: int = 0, theta_ratio=None,
-                        method: str = "cubic", kinds=KINDS, node_sample: int = 50) -> dict:
+                        method: str = "cubic", kinds=KINDS, node_sample: int = 50,
+                        simulate=None) -> dict:
     """Max and RMS error of :meth:`RestitutionTable.lookup` between the nodes.
 
     Simulates the held-out points (:func:`held_out_errors`) with the table's
@@ -252,6 +256,7 @@ def interpolation_error(table, numerics=None, n: int = 200, seed: int = 0, theta
     method : ``"cubic"`` (default) or ``"linear"``
     kinds : kinds of held-out points (default all: axis mid-points, cell centres, random)
     node_sample : table nodes re-simulated to report the table's own error there
+    simulate : the direct simulation (default :func:`simulate_dimensionless`)
 
     Returns
     -------
@@ -265,7 +270,7 @@ def interpolation_error(table, numerics=None, n: int = 200, seed: int = 0, theta
     from vimpact import __version__
 
     numerics = numerics_of(table) if numerics is None else numerics
-    err = held_out_errors(table, numerics, n, seed, theta_ratio, method, kinds)
+    err = held_out_errors(table, numerics, n, seed, theta_ratio, method, kinds, simulate)
     axes = [a for a in ("Q1", "Q2", "nu") if a in err.columns]
     good = np.all(np.isfinite(err[[f"{k}_err" for k in _OUTPUTS if k != "e_x"]].to_numpy()),
                   axis=1)
@@ -295,7 +300,7 @@ def interpolation_error(table, numerics=None, n: int = 200, seed: int = 0, theta
         "numerics": dataclasses.asdict(numerics),
         "outputs": outputs,
         "per_axis": per_axis,
-        "node_error": _node_error(table, numerics, theta_ratio, node_sample, seed)
+        "node_error": _node_error(table, numerics, theta_ratio, node_sample, seed, simulate)
         if node_sample else {},
         "vimpact_version": __version__,
     }
