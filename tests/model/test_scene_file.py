@@ -135,7 +135,8 @@ def test_friction_coefficient_and_impact_angle():
 def test_friction_example():
     scene, _ = load_scene(SCENES / "steel_on_polymer_friction.toml")
     assert 0.0 < scene.mu < math.inf and scene.computes_tangential
-    # incidence of docs/physics.md#coulomb-friction (Maw, Barber and Fawcett): gross slip from the start
+    # incidence (Maw, Barber and Fawcett; docs/physics.md#coulomb-friction): gross slip
+    # from the start
     nu = scene.material.nu
     psi = 2 * (1 - nu) / (scene.mu * (2 - nu)) * scene.v_c0 / scene.v_z0
     assert psi > 4 * (1 - nu) * scene.contact_mass_factor / (2 - nu)  # psi > 4 chi

@@ -188,8 +188,8 @@ def test_random_friction_rows_match_single_simulations(tmp_path):
 
 
 def test_spec_without_friction_has_no_friction_inputs(tmp_path):
-    spec = load_spec(write(tmp_path, RANDOM_FRICTION.replace('mu = { choice = [0.0, 0.25, "inf"] }\n',
-                                                             "")))
+    stick = RANDOM_FRICTION.replace('mu = { choice = [0.0, 0.25, "inf"] }\n', "")
+    spec = load_spec(write(tmp_path, stick))
     assert not spec.has_friction
     assert "mu" not in spec.columns() and "psi" not in spec.columns()
     assert "angle_deg" in spec.columns() and set(FRICTION_OUTPUTS) <= set(spec.columns())

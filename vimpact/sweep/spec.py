@@ -30,26 +30,27 @@ scene files live in :mod:`vimpact.model.toml_input`.
 ``[grid]``: parameter sets on a grid of the dimensionless parameters, simulated
 on the reference scene of :meth:`vimpact.Scene.from_dimensionless` (the grid is
 the product of all axes; ``Q1`` runs fastest, then ``Q2``, ``nu``,
-``theta_ratio``, ``psi``). Keys: ``tolerance`` (optional, not an axis: the interpolation
-error the grid should meet between its nodes, a number in [1e-9, 1e-1]; stored
-as :attr:`SweepSpec.grid_tolerance` and in the metadata as ``grid_tolerance``,
-for a refinement of the grid to read), ``Q1`` (kelvin_voigt, standard_solid; >= 0), ``Q2``
-(standard_solid; > 0), ``nu`` (required; in [0, 0.5]), ``theta_ratio``
-(Theta / (m R^2), default 0.4), ``psi`` (optional, >= 0: the incidence
-``2 (1 - nu) / (mu (2 - nu)) v_c0 / v_z0`` of docs/physics.md#coulomb-friction)
-with ``mu`` (not an axis: the friction coefficient, a number > 0, default 1;
-only with ``psi``). With friction the results depend on ``psi`` (with ``nu`` and
-``theta_ratio``) and not on ``mu`` and ``v_c0`` apart, so a row with ``psi > 0``
-is the reference scene with this ``mu`` and ``v_x0 = psi mu (2 - nu) / (2 (1 -
-nu)) v_z0``; a row with ``psi = 0`` is the full-stick limit (``mu = inf``,
-``v_x0 = v_z0``), the row of the same grid without ``psi``. Without ``psi`` the
-grid is full stick and has no ``mu`` and ``psi`` columns. An axis is a number, a list of numbers, or a
-table ``{ start, stop, per_decade }`` (log-spaced, both ends included) or
-``{ start, stop, num, log = true|false }`` (``num`` points; ``log`` defaults
-to the rule below). With ``per_decade`` the number of intervals is
-``round(per_decade * log10(stop / start))``, so both ends are exact. An
-elastic grid has ``nu`` and ``theta_ratio`` only (``Q1 = 0``); a Prony series
-has no dimensionless grid.
+``theta_ratio``, ``psi``). Keys: ``tolerance`` (optional, not an axis: the
+interpolation error the grid should meet between its nodes, a number in [1e-9,
+1e-1]; stored as :attr:`SweepSpec.grid_tolerance` and in the metadata as
+``grid_tolerance``, for a refinement of the grid to read), ``Q1``
+(kelvin_voigt, standard_solid; >= 0), ``Q2`` (standard_solid; > 0), ``nu``
+(required; in [0, 0.5]), ``theta_ratio`` (Theta / (m R^2), default 0.4),
+``psi`` (optional, >= 0: the incidence ``2 (1 - nu) / (mu (2 - nu)) v_c0 /
+v_z0`` of docs/physics.md#coulomb-friction) with ``mu`` (not an axis: the
+friction coefficient, a number > 0, default 1; only with ``psi``). With
+friction the results depend on ``psi`` (with ``nu`` and ``theta_ratio``) and
+not on ``mu`` and ``v_c0`` apart, so a row with ``psi > 0`` is the reference
+scene with this ``mu`` and ``v_x0 = psi mu (2 - nu) / (2 (1 - nu)) v_z0``; a
+row with ``psi = 0`` is the full-stick limit (``mu = inf``, ``v_x0 = v_z0``),
+the row of the same grid without ``psi``. Without ``psi`` the grid is full
+stick and has no ``mu`` and ``psi`` columns. An axis is a number, a list of
+numbers, or a table ``{ start, stop, per_decade }`` (log-spaced, both ends
+included) or ``{ start, stop, num, log = true|false }`` (``num`` points;
+``log`` defaults to the rule below). With ``per_decade`` the number of
+intervals is ``round(per_decade * log10(stop / start))``, so both ends are
+exact. An elastic grid has ``nu``, ``theta_ratio`` (and ``psi``) only (``Q1 = 0``); a
+Prony series has no dimensionless grid.
 
 ``[random]``: physical parameter sets drawn at random, as the thesis does to
 show that results collapse onto ``Q1`` (and ``Q2``). ``rows`` (required) is
