@@ -48,6 +48,9 @@ def material_from_args(a) -> Material:
         raise ValueError(f"--G1/--G2 belong to the standard solid, not --model {model}")
     if a.E is None and a.G is None:
         raise missing("E", "give the modulus as --E or --G (Pa)")
+    if a.E is not None and a.G is not None and model != "prony":
+        raise ValueError(f"--E = {a.E:g} cannot be combined with --G = {a.G:g}: give the "
+                         "modulus once (Pa)")
     if model == "prony":
         if not prony:
             raise missing("prony", "a Prony series needs at least one --prony G_I:TAU_I")

@@ -17,7 +17,7 @@ from vimpact.model.material import MODELS
 from vimpact.model.numerics import INTEGRATORS, PRESETS, Numerics
 from vimpact.model.scene import (DEFAULT_THETA_RATIO, TANGENTIAL_EFFECTS, TANGENTIAL_MEMORY,
                                  ScaleError, Scene)
-from vimpact.model.validation import InputError
+from vimpact.model.validation import InputError, positive
 
 
 def add_parser(sub) -> argparse.ArgumentParser:
@@ -179,7 +179,7 @@ def _scene_from_args(a) -> Scene:
             raise missing(name, f"the {what} is required (or use --Q1 --nu)")
     theta = a.Theta
     if theta is None and a.theta_ratio is not None:
-        theta = a.theta_ratio * a.m * a.R**2
+        theta = positive("theta_ratio", a.theta_ratio) * a.m * a.R**2
     return Scene(material, R=a.R, m=a.m, v_z0=a.vz0, v_x0=a.vx0, omega0=a.omega0, Theta=theta,
                  allow_large_contact=a.allow_large_contact, **effects)
 
