@@ -152,12 +152,11 @@ def refine_grid(model: str, axes: dict, tolerance: float, numerics=None, *,
         of the refined grid: cell centres and random points included),
         ``stopped`` (why the loop ended), ``nodes`` (grid points).
 
-    Hook for a sweep driver: with ``[grid] tolerance``, call
-    ``axes, report = refine_grid(spec.model, spec_axes, tolerance, spec.numerics,
-    theta_ratio=..., tangential=spec.tangential, tangential_memory=spec.tangential_memory,
-    rotation=spec.rotation)`` before the chunks are made, sweep ``axes`` instead of the
-    spec's, and store ``report`` as the metadata entry ``grid_refinement`` and
-    ``report["final"]`` as ``interpolation_error``.
+    A sweep with ``[grid] tolerance`` calls it before its chunks are made
+    (:func:`vimpact.sweep.runner.refined_spec`, with the spec's numerics and scene
+    options and this module's node budget :data:`MAX_NODES`, :data:`MAX_AXIS_NODES`),
+    sweeps the refined axes, stores ``report`` as the metadata entry
+    ``grid_refinement`` and measures the finished table's ``interpolation_error``.
     """
     from vimpact.lookup.verify import held_out_errors, interpolation_error
     from vimpact.model.numerics import Numerics

@@ -423,7 +423,10 @@ def run_sweep(spec_path, out=None, resume: bool = False,
     ------
     ValueError
         for a bad spec or output, parts of another run, parts without ``resume``,
-        missing chunks at ``combine``, a second sweep into the same output.
+        missing chunks at ``combine``, a second sweep into the same output;
+        :class:`~vimpact.model.validation.InputError` (a ``ValueError``) for a
+        ``[grid] tolerance`` the refinement cannot reach within its node budget
+        (:func:`refined_spec`), before anything is written.
     SweepInterrupted
         (a ``KeyboardInterrupt``) on Ctrl-C: finished chunks stay; the message
         says how to resume.
