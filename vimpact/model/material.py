@@ -49,10 +49,22 @@ class Material:
         poisson_ratio("nu", self.nu)
         positive("G_inf", self.G_inf)
         non_negative("eta0", self.eta0)
+        require("arms", self.arms, isinstance(self.arms, (tuple, list)),
+                "a sequence of pairs (G_i [Pa], tau_i [s])")
         for i, arm in enumerate(self.arms):
-            require(f"arm {i + 1}", arm, len(arm) == 2, "a pair (G_i [Pa], tau_i [s])")
+            require(f"arm {i + 1}", arm, isinstance(arm, (tuple, list)) and len(arm) == 2,
+                    "a pair (G_i [Pa], tau_i [s])")
             positive(f"G_{i + 1} (arm {i + 1} modulus, Pa)", arm[0])
             positive(f"tau_{i + 1} (arm {i + 1} relaxation time, s)", arm[1])
+        # the model names the rheology (and how Q1, Q2 are reported): it must fit it
+        fits = {"elastic": (not self.arms and self.eta0 == 0.0, "no arms and eta0 = 0"),
+                "kelvin_voigt": (not self.arms, "no Maxwell arms"),
+                "standard_solid": (len(self.arms) <= 1 and self.eta0 == 0.0,
+                                   "at most one Maxwell arm and eta0 = 0"),
+                "prony": (True, "")}
+        ok, what = fits[self.model]
+        require("model", self.model, ok, f"a rheology with {what} (given {len(self.arms)} "
+                f"arms, eta0 = {self.eta0:g} Pa s)")
 
     # ---- constructors -------------------------------------------------
     @classmethod
@@ -84,6 +96,8 @@ class Material:
         """Prony series: relaxed modulus ``G_inf`` (Pa), arms ``[(G_i [Pa], tau_i [s]), ...]``,
         optional parallel dashpot ``eta0`` (Pa s)."""
         nu = poisson_ratio("nu", nu)
+        require("arms", arms, isinstance(arms, (tuple, list)),
+                "a list of pairs (G_i [Pa], tau_i [s])")
         checked = []
         for i, arm in enumerate(arms, start=1):
             require(f"arm {i}", arm, isinstance(arm, (tuple, list)) and len(arm) == 2,

@@ -9,7 +9,8 @@ from dataclasses import dataclass, field
 
 from vimpact.model.hertz import HertzScales, Q1_PER_TAU, effective_modulus, hertz_scales
 from vimpact.model.material import Material
-from vimpact.model.validation import InputError, finite, flag, friction_coefficient, one_of, positive, require
+from vimpact.model.validation import (InputError, finite, flag, friction_coefficient, one_of,
+                                     poisson_ratio, positive, require)
 
 TANGENTIAL_MEMORY = ("incremental", "seed")
 
@@ -151,7 +152,7 @@ class Scene:
                     f"<= {Q1_PER_TAU * MAX_DASHPOT_TIME:.2g} for a Kelvin-Voigt body (beyond it "
                     "the kernels' arithmetic overflows; the impact is fully damped there, "
                     "e_z < 1e-160)")
-        nu = float(nu)
+        nu = poisson_ratio("nu", nu)  # a type check too: float("0.5") would take a string
         R, m, v_z0 = 1.0, 1.0, 1.0
         d = 1e-4  # a_H = sqrt(R d) = 0.01 R
         E_star = 15.0 * m * v_z0**2 / (16.0 * math.sqrt(R) * d**2.5)
