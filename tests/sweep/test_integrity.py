@@ -135,6 +135,34 @@ def test_parts_and_tables_carry_checksums_and_hash(tmp_path, clean):
 
 # ---- faults in a part, then --resume --------------------------------------------------
 
+def rewrite(path, table):
+    pq.write_table(table, path, write_page_checksum=True)
+
+
+def changed_value(path):
+    """One e_z value changed, the metadata (with both hashes) kept: a value changed after
+    it was hashed, in pages with valid checksums."""
+    table = pq.read_table(path)
+    e_z = table["e_z"].to_pylist()
+    e_z[0] += 2.2e-3
+    rewrite(path, table.set_column(table.schema.get_field_index("e_z"), "e_z",
+                                   pa.array(e_z)).replace_schema_metadata(table.schema.metadata))
+
+
+def changed_metadata(key, value):
+    """A ``vimpact.<key>`` entry changed, everything else (and the stored hashes) kept."""
+    def damage(path):
+        table = pq.read_table(path)
+        meta = dict(table.schema.metadata)
+        meta[f"vimpact.{key}".encode()] = value(meta[f"vimpact.{key}".encode()])
+        rewrite(path, table.replace_schema_metadata(meta))
+    return damage
+
+
+def one_bit(text: bytes) -> bytes:
+    return bytes([text[0] ^ 1]) + text[1:]
+
+
 def other_chunk(path):
     """Part 1 copied over this part: a vimpact part of this sweep, the wrong chunk."""
     path.write_bytes((path.parent / "part-00001.parquet").read_bytes())
@@ -160,6 +188,10 @@ PART_FAULTS = {
     "non-vimpact Parquet file": faults.write_foreign_parquet,
     "not Parquet at all": lambda p: p.write_bytes(b"PAR1 this is not a Parquet file\n"),
     "another chunk's part": other_chunk,
+    "a value changed after hashing": changed_value,
+    "one bit of its sweep hash (else it would pass for another sweep's)":
+        changed_metadata("sweep_hash", one_bit),
+    "its row counts changed": changed_metadata("counts", lambda v: v.replace(b"2", b"3")),
 }
 
 
@@ -235,21 +267,17 @@ def test_a_bit_flip_anywhere_in_a_part_is_caught_or_harmless(tmp_path, clean, se
 
 # ---- the final table ---------------------------------------------------------------
 
-def other_hash(path):
-    """The same data with another stored hash (a value changed after it was hashed)."""
-    table = pq.read_table(path)
-    meta = dict(table.schema.metadata)
-    meta[b"vimpact.content_sha256"] = store.content_hash(table.slice(1)).encode()
-    pq.write_table(table.replace_schema_metadata(meta), path, write_page_checksum=True)
-
-
 TABLE_FAULTS = {
     "bit flip in e_z data page": (lambda p: faults.flip_in_data_page(p, "e_z", seed=0),
                                   "checksum"),
     "bit flip in e_z data page of the last row group":
         (lambda p: faults.flip_in_data_page(p, "e_z", seed=1, row_group=2), "row group 2"),
     "damaged page header": (lambda p: faults.damage_page_header(p, "e_z"), "row group 0"),
-    "stored hash differs from the data": (other_hash, "content hash mismatch"),
+    "a value changed after hashing": (changed_value, "content hash mismatch"),
+    "units changed": (changed_metadata("units", lambda v: v.replace(b'"Pa"', b'"kPa"')),
+                      "metadata hash mismatch"),
+    "stored content hash changed": (changed_metadata("content_sha256", one_bit),
+                                    "metadata hash mismatch"),
     "truncated": (lambda p: faults.truncate(p, 0.9), "truncated"),
     "empty": (lambda p: faults.truncate(p, 0.0), "empty"),
     "not a vimpact table": (faults.write_foreign_parquet, "not a vimpact table"),
@@ -300,7 +328,8 @@ def test_a_table_without_a_hash_is_accepted_with_the_check_skipped(tmp_path, cle
     spec, clean_bytes = clean
     (tmp_path / "new.parquet").write_bytes(clean_bytes)
     table = pq.read_table(tmp_path / "new.parquet")
-    meta = {k: v for k, v in table.schema.metadata.items() if b"content_sha256" not in k}
+    meta = {k: v for k, v in table.schema.metadata.items()
+            if k not in (b"vimpact.content_sha256", b"vimpact.metadata_sha256")}
     old = tmp_path / "old.parquet"
     pq.write_table(table.replace_schema_metadata(meta), old)  # as vimpact wrote before
     assert store.verify_table(old).endswith("hash check skipped")

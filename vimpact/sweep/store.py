@@ -24,9 +24,11 @@ package and schema version), its chunk and row range, and a small summary
 merges without reading the data again.
 
 Integrity: every part and every table is written with Parquet page checksums
-(CRC-32 of each page) and a content hash ``vimpact.content_sha256``
+(CRC-32 of each page), a content hash ``vimpact.content_sha256``
 (:class:`ContentHash`: SHA-256 of the column values in a canonical form,
-independent of the Parquet encoding). A part is trusted only after
+independent of the Parquet encoding) and a hash of the ``vimpact.*`` metadata
+entries ``vimpact.metadata_sha256`` (:func:`metadata_hash`: the footer has no
+checksum). A part is trusted only after
 :func:`verify_part` has read it back (page checksums checked, hash
 recomputed): ``--resume`` moves a part that fails to ``<parts>/_corrupt/`` (one
 line on stderr names it and the reason) and computes it again; the combination
@@ -62,6 +64,9 @@ INT_KEYS = ("schema_version", "seed", "rows", "chunk", "row_start", "row_stop", 
 COMMON_METADATA = "_common_metadata"
 #: Metadata key (without the prefix) of the content hash (:class:`ContentHash`).
 CONTENT_HASH_KEY = "content_sha256"
+#: Metadata key (without the prefix) of the hash of the other ``vimpact.*`` entries
+#: (:func:`metadata_hash`).
+METADATA_HASH_KEY = "metadata_sha256"
 #: First line hashed by :class:`ContentHash`: names the definition (change it with it).
 CONTENT_HASH_VERSION = "vimpact content sha256 v1"
 #: Subdirectory of the parts directory that damaged parts are moved to.
@@ -207,6 +212,47 @@ def content_hash(table) -> str:
     return ContentHash().update(table).hexdigest()
 
 
+def metadata_hash(raw: dict | None) -> str:
+    """SHA-256 (64 hex digits) of the ``vimpact.*`` entries of Parquet key-value
+    metadata ``raw`` (bytes or str keys and values) other than
+    ``vimpact.metadata_sha256`` itself: over the entries sorted by key, each as the
+    little-endian ``uint64`` byte length of the key, the key, the length of the
+    value, the value (UTF-8). Stored as ``vimpact.metadata_sha256``, it makes a
+    changed metadata entry (the sweep hash, the spec, units, the content hash)
+    detectable: the page checksums do not cover the footer."""
+    def as_bytes(x) -> bytes:
+        return x if isinstance(x, bytes) else str(x).encode()
+    own = (META_PREFIX + METADATA_HASH_KEY).encode()
+    items = sorted((as_bytes(k), as_bytes(v)) for k, v in (raw or {}).items())
+    h = hashlib.sha256()
+    for key, value in items:
+        if key.startswith(META_PREFIX.encode()) and key != own:
+            for piece in (key, value):
+                h.update(len(piece).to_bytes(8, "little"))
+                h.update(piece)
+    return h.hexdigest()
+
+
+def _with_metadata_hash(schema_or_table):
+    """``schema_or_table`` with ``vimpact.metadata_sha256`` set to :func:`metadata_hash`
+    of its metadata."""
+    meta = dict(schema_or_table.schema.metadata or {}) if hasattr(schema_or_table, "schema") \
+        else dict(schema_or_table.metadata or {})
+    meta[(META_PREFIX + METADATA_HASH_KEY).encode()] = metadata_hash(meta).encode()
+    if hasattr(schema_or_table, "replace_schema_metadata"):
+        return schema_or_table.replace_schema_metadata(meta)
+    return schema_or_table.with_metadata(meta)
+
+
+def _check_metadata_hash(raw: dict | None) -> None:
+    """:class:`_Damaged` if ``raw`` stores a metadata hash that its entries do not give."""
+    raw = raw or {}
+    stored = raw.get((META_PREFIX + METADATA_HASH_KEY).encode())
+    if stored is not None and stored.decode(errors="replace") != metadata_hash(raw):
+        raise _Damaged("metadata hash mismatch (a vimpact.* metadata entry changed after "
+                       "it was written)")
+
+
 def _canonical(column) -> tuple[bytes, bytes, bytes]:
     """The validity, values and data bytes of one column (see :class:`ContentHash`)."""
     import numpy as np
@@ -293,6 +339,7 @@ def _scan(path: Path, hasher: ContentHash | None = None) -> tuple[dict, str, int
         meta = decode_metadata(pf.schema_arrow.metadata)
     except Exception as exc:  # noqa: BLE001
         raise _Damaged(f"schema unreadable ({_first_line(exc)})") from None
+    _check_metadata_hash(pf.schema_arrow.metadata)
     own = ContentHash(pf.schema_arrow.names)
     for group in range(pf.metadata.num_row_groups):
         try:
@@ -323,6 +370,10 @@ def _check_part(path: Path, spec, hasher: ContentHash | None = None) -> tuple[st
         return "bad", str(exc)
     except Exception as exc:  # noqa: BLE001
         return "bad", f"schema unreadable ({_first_line(exc)})"
+    try:  # first: a damaged sweep hash must not pass for another sweep's
+        _check_metadata_hash(pf.schema_arrow.metadata)
+    except _Damaged as exc:
+        return "bad", str(exc)
     got = meta.get("sweep_hash")
     if not got:
         return "bad", "not a part of a vimpact sweep (no vimpact.sweep_hash metadata)"
@@ -361,8 +412,9 @@ def rows_in_footer(pf) -> int:
 def verify_part(path, spec) -> str | None:
     """Why the part file ``path`` cannot be used by the sweep ``spec``, or ``None``.
 
-    Checks, in order: readable Parquet with its footer (not truncated); vimpact
-    sweep metadata with this sweep's hash; the chunk and row range its name says;
+    Checks, in order: readable Parquet with its footer (not truncated); its
+    metadata equal to its stored metadata hash; vimpact sweep metadata with this
+    sweep's hash; the chunk and row range its name says;
     a stored content hash; this sweep's columns; every page read back with its
     checksum verified; the content hash recomputed from the data equal to the
     stored one; the chunk's number of rows. Returns a one-line reason such as
@@ -377,7 +429,8 @@ def verify_table(path) -> str:
     the file and what failed otherwise.
 
     Checks: the file exists, is Parquet and not truncated (footer present); it has
-    ``vimpact.*`` metadata (else: foreign); every page reads back, with its CRC-32
+    ``vimpact.*`` metadata (else: foreign), equal to its ``vimpact.metadata_sha256``
+    (:func:`metadata_hash`) where stored; every page reads back, with its CRC-32
     verified where the writer stored one (vimpact writes them since
     ``vimpact.content_sha256`` exists); the :class:`ContentHash` recomputed from the
     data equals ``vimpact.content_sha256``. A dataset: ``_common_metadata``
@@ -422,9 +475,14 @@ def _verify_dataset(path: Path) -> tuple[int, int, bool]:
         raise _Damaged(f"an unfinished sweep dataset (no {COMMON_METADATA})")
     try:
         import pyarrow.parquet as pq
-        meta = decode_metadata(pq.read_schema(common).metadata)
+        raw = pq.read_schema(common).metadata
+        meta = decode_metadata(raw)
     except Exception as exc:  # noqa: BLE001
         raise _Damaged(f"{COMMON_METADATA} unreadable ({_first_line(exc)})") from None
+    try:
+        _check_metadata_hash(raw)
+    except _Damaged as exc:
+        raise _Damaged(f"{COMMON_METADATA}: {exc}") from None
     if not meta:
         raise _Damaged(f"not a vimpact table (no vimpact.* metadata in {COMMON_METADATA})")
     parts = []
@@ -475,6 +533,8 @@ def write_atomic(table, path: Path, *, schema_only: bool = False, more=(),
     file in the same directory, fsync, ``os.replace``, fsync of the directory.
 
     Data is written with Parquet page checksums and the metadata
+    ``vimpact.metadata_sha256`` (:func:`metadata_hash`, also for ``schema_only``,
+    whenever there are ``vimpact.*`` entries) and
     ``vimpact.content_sha256`` (:class:`ContentHash`), computed here from
     ``table``, or given as ``content_sha256`` (required with ``more``: the hash of
     all rows, which the caller computed while verifying them). ``more``: further
@@ -496,6 +556,9 @@ def write_atomic(table, path: Path, *, schema_only: bool = False, more=(),
         meta = dict(table.schema.metadata or {})
         meta[(META_PREFIX + CONTENT_HASH_KEY).encode()] = content_sha256.encode()
         table = table.replace_schema_metadata(meta)
+    if any(k.startswith(META_PREFIX.encode()) if isinstance(k, bytes) else
+           str(k).startswith(META_PREFIX) for k in (table.schema.metadata or {})):
+        table = _with_metadata_hash(table)
     tmp = path.with_name(f".{path.name}.{socket.gethostname()}.{os.getpid()}.tmp")
     try:
         with open(tmp, "wb") as f:
@@ -805,7 +868,8 @@ class OutputLock:
 
 
 __all__ = ["COMMON_METADATA", "CONTENT_HASH_KEY", "CONTENT_HASH_VERSION", "CORRUPT_DIR",
-           "ContentHash", "INT_KEYS", "JSON_KEYS", "META_PREFIX", "OutputLock", "check_output",
+           "ContentHash", "INT_KEYS", "JSON_KEYS", "METADATA_HASH_KEY", "META_PREFIX",
+           "OutputLock", "check_output", "metadata_hash",
            "combine", "content_hash", "decode_metadata", "decode_value", "encode_metadata",
            "encode_value", "existing_parts", "fsync_dir", "is_complete", "move_aside",
            "part_path", "parts_dir", "read_metadata", "remove_temporaries", "rows_in_footer",
