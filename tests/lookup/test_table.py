@@ -372,6 +372,28 @@ def test_psi_is_an_interpolation_axis(tmp_path):
         table.lookup(0.1, nu, psi=-1.0, extrapolate=True)
 
 
+def test_a_psi_table_from_friction_simulations_reads_its_rows(tmp_path):
+    """A table swept over psi by simulate_batch with Coulomb friction (psi set through mu at
+    v_c0 = v_z0; psi = 0 is mu = inf, full stick): the lookup gives its rows at the nodes,
+    and where gross slip holds throughout (largest psi) the rows follow the closed form
+    beta_x = -1 + 2 chi (1 + e_z) / psi (docs/physics.md#coulomb-friction)."""
+    nu, psis = 0.3, (0.0, 2.0, 8.0, 16.0)
+    mus = [np.inf if p == 0 else 2 * (1 - nu) / (p * (2 - nu)) for p in psis]
+    scenes = [Scene.from_dimensionless(q, nu, mu=mu) for mu in mus for q in (0.1, 1.0)]
+    df = results_frame(scenes)
+    df["psi"] = np.repeat(psis, 2)
+    df["mu"] = np.repeat(mus, 2)
+    write_table(tmp_path / "f.parquet", df, "kelvin_voigt")
+    table = RestitutionTable.open(tmp_path / "f.parquet")
+    got = table.lookup(df.Q1.to_numpy(), nu, psi=df.psi.to_numpy())
+    np.testing.assert_allclose(got["beta_x"], df.beta_x.to_numpy(), rtol=0, atol=1e-12)
+    assert table.info()["ranges"]["mu"][1] == np.inf
+    chi = (1 - nu) * (1 + 1 / 0.4) / (2 - nu)
+    last = df[df.psi == 16.0]
+    # F_x = mu F_z at every step: the impulse balance holds to rounding
+    np.testing.assert_allclose(last.beta_x, -1 + 2 * chi * (1 + last.e_z) / 16.0, atol=1e-12)
+
+
 def test_psi_on_a_stick_table_is_refused(kv):
     with pytest.raises(InputError, match="psi = 1.0 is not allowed: the table has no psi column"):
         kv.lookup(0.1, 0.5, psi=1.0)
