@@ -605,3 +605,12 @@ def test_cli_lookup_psi_and_theta_lists(vimpact_main, tmp_path, capsys):
                                       "0.3", "--psi", "6,10,12", "--theta-ratio", "0.4,0.4"],
                        capsys)
     assert code == 2 and "--theta-ratio has 2 values, --psi has 3 values" in err
+
+
+def test_cli_info_json_is_standard_with_mu_inf(vimpact_main, kv, tmp_path, capsys):
+    path = tmp_path / "stick.parquet"
+    write_table(path, kv.data.drop(columns=["model"]).assign(mu=np.inf), "kelvin_voigt")
+    code, out, err = run(vimpact_main, ["table", "info", str(path), "--json"], capsys)
+    assert code == 0, err
+    info = json.loads(out, parse_constant=lambda c: pytest.fail(f"non-standard JSON {c}"))
+    assert info["ranges"]["mu"] == ["inf", "inf"]

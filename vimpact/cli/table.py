@@ -173,10 +173,22 @@ def _open(path):
     return RestitutionTable.open(path)
 
 
+def _plain(x):
+    """``x`` with non-finite floats as text (``"inf"``: mu of a full-stick row), so the
+    JSON is standard."""
+    if isinstance(x, dict):
+        return {k: _plain(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [_plain(v) for v in x]
+    if isinstance(x, (float, np.floating)) and not math.isfinite(x):
+        return str(float(x))
+    return x
+
+
 def _cmd_info(a) -> int:
     info = _open(a.table).info()
     if a.json:
-        print(json.dumps(info, default=_json_value))
+        print(json.dumps(_plain(info), default=_json_value, allow_nan=False))
     else:
         from vimpact.lookup.table import format_info
 
