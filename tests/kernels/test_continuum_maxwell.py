@@ -282,6 +282,69 @@ def test_step_limit():
     assert out[OUT_STEPS] == 5
 
 
+def test_edge_search_finds_the_step_from_any_hint():
+    """The unloading edge's history step is searched from the previous call's
+    (``kh``): whatever the hint, it is the last loading step that starts at or
+    below the edge (what a bisection over all steps gives), and ``theta`` puts
+    the step's dense output on the edge."""
+    from vimpact.kernels.continuum_maxwell import _dense, _edge
+    rng = np.random.default_rng(3)
+    nh = 40
+    hs = np.concatenate([[0.0], np.cumsum(rng.uniform(0.01, 0.1, nh))])
+    rc = np.zeros((nh, 5, 1))
+    rc[:, 0, 0] = hs[:-1]
+    rc[:, 1, 0] = np.diff(hs)  # s linear in theta on each step
+    for s_t in rng.uniform(0.0, hs[-1], 30):
+        want = int(np.searchsorted(hs, s_t, side="right")) - 1
+        for hint in (0, nh - 1, int(rng.integers(0, nh)), -5, nh + 5):
+            kh = np.array([hint], dtype=np.int64)
+            k, th = _edge(rc, hs, nh, s_t, kh)
+            assert k == want and kh[0] == want
+            assert 0.0 <= th <= 1.0
+            assert abs(_dense(rc, k, th, 0) - s_t) < 1e-14
+
+
+@pytest.mark.parametrize("phase", [0, 1])
+def test_step_right_hand_side_is_the_functions(phase):
+    """The step has the right-hand side written out (no calls with arrays in
+    its loop); its derivative at the step's end (``K[6]``, FSAL) must be what
+    ``_rhs_load`` / ``_rhs_unload`` give there, to the bit, in both phases
+    (unloading on a made-up loading history with the edge inside it)."""
+    from vimpact.kernels.continuum_maxwell import _n_load, _n_unload, _rhs_once, _step
+    rng = np.random.default_rng(11 + phase)
+    n, tang = 2, True
+    g = np.array([1.5, 0.4])
+    itau = 1.0 / np.array([0.3, 2.0])
+    m_l, m_u = _n_load(n, tang), _n_unload(n, tang)
+    mm = max(m_l, m_u)
+    nh = 5
+    hs = np.linspace(0.0, 1.0, nh + 1)
+    rc = np.zeros((nh, 5, m_l))
+    rc[:, :, 3:] = rng.uniform(-0.1, 0.1, (nh, 5, m_l - 3))
+    rc[:, 0, 0] = hs[:-1]
+    rc[:, 1, 0] = np.diff(hs)
+    rc[:, 0, 2] = 2.0 * hs[:-1]  # t at the start of each step
+    rc[:, 1, 2] = 2.0 * np.diff(hs)
+    m = m_l if phase == 0 else m_u
+    y = np.zeros(mm)
+    y[:m] = rng.uniform(0.2, 0.8, m)
+    y[0] = 0.55  # the edge inside step 2
+    y[2] = 2.5  # t after the history
+    K = np.zeros((7, mm))
+    e_val = np.zeros(n + 1)
+    kh = np.zeros(1, dtype=np.int64)
+    atol = np.full(mm, 1e-8)
+    _rhs_once(phase, y, K, 0, 0.1, g, itau, n, 0.8, 3.5, tang, rc, hs, nh, e_val, kh)
+    y1 = np.zeros(mm)
+    tmp = np.zeros(mm)
+    err = _step(phase, m, y, 0.01, K, y1, tmp, 0.1, g, itau, n, 0.8, 3.5, tang, rc, hs, nh,
+                e_val, atol, 1e-8, kh)
+    assert math.isfinite(err) and np.all(y1[:m] != y[:m])
+    K2 = np.zeros((7, mm))
+    _rhs_once(phase, y1, K2, 0, 0.1, g, itau, n, 0.8, 3.5, tang, rc, hs, nh, e_val, kh)
+    assert np.array_equal(K2[0, :m], K[6, :m])
+
+
 def test_zero_time_arms_are_dropped():
     """An arm with ``tau = 0`` follows at once and carries no force."""
     a = outputs(run(0.1, [1.0, 5.0], [0.5, 0.0]))
