@@ -394,6 +394,14 @@ def test_a_psi_table_from_friction_simulations_reads_its_rows(tmp_path):
     np.testing.assert_allclose(last.beta_x, -1 + 2 * chi * (1 + last.e_z) / 16.0, atol=1e-12)
 
 
+def test_the_only_theta_ratio_may_be_given_as_an_array(kv):
+    same = kv.lookup([0.1, 0.2], 0.5, theta_ratio=[0.4, 0.4])
+    assert same["e_z"].tolist() == kv.lookup([0.1, 0.2], 0.5)["e_z"].tolist()
+    with pytest.raises(InputError, match=r"theta_ratio = 0.5 is not allowed: the table holds "
+                                         r"Theta / \(m R\^2\) = 0.4 only"):
+        kv.lookup([0.1, 0.2], 0.5, theta_ratio=[0.4, 0.5])
+
+
 def test_psi_on_a_stick_table_is_refused(kv):
     with pytest.raises(InputError, match="psi = 1.0 is not allowed: the table has no psi column"):
         kv.lookup(0.1, 0.5, psi=1.0)

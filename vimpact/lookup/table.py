@@ -608,7 +608,8 @@ class RestitutionTable:
         if not len(match):
             raise InputError(
                 f"theta_ratio = {theta_ratio!r} is not allowed: the table holds Theta / (m R^2) = "
-                + ", ".join(_fmt(v) for v in values) + " (no interpolation in theta_ratio)")
+                + ", ".join(_fmt(v) for v in values) + " only (a table with several values "
+                "interpolates between them)")
         return None if len(values) == 1 else float(match[0])
 
     def _psi_values(self) -> np.ndarray:
@@ -816,8 +817,10 @@ class RestitutionTable:
                              "2 (1 - nu) / (mu (2 - nu)) v_c0 / v_z0)")
         thetas = self._theta_values() if "theta_ratio" in self.data.columns else np.array([])
         theta_axis = len(thetas) > 1
-        if not theta_axis:
-            self._resolve_theta(theta_ratio)  # one value: only it (raises otherwise)
+        if not theta_axis:  # one value: only it (raises otherwise)
+            for t in ([None] if theta_ratio is None else
+                      np.unique(np.asarray(theta_ratio, dtype=float).ravel())):
+                self._resolve_theta(None if t is None else float(t))
         elif theta_ratio is None:
             self._resolve_theta(None)  # raises: several values, give one
         named = {"Q1": Q1, "nu": nu} if Q2 is None else {"Q1": Q1, "Q2": Q2, "nu": nu}
