@@ -145,3 +145,73 @@ def _arm_stress(w, qrow, g):
     for i in range(g.shape[0]):
         acc += g[i] * (w - qrow[i])
     return acc
+
+
+@jit()
+def arm_implicit_coefficients(g, tau, h):
+    """Split of each arm's step impulse for the Verlet kick (fast arms implicit).
+
+    Over a step ``h`` on which the element's displacement is linear with the
+    drift velocity ``v`` (from ``w0``, arm ``q0``), the exact arm force
+    ``g (w - q)`` has the impulse ``h g [(1 - phi)(w0 - q0) + tau phi v]``; its
+    end value is ``g [E (w0 - q0) + tau (1 - E) v]``. The kick takes the end
+    value in its second half, so its first half must carry
+    ``g [kap (w0 - q0) + c v]`` with ``kap = 2 (1 - phi) - E`` and
+    ``c = tau (1 + E - 2 (1 - E) x^-1)``, ``x = h / tau``: ``c >= 0`` is a
+    damping taken implicitly in the half-step velocity like the dashpot (an
+    arm much faster than the step acts as the dashpot ``g tau``; a slow one
+    as its spring, ``c -> h x / 6``).
+
+    Returns
+    -------
+    kap : (n_arms,) weights of the arms' stresses ``g_i (w0 - q_i)`` at the step start
+    c : ``sum_i g_i c_i``, the arms' damping per unit element stiffness (units of ``T``)
+    """
+    n = tau.shape[0]
+    kap = np.empty(n)
+    c = 0.0
+    for i in range(n):
+        E, omE, phi = _arm_coefficient(tau[i], h)
+        kap[i] = 2.0 * (1.0 - phi) - E
+        x = h / tau[i] if tau[i] > 0.0 else np.inf
+        if x < 1e-3:  # series: 1 + E - 2 (1 - E) / x = x^2/6 - x^3/12 + x^4/40
+            ci = h * x * (1.0 / 6.0 - x * (1.0 / 12.0 - x / 40.0))
+        else:
+            ci = h / x * (1.0 + E - 2.0 * omE / x)
+        c += g[i] * ci
+    return kap, c
+
+
+@jit(inline="always")
+def _arm_start(w, qrow, g, kap):
+    """``sum g_i kap_i (w - q_i)``: the arms' start-of-step stress in the Verlet kick
+    (:func:`arm_implicit_coefficients`)."""
+    acc = 0.0
+    for i in range(g.shape[0]):
+        acc += g[i] * kap[i] * (w - qrow[i])
+    return acc
+
+
+@jit(inline="always")
+def _follow_over_impulse(w0, w1, qrow, g, tau, dt):
+    """Like :func:`_follow_over` (arms along ``w0 -> w1`` over ``dt``, written to
+    ``qrow``); returns ``(sum g_i (w1 - q_i), mean)``, ``mean`` the arms' stress
+    averaged over ``dt``, exact for the linear path:
+    ``sum g_i [(1 - phi_i)(w0 - q0_i) + (tau_i phi_i / dt)(w1 - w0)]``. An element
+    entering contact within a step: an arm faster than that part jumps to its
+    dashpot-like stress at once, which a straight line from the entry stress misses."""
+    acc = 0.0
+    mean = 0.0
+    for i in range(g.shape[0]):
+        E, omE, phi = _arm_coefficient(tau[i], dt)
+        x = dt / tau[i] if tau[i] > 0.0 else np.inf
+        if x < 1e-3:  # phi / x = 1/2 - x/6 + x^2/24
+            phi_x = 0.5 - x * (1.0 / 6.0 - x / 24.0)
+        else:
+            phi_x = phi / x
+        q0 = qrow[i]
+        qi = E * q0 + omE * w0 + phi * (w1 - w0)
+        qrow[i] = qi
+        acc += g[i] * (w1 - qi)
+        mean += g[i] * ((1.0 - phi) * (w0 - q0) + phi_x * (w1 - w0))
+    return acc, mean

@@ -35,6 +35,15 @@ Integrators (the value of ``integrator``):
     drift ``u += h v+``, elements follow the linear path of the drift (for
     which the arm update is exact), then ``v = v+ - h/2 (F_el' + C' v+)``.
     Second order for smooth forces, unconditionally stable for the dashpot.
+    Maxwell arms get the exact impulse of the drift path: the second half-kick
+    takes their end stress, the first half the rest, whose damping part
+    (``sum g_i tau_i (1 + E_i - 2 (1 - E_i) tau_i / h)``) is implicit in the
+    half-step velocity like the dashpot (:func:`vimpact.kernels.arms.arm_implicit_coefficients`):
+    an arm faster than the step stays second order and stable (it acts as
+    the dashpot ``g_i tau_i``), where taking its stress explicitly was first
+    order. An element entering within the step gets the arms' exact mean
+    stress over its ramp; the force that decides whether an element still
+    pushes at the step end takes the arms' damping part at the end velocity.
 
 Compile-time specialization (issue 5): the impact body :func:`_impact` takes
 the scene's effects as its first arguments (``tangential``, ``memory``,
@@ -53,8 +62,10 @@ from typing import NamedTuple
 import numpy as np
 from numba import prange
 
-from vimpact.kernels.arms import (_arm_coefficient, _arm_stress, _follow, _follow_over,
-                                  _follow_value, _free_rate, _relax, _to_stress, arm_coefficients)
+from vimpact.kernels.arms import (_arm_coefficient, _arm_start, _arm_stress, _follow,
+                                  _follow_over, _follow_over_impulse, _follow_value, _free_rate,
+                                  _relax, _to_stress,
+                                  arm_coefficients, arm_implicit_coefficients)
 from vimpact.kernels.jit import jit
 from vimpact.kernels.layout import (  # noqa: F401 - re-exported: the kernels' common layout
     ELEMENT_STIFFNESS, EULER, N_OUT, N_REC, OUT_B_MAX, OUT_N_REC, OUT_STATUS, OUT_STEPS,
@@ -107,6 +118,19 @@ def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT, FRICTION,
     tau0_h = c0 / h
     den_free = tau0_h + 1.0 + G - sum_gphi
     decay0 = math.exp(-h / c0) if DASHPOT else 0.0
+    # Verlet: each arm's step impulse is exact for the drift path; its first half
+    # takes the arm stresses weighted by kap and the damping ca implicitly in the
+    # half-step velocity, like the dashpot (arm_implicit_coefficients), so arms
+    # faster than the step stay second order and stable
+    IMPLICIT = INTEGRATOR == VERLET and ARMS
+    kap, ca = arm_implicit_coefficients(g[:n_arms], tau[:n_arms], h)
+    # the arms' end stress takes the drift velocity with the weight cae = sum g tau (1 - E);
+    # the force at the step end (whether an element still pushes, and the line
+    # of a partial step) takes the end velocity instead, as the dashpot does
+    cae = 0.0
+    if IMPLICIT:
+        for i in range(n_arms):
+            cae += g[i] * h * (1.0 - phi[i])
 
     k_el = 2.0 * ELEMENT_STIFFNESS * dxi  # both halves of the symmetric row
     xi2 = np.empty(n_elem)
@@ -121,6 +145,7 @@ def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT, FRICTION,
     contact = np.zeros(n_elem, dtype=np.bool_)
     # last normal force (Verlet: its spring part) of each element in contact / k_el
     f = np.zeros(n_elem)
+    fs = np.zeros(n_elem if IMPLICIT else 0)  # ... its start-of-step form (IMPLICIT)
     FRIC = FRICTION and TANGENTIAL
     n_af = n_arms if FRIC else 0
     p_save = np.empty(n_af)  # arms of a slip candidate before the stick trial
@@ -133,10 +158,11 @@ def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT, FRICTION,
     # ... in the normal force only where it jumps at entry: the dashpot (else the
     # force is continuous at entry and exit, and the elastic Verlet impact stays
     # time reversible: e_z = 1 to rounding)
-    NCORR = PARTIAL and DASHPOT
+    NCORR = PARTIAL and (DASHPOT or ARMS)  # (an arm faster than the step acts as a dashpot)
     # last step's position part of each element's tangential force (/ k_el kappa)
     # and, with friction, its slip direction (0: sticking)
     ftp = np.zeros(n_t if PARTIAL else 0)
+    ftps = np.zeros(n_t if IMPLICIT else 0)  # ... its start-of-step form (IMPLICIT)
     fsgn = np.zeros(n_t if PARTIAL and FRIC else 0)
     w_fric = 0.0
     slip_now = 0.0
@@ -149,6 +175,10 @@ def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT, FRICTION,
     C = 0.0  # dashpot coefficient of the normal force
     Ft_el = 0.0
     Ct = 0.0
+    F_s = 0.0  # IMPLICIT: the start-of-step forms of F_el, Ft_el and the arms' damping
+    Ft_s = 0.0
+    Ca = 0.0
+    Cta = 0.0
     active = 0  # elements [0, active) have ever been touched
     t_exit = 0.0  # time the last element left (impact starts touching at t = 0)
     u_max = 0.0
@@ -166,16 +196,19 @@ def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT, FRICTION,
         elif INTEGRATOR == SYMPLECTIC_EULER:
             v_test = (v - h * F_el) / (1.0 + h * C)
             u1 = u + h * v_test
+        elif IMPLICIT:
+            v_test = (v - 0.5 * h * F_s) / (1.0 + 0.5 * h * (C + Ca))
+            u1 = u + h * v_test
         else:
             v_test = (v - 0.5 * h * F_el) / (1.0 + 0.5 * h * C)
             u1 = u + h * v_test
         vc_test = 0.0
         duc = 0.0
         if TANGENTIAL:
-            Ft_pos = Ft_el
+            Ft_pos = Ft_s if IMPLICIT else Ft_el
             if FRIC and DASHPOT:  # slipping elements: mu times their normal force, whose
                 # dashpot part takes this step's normal velocity (as the normal kick)
-                Ft_pos = Ft_el + Cs * (v if INTEGRATOR == EULER else v_test)
+                Ft_pos = Ft_pos + Cs * (v if INTEGRATOR == EULER else v_test)
             if INTEGRATOR == EULER:
                 vc_test = vc - h * mu_t * (Ft_pos + Ct * vc)
                 duc = h * vc
@@ -183,7 +216,7 @@ def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT, FRICTION,
                 vc_test = (vc - h * mu_t * Ft_pos) / (1.0 + h * mu_t * Ct)
                 duc = h * vc_test
             else:
-                vc_test = (vc - 0.5 * h * mu_t * Ft_pos) / (1.0 + 0.5 * h * mu_t * Ct)
+                vc_test = (vc - 0.5 * h * mu_t * Ft_pos) / (1.0 + 0.5 * h * mu_t * (Ct + Cta))
                 duc = h * vc_test
         uc1 = uc + duc
         # ---- elements ----
@@ -191,6 +224,8 @@ def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT, FRICTION,
             active += 1
         sum_r = 0.0
         sum_rt = 0.0
+        sum_rs = 0.0  # IMPLICIT: start-of-step forms for the next step
+        sum_rts = 0.0
         t_leave = 0.0
         n_c = 0
         n_stick = 0
@@ -219,6 +254,9 @@ def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT, FRICTION,
             f_entry = 0.0
             ft_entry = 0.0
             fol = 0.0
+            fa_entry = 0.0
+            arm_mean = 0.0
+            arm_mean_t = 0.0
             if was_in:
                 r = w1
                 if ARMS:
@@ -245,31 +283,44 @@ def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT, FRICTION,
                     if ARMS:
                         f_entry += _arm_stress(wf, q[j], g)
                 r = w1
-                if ARMS:
+                if IMPLICIT:  # the arms' exact mean stress over the entering part
+                    fa_entry = _arm_stress(wf, q[j], g)
+                    fo, arm_mean = _follow_over_impulse(wf, w1, q[j], g, tau, theta * h)
+                    r += fo
+                elif ARMS:
                     r += _follow_over(wf, w1, q[j], g, tau, theta * h)
             w[j] = w1
             fj = r + c0 * v_test
+            if IMPLICIT:  # the arms' stress at the end velocity
+                r_end = r + cae * (ve - v_test)
+            else:
+                r_end = r
             # the element leaves when its force would pull (Verlet: its force at the
             # step end, the dashpot at the end velocity 2 v_test - v)
-            if (r + c0 * ve <= 0.0) if PARTIAL else (fj <= 0.0):
+            if (r_end + c0 * ve <= 0.0) if PARTIAL else (fj <= 0.0):
                 if was_in:  # interpolate its force to zero within the step
                     if PARTIAL:
                         T0 = f[j] + c0 * v
-                        T1 = r + c0 * ve
+                        T1 = r_end + c0 * ve
                         if T0 <= 0.0:
                             alpha = 0.0
                         elif T1 >= 0.0:
                             alpha = 1.0
                         else:
                             alpha = T0 / (T0 - T1)
-                        if NCORR:
-                            corr_n += alpha * T0 - (f[j] + c0 * v_test)
+                        if NCORR:  # minus what the first half-kick applied
+                            if IMPLICIT:
+                                corr_n += alpha * T0 - (fs[j] + (c0 + ca) * v_test)
+                            else:
+                                corr_n += alpha * T0 - (f[j] + c0 * v_test)
                         if TANGENTIAL:  # tangential force T0t -> trial T1t over the step
                             s0 = s[j]
                             s1 = uc1 if MEMORY == 1 else s0 + duc
                             T1t = s1 + c0 * vce
                             if ARMS:
                                 T1t += _follow_value(s0, s1, p[j], g, E, omE, phi)
+                            if IMPLICIT:
+                                T1t += cae * (vce - vc_test)
                             sg = fsgn[j] if FRIC else 0.0
                             if sg != 0.0 and not NCORR:  # slipping: mu times the normal
                                 T0t = 0.0  # force, which takes no correction here
@@ -281,7 +332,10 @@ def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT, FRICTION,
                                 T1t = sg * mu_k / kappa * T1
                             else:
                                 T0t = ftp[j] + c0 * vc
-                                A_t = ftp[j] + c0 * vc_test
+                                if IMPLICIT:
+                                    A_t = ftps[j] + (c0 + ca) * vc_test
+                                else:
+                                    A_t = ftp[j] + c0 * vc_test
                                 if FRIC:  # the cone shrinks to 0 with the normal force
                                     if mu_k < math.inf:
                                         T1t = math.copysign(mu_k / kappa, T1t) * T1
@@ -291,13 +345,23 @@ def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT, FRICTION,
                     t_leave = max(t_leave, (step + alpha) * h)
                 contact[j] = False
                 continue
+            entry_n = 0.0  # what the normal force over the entering part adds
             if NCORR and not was_in:  # from f_entry to the end force over theta h
-                corr_n += theta * (f_entry + r + c0 * ve) - fj
+                if IMPLICIT:  # (the arms at their exact mean over it)
+                    entry_n = (theta * (f_entry - fa_entry + w1 + c0 * ve + 2.0 * arm_mean)
+                               - fj)
+                else:
+                    entry_n = theta * (f_entry + r + c0 * ve) - fj
+                corr_n += entry_n
             contact[j] = True
-            f[j] = r if PARTIAL else fj
+            f[j] = r_end if PARTIAL else fj
             n_c += 1
             j_outer = j
             sum_r += r
+            if IMPLICIT:
+                rs = w1 + _arm_start(w1, q[j], g, kap)
+                fs[j] = rs
+                sum_rs += rs
             if TANGENTIAL and not FRIC:
                 s0 = s[j]
                 if MEMORY == 1:  # seed: total displacement of the contact point
@@ -316,13 +380,21 @@ def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT, FRICTION,
                 if ARMS:
                     if was_in:
                         fol = _follow(s0, s1, p[j], g, E, omE, phi)
+                    elif IMPLICIT and MEMORY == 0:  # arms at their exact mean (as normal)
+                        ft_entry -= _arm_stress(s0, p[j], g)
+                        fol, arm_mean_t = _follow_over_impulse(s0, s1, p[j], g, tau, theta * h)
+                        ft_entry += 2.0 * arm_mean_t - fol
                     else:
                         fol = _follow_over(s0, s1, p[j], g, tau, theta * h)
                     sum_rt += fol
                 s[j] = s1
+                if IMPLICIT:
+                    P1s = s1 + _arm_start(s1, p[j], g, kap)
+                    ftps[j] = P1s
+                    sum_rts += P1s
                 if PARTIAL:
                     P1 = s1 + fol
-                    ftp[j] = P1
+                    ftp[j] = P1 + cae * (vce - vc_test) if IMPLICIT else P1
                     if not was_in:
                         if MEMORY == 1:  # seed: the element jumps to the total displacement
                             ft_entry = P1 + c0 * vce
@@ -353,9 +425,13 @@ def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT, FRICTION,
                     sum_rt += fol
                     n_stick += 1
                     s[j] = s1
+                    if IMPLICIT:
+                        P1s = s1 + _arm_start(s1, p[j], g, kap)
+                        ftps[j] = P1s
+                        sum_rts += P1s
                     if PARTIAL:
                         P1 = s1 + fol
-                        ftp[j] = P1
+                        ftp[j] = P1 + cae * (vce - vc_test) if IMPLICIT else P1
                         fsgn[j] = 0.0
                         if not was_in:
                             corr_t += theta * (ft_entry + P1 + c0 * vce) - (P1 + c0 * vc_test)
@@ -382,7 +458,7 @@ def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT, FRICTION,
                         ftp[j] = sgn * mu_k / kappa * r
                         fsgn[j] = sgn
                         if NCORR and not was_in:
-                            corr_t += sgn * mu_k / kappa * (theta * (f_entry + r + c0 * ve) - fj)
+                            corr_t += sgn * mu_k / kappa * entry_n
         if n_c == 0 and t_leave > 0.0:
             t_exit = t_leave  # the last elements left within this step
         F_el1 = k_el * sum_r
@@ -390,10 +466,16 @@ def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT, FRICTION,
         Ft_el1 = k_el * kappa * sum_rt
         Ct1 = k_el * kappa * c0 * n_c
         Cs1 = 0.0
+        F_s1 = k_el * sum_rs
+        Ft_s1 = k_el * kappa * sum_rts
+        Ca1 = k_el * ca * n_c
+        Cta1 = k_el * kappa * ca * n_c
         if FRIC:
             Ct1 = k_el * kappa * c0 * n_stick
+            Cta1 = k_el * kappa * ca * n_stick
             if n_slip > 0:  # (mu_k may be inf: only slipping elements carry it)
                 Ft_el1 += mu_k * k_el * sum_slip_r
+                Ft_s1 += mu_k * k_el * sum_slip_r  # slipping: the normal force as it is
                 Cs1 = mu_k * k_el * c0 * sum_slip_sign
             if n_slip == n_c and n_c > 0:
                 t_gross += h
@@ -412,6 +494,7 @@ def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT, FRICTION,
         u = u1
         uc = uc1
         F_el, C, Ft_el, Ct, Cs = F_el1, C1, Ft_el1, Ct1, Cs1
+        F_s, Ft_s, Ca, Cta = F_s1, Ft_s1, Ca1, Cta1
         step += 1
         t = step * h
         if not (math.isfinite(u) and math.isfinite(v) and math.isfinite(vc)):
@@ -467,9 +550,9 @@ class KernelSpec(NamedTuple):
     tangential : the tangential problem is advanced
     memory : 0 incremental, 1 seed (meaningful only with ``tangential``)
     arms : the material has Maxwell arms
-    dashpot : the material has a parallel dashpot; it also selects how an element
-        in contact for part of a step is weighted, so a kernel must only run rows
-        whose dashpot matches its flag (routing groups rows that way)
+    dashpot : the material has a parallel dashpot; with ``arms`` it also selects how
+        an element in contact for part of a step is weighted, so a kernel must only
+        run rows whose dashpot and arms match its flags (routing groups rows that way)
     friction : Coulomb friction (finite ``mu``); ``False`` is full stick
     """
 

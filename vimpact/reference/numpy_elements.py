@@ -21,8 +21,14 @@ integrator, so for the same discretization both agree to rounding (about
 contact for only part of a step weighed by that part (its force taken
 linear in time over it: from its last force to zero at the leave fraction
 ``alpha``, from its force at the moment of entry over the entering fraction
-``theta``); the normal force only with a dashpot (without one it is
-continuous at entry and exit).
+``theta``); the normal force only with a dashpot or Maxwell arms (without
+them it is continuous at entry and exit). Maxwell arms enter the kick with
+their exact impulse over the drift path: the second half-kick takes their
+stress at the step end, the first half the rest, its damping part implicit in
+the half-step velocity like ``eta0`` (:meth:`Rheology.kick_split`); an element
+entering within the step gets the arms' exact mean stress over its ramp, and
+the force that decides whether an element still pushes at the step end takes
+the arms' damping part at the end velocity.
 
 Coulomb friction (docs/physics.md#coulomb-friction), written here independently of the
 kernel: every element in contact first takes the stick trial; if its
@@ -124,6 +130,40 @@ class Rheology:
         w1 = rhs / lhs
         return w1, advance_arms(q0, w0, w1, coefficients)
 
+    def kick_split(self, h, coefficients):
+        """How the Verlet kick splits each arm's exact step impulse (fast arms implicit).
+
+        On a step ``h`` where an element's ``w`` moves linearly at the drift
+        velocity ``v``, the arm stress ``G_i (w - q_i)`` has the exact impulse
+        ``h G_i [(1 - phi_i)(w0 - q0_i) + tau_i phi_i v]`` and the end value
+        ``G_i [E_i (w0 - q0_i) + tau_i (1 - E_i) v]``. With the end value in the
+        second half-kick, the first half must carry ``G_i [kap_i (w0 - q0_i) +
+        c_i v]``: ``kap_i = 2 (1 - phi_i) - E_i`` and the damping
+        ``c_i = tau_i (1 + E_i - 2 (1 - E_i) tau_i / h) >= 0`` taken implicitly
+        like ``eta0``. Returns ``(kap, sum G_i c_i, sum G_i tau_i (1 - E_i))``
+        (1, Pa s, Pa s).
+        """
+        E, one_minus_E, phi = coefficients
+        x = h / self.tau
+        c = np.where(x < 1e-3, h * x * (1.0 / 6.0 - x * (1.0 / 12.0 - x / 40.0)),
+                     self.tau * (1.0 + E - 2.0 * one_minus_E / np.where(x > 0.0, x, 1.0)))
+        return 2.0 * (1.0 - phi) - E, float((self.G * c).sum()), float((self.G * h * (1.0 - phi)).sum())
+
+    def start_stress(self, w, q, kap):
+        """``G_inf w + sum_i G_i kap_i (w - q_i)`` (Pa): the first half-kick's stress."""
+        return self.G_inf * w + (self.G * kap * (w[:, None] - q)).sum(axis=1)
+
+    def arm_mean_stress(self, w0, w1, q0, dt):
+        """The arms' stress averaged over ``dt`` (Pa, per element) on the linear path
+        ``w0 -> w1`` from ``q0``: ``sum G_i [(1 - phi_i)(w0 - q0_i) + (tau_i phi_i /
+        dt)(w1 - w0)]``; ``dt`` per element."""
+        _, _, phi = arm_update_coefficients(self.tau[None, :], dt[:, None])
+        x = dt[:, None] / self.tau[None, :]
+        phi_x = np.where(x < 1e-3, 0.5 - x * (1.0 / 6.0 - x / 24.0),
+                         phi / np.where(x > 0.0, x, 1.0))
+        return (self.G * ((1.0 - phi) * (w0[:, None] - q0)
+                          + phi_x * (w1 - w0)[:, None])).sum(axis=1)
+
     def free_rate(self, w, q):
         """``dw/dt`` (m/s) of free surface elements under zero force."""
         spring = self.spring_stress(w, q)
@@ -193,6 +233,10 @@ def naive_impact(scene, steps, elements, row_width=1.05, max_time=100.0, mu=None
     max_steps = int(math.ceil(max_time * (hz.t_H + 10.0 * rheo.eta0 / rheo.G_inf) / h))
 
     arms_h = arm_update_coefficients(rheo.tau, h)  # full-step coefficients, per arm
+    # arms in the kick: exact step impulse, damping part implicit (Rheology.kick_split)
+    implicit = rheo.n_arms > 0
+    kap, arm_damping, arm_end = rheo.kick_split(h, arms_h) if implicit else (None, 0.0, 0.0)
+    weighted = rheo.eta0 > 0.0 or implicit  # force can jump at entry: weigh partial steps
 
     # element state
     w = np.zeros(n)  # normal surface displacement, m
@@ -201,6 +245,7 @@ def naive_impact(scene, steps, elements, row_width=1.05, max_time=100.0, mu=None
     p = np.zeros((n, rheo.n_arms))  # tangential arm variables, m
     contact = np.zeros(n, dtype=bool)
     f_last = np.zeros(n)  # last normal spring force of each element in contact, N
+    f_start = np.zeros(n)  # ... as the first half-kick takes it (start_stress), N
 
     # sphere state
     u, v_z = 0.0, float(scene.v_z0)  # indentation (m), normal velocity (m/s)
@@ -209,6 +254,7 @@ def naive_impact(scene, steps, elements, row_width=1.05, max_time=100.0, mu=None
     # forces of the current state: spring part and dashpot coefficient (N, N s/m)
     Fz_spring, Cz = 0.0, 0.0
     Fx_spring, Cx = 0.0, 0.0
+    Fz_start, Fx_start, Cz_arm, Cx_arm = 0.0, 0.0, 0.0, 0.0  # first half-kick: arms split
 
     memory = scene.tangential_memory
     if mu is None:
@@ -220,6 +266,7 @@ def naive_impact(scene, steps, elements, row_width=1.05, max_time=100.0, mu=None
     # last step's tangential force of each element in contact without its
     # dashpot part (N) and its slip direction (0: sticking)
     ft_pos = np.zeros(n)
+    ft_start = np.zeros(n)  # sticking: as the first half-kick takes it, N
     slip_sign = np.zeros(n)
     Fx_slip, Cx_slip = 0.0, 0.0  # slipping elements: mu F_n, spring part (N), per v_z (N s/m)
     t_gross, w_friction, slip_width_max = 0.0, 0.0, 0.0
@@ -231,12 +278,12 @@ def naive_impact(scene, steps, elements, row_width=1.05, max_time=100.0, mu=None
     while step < max_steps:
         # ---- first half kick, dashpot implicit in the half-step velocities ----
         # m v+ = m v - h/2 (Fz_spring + Cz v+)
-        v_z_half = (m * v_z - 0.5 * h * Fz_spring) / (m + 0.5 * h * Cz)
+        v_z_half = (m * v_z - 0.5 * h * Fz_start) / (m + 0.5 * h * (Cz + Cz_arm))
         # m v_x+ = m v_x - h/2 F_x,  Theta omega+ = Theta omega - h/2 R F_x,
         # F_x = Fx_spring + Cx (v_x+ + R omega+): a 2x2 linear system
-        k = 0.5 * h * Cx
+        k = 0.5 * h * (Cx + Cx_arm)
         A = np.array([[m + k, k * R], [k * R, Theta + k * R * R]])
-        Fx_known = Fx_spring + Fx_slip + Cx_slip * v_z_half
+        Fx_known = Fx_start + Fx_slip + Cx_slip * v_z_half
         b = np.array([m * v_x - 0.5 * h * Fx_known, Theta * omega - 0.5 * h * R * Fx_known])
         v_x_half, omega_half = np.linalg.solve(A, b)
         v_c_half = v_x_half + R * omega_half
@@ -282,6 +329,15 @@ def naive_impact(scene, steps, elements, row_width=1.05, max_time=100.0, mu=None
         v_entry = v_z_start + 2.0 * (1.0 - theta) * (v_z_half - v_z_start)
         f_entry[entering] = c_n * weight * (rheo.spring_stress(w_relaxed[entering], q[entering])
                                             + rheo.eta0 * v_entry[entering])
+        # with arms: the force over the entering part is the relaxed spring and the
+        # dashpot on a line, plus the arms' exact mean stress on the ramp
+        f_entry_lin = np.zeros(n)
+        arm_mean = np.zeros(n)
+        if implicit:
+            f_entry_lin[entering] = c_n * weight * (rheo.G_inf * w_relaxed[entering]
+                                                    + rheo.eta0 * v_entry[entering])
+            arm_mean[entering] = c_n * weight * rheo.arm_mean_stress(
+                w_relaxed[entering], w_sphere[entering], q[entering], theta[entering] * h)
         q[entering] = advance_arms(q[entering], w_relaxed[entering], w_sphere[entering], arms_theta)
 
         touching = was_in | entering
@@ -289,7 +345,9 @@ def naive_impact(scene, steps, elements, row_width=1.05, max_time=100.0, mu=None
         spring = np.zeros(n)
         spring[touching] = c_n * weight * rheo.spring_stress(w[touching], q[touching])  # N
         force = spring + c_n * weight * rheo.eta0 * v_z_half  # N, element and mirror image
-        force_end = spring + c_n * weight * rheo.eta0 * v_z_end  # at the step end
+        # at the step end: the arms' damping part at the end velocity, as the dashpot
+        spring_end = spring + c_n * weight * arm_end * (v_z_end - v_z_half) * touching
+        force_end = spring_end + c_n * weight * rheo.eta0 * v_z_end
         # no adhesion: an element whose force would pull at the step end leaves
         leaving = touching & (force_end <= 0.0)
         now_in = touching & ~leaving
@@ -308,12 +366,15 @@ def naive_impact(scene, steps, elements, row_width=1.05, max_time=100.0, mu=None
             alpha = np.where(T0 <= 0.0, 0.0, np.where(T1 >= 0.0, 1.0, T0 / np.where(
                 T0 - T1 > 0.0, T0 - T1, 1.0)))
             t_leave = ((step + alpha) * h).max()
-            if rheo.eta0 > 0.0:  # the normal force jumps at entry only with a dashpot
-                corr_z += float((alpha * T0 - (f_last[left] + dash_z * v_z_half)).sum())
+            if weighted:  # the normal force jumps at entry only with a dashpot (or a fast arm)
+                applied = (f_start[left] + (dash_z + c_n * weight * arm_damping) * v_z_half
+                           if implicit else f_last[left] + dash_z * v_z_half)
+                corr_z += float((alpha * T0 - applied).sum())
             # tangential: from T0t at the start to the stick trial T1t at the end
             s_l = np.full(int(left.sum()), u_c_new) if memory == "seed" else s[left] + du_c
             p_l = advance_arms(p[left], s[left], s_l, arms_h)  # trial only, not kept
-            T1t = c_t * weight * (rheo.spring_stress(s_l, p_l) + rheo.eta0 * v_c_end_step)
+            T1t = c_t * weight * (rheo.spring_stress(s_l, p_l) + rheo.eta0 * v_c_end_step
+                                  + arm_end * (v_c_end_step - v_c_half))
             if friction:  # the cone shrinks to zero with the normal force
                 T1t = np.copysign(mu, T1t) * T1
             sg = slip_sign[left]
@@ -322,18 +383,29 @@ def naive_impact(scene, steps, elements, row_width=1.05, max_time=100.0, mu=None
                                           else 0.0, dash_t * v_c_start)
             A_t = ft_pos[left] + np.where(sg != 0.0, sg * mu * dash_z * v_z_half if friction
                                           else 0.0, dash_t * v_c_half)
+            if implicit:  # sticking: what the first half-kick applied
+                A_t = np.where(sg != 0.0, A_t, ft_start[left]
+                               + (dash_t + c_t * weight * arm_damping) * v_c_half)
             if friction:
                 T1t = np.where(sg != 0.0, sg * mu * T1, T1t)
             path = 2.0 * alpha * T0t + alpha**2 * (T1t - T0t) - A_t
-            if rheo.eta0 == 0.0:  # slipping: mu times the normal force, not corrected
+            if not weighted:  # slipping: mu times the normal force, not corrected
                 path = np.where(sg != 0.0, 0.0, path)
             corr_x += float(path.sum())
         contact = now_in
-        f_last[now_in] = spring[now_in]
+        f_last[now_in] = spring_end[now_in]
+        if implicit:
+            f_start[now_in] = c_n * weight * rheo.start_stress(w[now_in], q[now_in], kap)
         new = now_in & entering
         # entering for the last theta h: from the force at entry to the end force
-        if rheo.eta0 > 0.0:
-            corr_z += float((theta[new] * (f_entry[new] + force_end[new]) - force[new]).sum())
+        entry_z = np.zeros(n)  # what the normal force over the entering part adds
+        if implicit:  # (the arms at their exact mean)
+            lin_end = c_n * weight * (rheo.G_inf * w[new] + rheo.eta0 * v_z_end)
+            entry_z[new] = (theta[new] * (f_entry_lin[new] + lin_end + 2.0 * arm_mean[new])
+                            - force[new])
+        elif weighted:
+            entry_z[new] = theta[new] * (f_entry[new] + force_end[new]) - force[new]
+        corr_z += float(entry_z[new].sum())
 
         # tangential state of the elements in contact (docs/physics.md#full-stick)
         s_start, p_start = s.copy(), p.copy()  # relaxed state for the entering ones
@@ -343,6 +415,10 @@ def naive_impact(scene, steps, elements, row_width=1.05, max_time=100.0, mu=None
             s_new = s + du_c * theta  # theta = 1 for elements that were in contact
         stay = now_in & was_in
         arms_new = arm_update_coefficients(rheo.tau[None, :], (theta[new] * h)[:, None])
+        arm_mean_t = np.zeros(n)
+        if implicit and not friction and memory != "seed":  # entering: the arms' exact mean
+            arm_mean_t[new] = c_t * weight * rheo.arm_mean_stress(
+                s_start[new], s_new[new], p_start[new], theta[new] * h)
         p[stay] = advance_arms(p_start[stay], s_start[stay], s_new[stay], arms_h)
         p[new] = advance_arms(p_start[new], s_start[new], s_new[new], arms_new)
         s[now_in] = s_new[now_in]
@@ -356,6 +432,10 @@ def naive_impact(scene, steps, elements, row_width=1.05, max_time=100.0, mu=None
         ft_end = t_spring + c_t * weight * rheo.eta0 * v_c_end_step
         if memory == "seed":  # the element jumps to the total displacement at entry
             ft_entry[new] = ft_end[new]
+        elif implicit and not friction:  # relaxed spring and dashpot on a line, arms exact
+            ft_entry[new] = (c_t * weight * (rheo.G_inf * (s_start[new] + s[new])
+                                             + rheo.eta0 * (v_c_entry[new] + v_c_end_step))
+                             + 2.0 * arm_mean_t[new] - ft_end[new])
         slip = np.zeros(n, dtype=bool)
         if friction:
             slip = now_in & (np.abs(f_t) > mu * force)
@@ -364,7 +444,9 @@ def naive_impact(scene, steps, elements, row_width=1.05, max_time=100.0, mu=None
         stick_new = new & ~slip
         corr_x += float((theta[stick_new] * (ft_entry[stick_new] + ft_end[stick_new])
                          - f_t[stick_new]).sum())
-        ft_pos[now_in] = t_spring[now_in]
+        ft_pos[now_in] = t_spring[now_in] + c_t * weight * arm_end * (v_c_end_step - v_c_half)
+        if implicit:
+            ft_start[now_in] = c_t * weight * rheo.start_stress(s[now_in], p[now_in], kap)
         slip_sign[now_in] = 0.0
         if slip.any():
             # the element's own path s_start -> s1 over dt (h, or theta h when
@@ -391,9 +473,8 @@ def naive_impact(scene, steps, elements, row_width=1.05, max_time=100.0, mu=None
             ft_pos[idx] = sg * mu * spring[idx]
             slip_sign[idx] = sg
             # entering slipping: mu times the normal force over the whole part
-            ent = ~was_in[idx] & (rheo.eta0 > 0.0)
-            corr_x += float((sg[ent] * mu * (theta[idx][ent] * (f_entry[idx][ent]
-                             + force_end[idx][ent]) - force[idx][ent])).sum())
+            ent = ~was_in[idx] & weighted
+            corr_x += float((sg[ent] * mu * entry_z[idx][ent]).sum())
             slip_width_max = max(slip_width_max, idx.size * dx)
         if check_cone and friction and now_in.any():
             # slipping elements sit on the cone by construction (f_t = mu f_n
@@ -410,6 +491,12 @@ def naive_impact(scene, steps, elements, row_width=1.05, max_time=100.0, mu=None
         Cz = c_n * weight * rheo.eta0 * n_c
         Fx_spring = c_t * weight * rheo.spring_stress(s[stick], p[stick]).sum()
         Cx = c_t * weight * rheo.eta0 * int(stick.sum())
+        Fz_start, Fx_start = Fz_spring, Fx_spring
+        if implicit:
+            Fz_start = float(f_start[now_in].sum())
+            Fx_start = float(ft_start[stick].sum())
+            Cz_arm = c_n * weight * arm_damping * n_c
+            Cx_arm = c_t * weight * arm_damping * int(stick.sum())
         Fx_slip = float(ft_pos[slip].sum()) if slip.any() else 0.0
         Cx_slip = float((slip_sign[slip] * mu * c_n * weight * rheo.eta0).sum()) if slip.any() else 0.0
         if n_c > 0 and int(slip.sum()) == n_c:
