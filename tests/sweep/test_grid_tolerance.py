@@ -70,7 +70,7 @@ def test_resume_reads_the_cached_refinement(swept):
     assert cache["sweep_hash"] == load_spec(spec_path).sweep_hash
     assert not parts_dir(out).exists()  # the cache left with the parts
     table = RestitutionTable.open(out)
-    assert json.loads(table.meta("grid_refinement")) == cache["report"]
+    assert table.meta("grid_refinement") == cache["report"]
     np.testing.assert_array_equal(np.unique(table.data["Q1"]), cache["axes"]["Q1"])
     np.testing.assert_array_equal(np.unique(table.data["nu"]), cache["axes"]["nu"])
 
@@ -78,7 +78,7 @@ def test_resume_reads_the_cached_refinement(swept):
 def test_refined_sweep_meets_its_tolerance_at_points_it_never_saw(swept):
     _, out, _, _ = swept
     table = RestitutionTable.open(out)
-    report = json.loads(table.meta("grid_refinement"))
+    report = table.meta("grid_refinement")
     assert report["met"] and report["tolerance"] == TOL
     # the refinement had to insert nodes, and says where and what error it found there
     inserted = report["rounds"][0]["inserted"]
@@ -134,5 +134,5 @@ def test_refined_dataset_keeps_only_its_parts(tmp_path):
     assert not (out / runner.GRID_CACHE).exists()
     assert "content hash verified" in verify_table(out)
     table = RestitutionTable.open(out)
-    assert json.loads(table.meta("grid_refinement"))["met"]
+    assert table.meta("grid_refinement")["met"]
     assert table.interpolation_error["outputs"]["beta_x"]["max"] <= TOL

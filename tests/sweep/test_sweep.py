@@ -238,18 +238,12 @@ def test_kelvin_voigt_grid_rows_have_no_q2_and_read_back(tmp_path):
     np.testing.assert_allclose(res["beta_x"], df.beta_x, rtol=1e-12)
 
 
-@pytest.mark.xfail(strict=True, reason="vimpact/sweep/runner.py compute_chunk writes Q2 = 0 on "
-                                       "random Kelvin-Voigt and elastic rows; it should write NaN "
-                                       "(G2 -> inf), as grid rows have")
 def test_random_kelvin_voigt_rows_have_no_q2(tmp_path):
     df = pd.read_parquet(run_sweep(write(tmp_path, RANDOM_KV.replace("rows = 8", "rows = 2")),
                                    progress=False))
     assert df.Q2.isna().all()
 
 
-@pytest.mark.xfail(strict=True, reason="needs vimpact/sweep/runner.py compute_chunk to write the "
-                                       "string column model from engine_columns' inputs['model'] "
-                                       "and spec.LABELS / columns() to list it")
 def test_rows_name_their_rheology(tmp_path):
     df = pd.read_parquet(run_sweep(write(tmp_path, GRID_KV), progress=False))
     assert (df.model == "kelvin_voigt").all() and df.Q2.isna().all()

@@ -128,7 +128,7 @@ def compute_chunk(spec: SweepSpec, chunk: int, timings: dict | None = None):
             elif spec.model == "standard_solid":
                 cols["Q2"][rows] = frame["Q2"].to_numpy(dtype=float)
             else:
-                cols["Q2"][rows] = np.where(valid, 0.0, np.nan)  # the Kelvin-Voigt limit G2 -> inf
+                cols["Q2"][rows] = np.nan  # the Kelvin-Voigt limit G2 -> inf (never 0: log 0)
         if spec.mode == "grid" and spec.model == "elastic":
             cols["Q1"][rows] = np.where(valid, 0.0, np.nan)
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -140,7 +140,7 @@ def compute_chunk(spec: SweepSpec, chunk: int, timings: dict | None = None):
         vc0 = np.ones(n)
     guard_nan(cols, status, error, (vc0 == 0.0) | (spec.tangential == "none"),
               np.isin(status, list(FINISHED)))
-    labels = {"path": path, "status": status, "error": error}
+    labels = {"model": inputs["model"], "path": path, "status": status, "error": error}
     schema = spec.schema()
     arrays = [pa.array(labels[c] if c in labels else cols[c], type=f.type)
               for c, f in zip(spec.columns(), schema)]

@@ -239,8 +239,10 @@ OUTPUTS = ("e_z", "e_x", "beta_x", "energy_ratio", "t_contact_s", "u_max_m", "a_
             "gross_slip_fraction", "friction_energy_J")
 #: Outputs that are NaN when v_c0 = 0 (no tangential force).
 TANGENTIAL_OUTPUTS = ("e_x", "beta_x", "mu_eff", "gross_slip_fraction")
-#: String columns (null where not applicable: path of a row that never ran, error of a good row).
-LABELS = ("path", "status", "error")
+#: String columns: the row's rheology (``model``: elastic, kelvin_voigt, standard_solid or
+#: prony; tells a Kelvin-Voigt row's ``Q2 = NaN`` apart), and path, status, error (null where
+#: not applicable: path of a row that never ran, error of a good row).
+LABELS = ("model", "path", "status", "error")
 
 # ---- spec keys -------------------------------------------------------------
 
@@ -524,7 +526,7 @@ class SweepSpec:
         if self.has_friction:
             dimensionless.append("psi")
         return (["row"] + self.input_columns() + dimensionless + list(OUTPUTS)
-                + ["path", "status", "error"])
+                + list(LABELS))
 
     def units(self) -> dict[str, str]:
         """Unit of every column (``"1"`` dimensionless, ``""`` for labels)."""

@@ -56,7 +56,8 @@ from vimpact.model.validation import InputError
 #: Prefix of every key-value metadata key vimpact writes.
 META_PREFIX = "vimpact."
 #: Metadata keys stored as JSON.
-JSON_KEYS = ("numerics", "units", "columns", "statuses", "paths", "rotation", "counts")
+JSON_KEYS = ("numerics", "units", "columns", "statuses", "paths", "rotation", "counts",
+             "grid_tolerance", "grid_refinement", "interpolation_error")
 #: Metadata keys stored as integers.
 INT_KEYS = ("schema_version", "seed", "rows", "chunk", "row_start", "row_stop", "n_chunks",
             "chunk_size")
