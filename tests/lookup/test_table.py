@@ -622,3 +622,7 @@ def test_cli_info_json_is_standard_with_mu_inf(vimpact_main, kv, tmp_path, capsy
     assert code == 0, err
     info = json.loads(out, parse_constant=lambda c: pytest.fail(f"non-standard JSON {c}"))
     assert info["ranges"]["mu"] == ["inf", "inf"]
+    assert "  mu              inf\n" in str(RestitutionTable.open(path))
+    mixed = kv.data.drop(columns=["model"]).assign(mu=np.where(kv.data.Q1 > 1, np.inf, 0.3))
+    write_table(path, mixed, "kelvin_voigt")
+    assert "  mu              0.3 .. inf\n" in str(RestitutionTable.open(path))

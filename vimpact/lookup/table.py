@@ -1043,8 +1043,8 @@ def format_info(info: dict) -> str:
     if unknown:
         lines.append(f"                  (unknown status: {', '.join(unknown)})")
     for name, r in info["ranges"].items():
-        text = "no data" if r is None else (_fmt(r[0]) if _same(r[0], r[1])
-                                            else f"{_fmt(r[0])} .. {_fmt(r[1])}")
+        one = r is not None and (r[0] == r[1] or (np.isfinite(r[1]) and _same(r[0], r[1])))
+        text = "no data" if r is None else (_fmt(r[0]) if one else f"{_fmt(r[0])} .. {_fmt(r[1])}")
         lines.append(f"  {name:<15} {text}")
     if info["grid"]:
         shape = " x ".join(f"{n} {a}" for a, n in info["grid"].items())
