@@ -180,3 +180,24 @@ def test_cli_verify_writes_the_bound_that_info_and_lookup_report(kv, tmp_path, c
     assert out["error_bound"]["e_z"] == pytest.approx(1.5 * first["outputs"]["e_z"]["max"])
     assert main(["table", "lookup", path, "--Q1", "0.3", "--nu", "0.3", "--method", "linear"]) == 0
     assert "not measured for linear" in capsys.readouterr().out
+
+
+def test_held_out_points_of_a_psi_table_are_the_sweeps_friction_scenes(tmp_path):
+    """table verify on a psi grid simulates the sweep's scene at each held-out psi
+    (friction coefficient mu, v_x0 from psi): in gross slip throughout (psi > 4 chi)
+    its beta_x is the impulse balance of docs/physics.md#coulomb-friction,
+    beta_x = -1 + 2 chi (1 + e_z) / psi, which the code does not use."""
+    from vimpact.sweep import run_sweep
+
+    spec = tmp_path / "psi.toml"
+    spec.write_text('model = "kelvin_voigt"\nchunk_size = 8\n[numerics]\npreset = "fast"\n'
+                    '[grid]\nQ1 = 0.1\nnu = [0.3, 0.5]\npsi = [10.0, 14.0, 20.0]\nmu = 0.3\n')
+    table = RestitutionTable.open(run_sweep(spec, progress=False))
+    err = held_out_errors(table, n=6, seed=3)
+    assert len(err) and (err["status"] == "ok").all() and err["psi"].min() >= 10.0
+    nu = err["nu"].to_numpy()
+    chi = (1 - nu) * (1 + 1 / 0.4) / (2 - nu)
+    expected = -1 + 2 * chi * (1 + err["e_z_sim"].to_numpy()) / err["psi"].to_numpy()
+    np.testing.assert_allclose(err["beta_x_sim"].to_numpy(), expected, rtol=0, atol=1e-9)
+    # the lookup between these nodes follows 1/psi closely (smooth in gross slip)
+    assert err["beta_x_err"].max() < 1e-2

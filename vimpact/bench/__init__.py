@@ -35,6 +35,7 @@ BENCHMARKS: dict[str, str] = {
     "imports": "vimpact.bench.imports",
     "friction": "benchmarks.friction",
     "sweep_backends": "benchmarks.sweep_backends",
+    "lookup": "benchmarks.lookup",
 }
 
 

@@ -68,7 +68,7 @@ def numerics_of(table):
 def simulate_dimensionless(model: str, Q1, nu, Q2=None, *, numerics=None,
                            theta_ratio: float = 0.4, tangential: str = "auto",
                            tangential_memory: str = "incremental",
-                           rotation: bool = True) -> pd.DataFrame:
+                           rotation: bool = True, psi=None, mu: float = 1.0) -> pd.DataFrame:
     """Simulate impacts given by their dimensionless parameters, columnar.
 
     The scenes are those of :meth:`vimpact.Scene.from_dimensionless` (and of a grid
@@ -83,6 +83,10 @@ def simulate_dimensionless(model: str, Q1, nu, Q2=None, *, numerics=None,
     numerics : :class:`vimpact.Numerics` (default: ``Numerics()``)
     theta_ratio : Theta / (m R^2)
     tangential, tangential_memory, rotation : as for :class:`vimpact.Scene`
+    psi : friction incidence per point (dimensionless, >= 0; None: full stick); the
+        scene is a psi grid sweep's (:func:`vimpact.sweep.parameters.psi_reference`:
+        friction coefficient ``mu``, ``v_x0`` from psi; psi = 0 is full stick)
+    mu : friction coefficient of the points with ``psi > 0``, dimensionless
 
     Returns
     -------
@@ -104,6 +108,9 @@ def simulate_dimensionless(model: str, Q1, nu, Q2=None, *, numerics=None,
             "theta_ratio": np.full(n, float(theta_ratio)),
             "tangential": np.full(n, tangential), "tangential_memory": np.full(n, tangential_memory),
             "rotation": np.full(n, bool(rotation))}
+    if psi is not None:
+        from vimpact.sweep.parameters import psi_reference
+        cols["v_x0_m_s"], cols["mu"] = psi_reference(np.broadcast_to(psi, (n,)), nu, mu)
     if model == "kelvin_voigt":
         cols["eta0_Pa_s"] = eta
     elif model == "standard_solid":
@@ -167,6 +174,19 @@ def _scene_options(table) -> dict:
             "rotation": bool(table.meta("rotation", True))}
 
 
+def _friction(table, psi) -> dict:
+    """Keyword arguments of :func:`simulate_dimensionless` for a psi table: the
+    points' psi and the one friction coefficient its rows with psi > 0 were made with."""
+    if psi is None:
+        return {}
+    mu = table.data["mu"].to_numpy(float) if "mu" in table.data.columns else np.array([1.0])
+    finite = np.unique(mu[np.isfinite(mu)])
+    if finite.size > 1:
+        raise InputError(f"the table{table._where(table.path)} holds psi rows made with several "
+                         f"friction coefficients mu = {finite.tolist()}: not a psi grid")
+    return {"psi": psi, "mu": float(finite[0]) if finite.size else 1.0}
+
+
 def held_out_errors(table, numerics=None, n: int = 200, seed: int = 0, theta_ratio=None,
                     method: str = "cubic", kinds=KINDS, simulate=None) -> pd.DataFrame:
     """Lookup minus direct simulation at held-out points, one row per point.
@@ -199,13 +219,14 @@ def held_out_errors(table, numerics=None, n: int = 200, seed: int = 0, theta_rat
             and len(table._theta_values()) else 0.4)
     else:
         t = theta
+    psi = pts["psi"].to_numpy() if "psi" in pts else None
     sim = (simulate or simulate_dimensionless)(
         table.model, pts["Q1"].to_numpy(), pts["nu"].to_numpy(),
         pts["Q2"].to_numpy() if "Q2" in pts else None,
-        numerics=numerics, theta_ratio=t, **_scene_options(table))
+        numerics=numerics, theta_ratio=t, **_scene_options(table), **_friction(table, psi))
     look = table.lookup(*(pts[a].to_numpy() for a in ("Q1", "nu")),
                         Q2=pts["Q2"].to_numpy() if "Q2" in pts else None,
-                        theta_ratio=theta_ratio, method=method)
+                        theta_ratio=theta_ratio, method=method, psi=psi)
     ok = (sim["status"] == "ok").to_numpy()
     out = pts.copy()
     out["status"] = sim["status"].to_numpy()
@@ -228,9 +249,10 @@ def _node_error(table, numerics, theta_ratio, n_nodes: int, seed: int, simulate=
     rows = rows.iloc[np.sort(pick)]
     t = float(rows["theta_ratio"].iloc[0]) if "theta_ratio" in rows.columns else 0.4
     Q2 = rows["Q2"].to_numpy(float) if table.model == "standard_solid" else None
+    psi = rows["psi"].to_numpy(float) if "psi" in rows.columns else None
     sim = (simulate or simulate_dimensionless)(
         table.model, rows["Q1"].to_numpy(float), rows["nu"].to_numpy(float), Q2,
-        numerics=numerics, theta_ratio=t, **_scene_options(table))
+        numerics=numerics, theta_ratio=t, **_scene_options(table), **_friction(table, psi))
     ok = (sim["status"] == "ok").to_numpy()
     return {name: float(np.nanmax(np.abs(sim[name].to_numpy(float)[ok]
                                          - rows[name].to_numpy(float)[ok]), initial=0.0))

@@ -314,6 +314,10 @@ def refined_spec(spec: SweepSpec, parts: Path, log: Callable[[str], None] | None
         raise InputError(f"grid.tolerance = {tol!r} is not allowed with {theta.size} "
                          "theta_ratio values: a refined grid has one theta_ratio (one "
                          "spec per value)")
+    if "psi" in spec.axes:
+        raise InputError(f"grid.tolerance = {tol!r} is not allowed with a psi axis: the "
+                         "refinement covers Q1, Q2 and nu of stick grids (check a psi grid "
+                         "with vimpact table verify instead)")
     cache = Path(parts) / GRID_CACHE
     cached = _read_grid_cache(cache, spec)
     if cached is not None:
