@@ -36,6 +36,7 @@ BENCHMARKS: dict[str, str] = {
     "friction": "benchmarks.friction",
     "sweep_backends": "benchmarks.sweep_backends",
     "lookup": "benchmarks.lookup",
+    "continuum_maxwell": "benchmarks.continuum_maxwell",
 }
 
 

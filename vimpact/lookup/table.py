@@ -314,6 +314,7 @@ def validate_table(data: pd.DataFrame, metadata: dict, path=None) -> None:
                          f"{_rows_text(i)} is not a vimpact status (known: "
                          + ", ".join(STATUSES) + ")")
     ok = np.isin(status, DATA_STATUSES)
+    ran = status != "invalid"  # every other row is an impact at its inputs
     bounds = {"e_z": (0.0, 1.0 + BOUND_SLACK, "in [0, 1 + 1e-6]"),
               "e_x": (0.0, 1.0 + BOUND_SLACK, "in [0, 1 + 1e-6]"),
               "beta_x": (-1.0 - BOUND_SLACK, 1.0 + BOUND_SLACK, "|beta_x| <= 1 + 1e-6")}
@@ -348,14 +349,15 @@ def validate_table(data: pd.DataFrame, metadata: dict, path=None) -> None:
             raise InputError(f"{where} is not allowed: column {name} = nan at {_rows_text(i)} "
                              f"with status ok (a data row needs {name} {allowed})")
         with np.errstate(invalid="ignore"):
-            bad = (~np.isnan(v) & ~inside(v)) | (np.isinf(v) & (name != "mu"))
+            # a row that never ran (status invalid: e.g. nu = 0.7 asked for) keeps its inputs
+            bad = ran & ((~np.isnan(v) & ~inside(v)) | (np.isinf(v) & (name != "mu")))
         if bad.any():
             i = np.flatnonzero(bad)
             raise InputError(f"{where} is not allowed: column {name} = {_fmt(v[i[0]])} at "
                              f"{_rows_text(i)} is outside its domain ({name} {allowed})")
     keys = [c for c in ("Q1", "Q2", "nu", "theta_ratio", "psi", "mu", "model")
             if c in data.columns]
-    dup = data.duplicated(subset=keys, keep=False).to_numpy()
+    dup = ran & data.duplicated(subset=keys, keep=False).to_numpy()
     if dup.any():
         i = np.flatnonzero(dup)
         first = data.iloc[i[0]]
@@ -484,13 +486,16 @@ class RestitutionTable:
     def save(self, path) -> Path:
         """Write the table as Parquet with its ``vimpact.*`` metadata (what :meth:`open` reads)."""
         import pyarrow as pa
-        import pyarrow.parquet as pq
+
+        from vimpact.sweep.store import write_atomic
 
         arrow = pa.Table.from_pandas(self.data, preserve_index=False)
         meta = dict(arrow.schema.metadata or {})
         meta[(_META_PREFIX + "model").encode()] = self.model.encode()  # what open() requires
         meta.update({k.encode(): v.encode() for k, v in self.metadata.items()})
-        pq.write_table(arrow.replace_schema_metadata(meta), path)
+        # atomically, with page checksums and fresh content/metadata hashes (the stored
+        # ones describe the file this table was read from, not these columns)
+        write_atomic(arrow.replace_schema_metadata(meta), Path(path))
         return Path(path)
 
     # ---- metadata --------------------------------------------------------
