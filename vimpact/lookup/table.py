@@ -269,8 +269,10 @@ def incidence(angle_deg, mu, nu):
     if not np.all((nu >= 0.0) & (nu <= 0.5)):
         raise InputError(f"nu = {float(nu[~((nu >= 0) & (nu <= 0.5))].flat[0])!r} is not "
                          "allowed: must be in [0, 0.5]")
+    from vimpact.sweep.parameters import incidence as psi_of  # the one psi rule
+
     ratio = np.tan(np.radians(angle))
-    psi = 0.0 * ratio if math.isinf(mu) else 2.0 * (1.0 - nu) / (mu * (2.0 - nu)) * ratio
+    psi = psi_of(mu, nu, ratio, np.ones_like(ratio))
     return float(psi) if np.ndim(psi) == 0 else psi
 
 
