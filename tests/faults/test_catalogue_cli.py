@@ -219,6 +219,29 @@ def test_sweep_spec_missing(tmp_path, capsys):
                           "none.toml", "not found")
 
 
+#: Other subcommands (table validation is tests/lookup's): what the line must name.
+#: plot names its options without the dashes ("out = 'x.txt'"): the value is checked here.
+OTHER_ERRORS = [
+    ("plot-unknown-figure", ["plot", "fig9", "--out", "x.png"], ["'fig9'"]),
+    ("plot-out-txt", ["plot", "fig3_2", "--out", "x.txt"], ["'x.txt'", ".png"]),
+    ("plot-out-no-folder", ["plot", "fig3_2", "--out", "no/such/x.png"], ["'no/such/x.png'"]),
+    ("plot-table-needed", ["plot", "fig5_1", "--out", "x.png"], ["--table"]),
+    ("plot-table-missing", ["plot", "fig5_1", "--out", "x.png", "--table", "none.parquet"],
+     ["'none.parquet'"]),
+    ("dem-file-missing", ["dem", "none.toml", "--for", "lammps"], ["none.toml"]),
+    ("dem-code-unknown", ["dem", "none.toml", "--for", "gromacs"], ["--for", "gromacs"]),
+    ("bench-unknown", ["bench", "nosuch"], ["'nosuch'"]),
+    ("bench-compare-missing", ["bench", "compare", "a.json", "b.json"], ["a.json"]),
+    ("command-unknown", ["simulat"], ["simulat"]),
+]
+
+
+@pytest.mark.parametrize("argv, names", [pytest.param(a, n, id=i) for i, a, n in OTHER_ERRORS])
+def test_other_subcommands_refuse(argv, names, tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    assert_one_line_error(*run(argv, capsys), *names)
+
+
 # ---- extreme admissible inputs: exit 0 and a status that says what happened -------
 
 def _json(argv: list[str], capsys) -> dict:
