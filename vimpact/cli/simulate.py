@@ -140,6 +140,7 @@ def scene_from_args(a) -> Scene:
     except ScaleError as exc:  # no one input is at fault: name the options that set the scales
         typed = [f"--{n.replace('_', '-')} = {getattr(a, n)}" for n in _SCALE_OPTIONS
                  if getattr(a, n, None) is not None]
+        typed += [f"--{n} = {getattr(a, n)}" for n in ("vx0", "omega0") if getattr(a, n) != 0.0]
         if a.Q1 is not None or not typed:
             raise _as_flags(exc) from None
         reason = str(exc).split(" is not allowed: ", 1)[-1]

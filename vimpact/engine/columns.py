@@ -293,12 +293,18 @@ class SceneColumns:
                   & np.isfinite(self.a_H) & (self.a_H > 0) & np.isfinite(tau0)
                   & np.isfinite(self.G_arm / self.G_inf[:, None]).all(axis=1)
                   & np.isfinite(self.tau_arm / self.T[:, None]).all(axis=1)
-                  & np.isfinite(self.contact_mass_factor) & np.isfinite(self.v_c0))
+                  & np.isfinite(self.contact_mass_factor) & np.isfinite(self.v_c0)
+                  # the energies the results are checked with (passivity, energy_ratio)
+                  & np.isfinite(self.m * (self.v_z0**2 + self.v_x0**2)
+                                + self.Theta * self.omega0**2)
+                  & np.isfinite(self.v_c0**2 / self.contact_mass_factor))
         for i in np.flatnonzero(~ok & self.valid):
             self.reasons[i] = (
                 f"the inputs of this row (G_inf = {self.G_inf[i]:.3g} Pa, R = {self.R[i]:.3g} m, "
-                f"m = {self.m[i]:.3g} kg, v_z0 = {self.v_z0[i]:.3g} m/s) give Hertz scales or "
-                "kernel inputs outside the floating-point range: not allowed")
+                f"m = {self.m[i]:.3g} kg, v_z0 = {self.v_z0[i]:.3g} m/s, v_x0 = "
+                f"{self.v_x0[i]:.3g} m/s, omega0 = {self.omega0[i]:.3g} rad/s) give Hertz "
+                "scales, kernel inputs or a kinetic energy outside the floating-point range: "
+                "not allowed")
         with np.errstate(all="ignore"):
             damped = ok & (tau0 > MAX_DASHPOT_TIME)
         for i in np.flatnonzero(damped & self.valid):

@@ -111,15 +111,22 @@ class Scene:
         with np.errstate(all="ignore"):
             hz = hertz_scales(mat.G_inf, mat.nu, self.R, self.m, self.v_z0)
             ratio = self.Theta / (self.m * self.R**2) if math.isfinite(self.R**2 * self.m) else 0.0
+            m, v_z0, v_x0, omega0 = (np.float64(x) for x in (self.m, self.v_z0, self.v_x0,
+                                                             self.omega0))  # inf, not OverflowError
+            energy = m * (v_z0**2 + v_x0**2) + np.float64(self.Theta) * omega0**2
+            energy += (v_x0 + np.float64(self.R) * omega0) ** 2  # v_c0^2 (kernel unit of F_x)
         if not (all(math.isfinite(x) and x > 0.0 for x in hz) and ratio > 0.0
+                and math.isfinite(energy)
                 and math.isfinite(1.0 / ratio) and math.isfinite(mat.dashpot_time / hz.T)
                 and all(math.isfinite(tau / hz.T) and math.isfinite(G / mat.G_inf)
                         for G, tau in mat.arms)):
             raise ScaleError(
                 f"the scene (G_inf = {mat.G_inf:.3g} Pa, R = {self.R:.3g} m, m = {self.m:.3g} kg, "
-                f"v_z0 = {self.v_z0:.3g} m/s, Theta = {self.Theta:.3g} kg m^2) is not allowed: "
-                "its Hertz scales or dimensionless inputs leave the floating-point range",
-                ("G_inf", "R", "m", "v_z0", "Theta"))
+                f"v_z0 = {self.v_z0:.3g} m/s, v_x0 = {self.v_x0:.3g} m/s, omega0 = "
+                f"{self.omega0:.3g} rad/s, Theta = {self.Theta:.3g} kg m^2) is not allowed: "
+                "its Hertz scales, dimensionless inputs or kinetic energy leave the "
+                "floating-point range",
+                ("G_inf", "R", "m", "v_z0", "v_x0", "omega0", "Theta"))
         if mat.dashpot_time / hz.T > MAX_DASHPOT_TIME:
             raise ScaleError(
                 f"eta0 = {mat.eta0:.3g} Pa s is not allowed with G_inf = {mat.G_inf:.3g} Pa, "
