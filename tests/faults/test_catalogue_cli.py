@@ -115,6 +115,7 @@ SIMULATE_ERRORS = [
     ("vz0-1e-200", with_value(PHYS, "--vz0", "1e-200"), ["--vz0 = 1e-200", "floating-point"]),
     ("vz0-zero", with_value(PHYS, "--vz0", "0"), ["--vz0 = 0"]),
     ("vz0-negative", with_value(PHYS, "--vz0", "-2"), ["--vz0 = -2"]),
+    ("omega0-1e300", PHYS + ["--omega0", "1e300"], ["--omega0 = 1e+300", "kinetic energy"]),
     ("E-negative", with_value(PHYS, "--E", "-1e9"), ["--E = -1"]),
     ("E-and-G", PHYS + ["--G", "1e9"], ["--E", "--G"]),
     ("nu-0.7", with_value(PHYS, "--nu", "0.7"), ["--nu = 0.7"]),
