@@ -11,8 +11,9 @@ SI numbers too (``eta`` over 30 decades around the scene's own ``G_inf T``), so
 the Prony series are drawn relative to ``G_inf`` over [1e-3, 1e3] and their times
 relative to ``T`` over [1.3e-3, 1e4] in the default run (the full-stick continuum
 path) and over [1e-4, 1e4] in the ``slow`` run (arms faster than 1e-3 T take the
-element path; further out it is refused as too costly or runs for minutes: cost,
-not correctness, which the catalogues cover with single extreme rows).
+element path, and Coulomb friction ``mu`` in [1e-3, 10] besides full stick; further
+out it is refused as too costly or runs for minutes: cost, not correctness, which
+the catalogues cover with single extreme rows).
 
 Every row must be one of
 
@@ -87,7 +88,8 @@ def rows(draw, fast_arms: bool = False) -> dict:
            "omega0_rad_s": draw(_signed(-15.0, 15.0)) * v_z0 / R,
            "theta_ratio": draw(st.one_of(st.just(0.4), _decades(-3.0, 0.0))),
            "rotation": draw(st.booleans()),
-           "tangential": draw(st.sampled_from(("auto", "stick", "none")))}
+           "tangential": draw(st.sampled_from(("auto", "stick", "none"))),
+           "mu": draw(st.one_of(st.just(math.inf), _decades(-3.0, 1.0))) if fast_arms else math.inf}
     with np.errstate(all="ignore"):
         T = hertz_scales(G, nu, R, m, v_z0).T
     T = T if math.isfinite(T) and T > 0.0 else 1.0
@@ -109,7 +111,7 @@ def _columns(batch: list[dict]) -> pd.DataFrame:
     k = max(len(r["arms"]) for r in batch)
     data = {key: [r.get(key, 0.0) for r in batch] for key in
             ("model", "nu", "G_inf_Pa", "eta0_Pa_s", "R_m", "m_kg", "v_z0_m_s", "v_x0_m_s",
-             "omega0_rad_s", "theta_ratio", "rotation", "tangential")}
+             "omega0_rad_s", "theta_ratio", "rotation", "tangential", "mu")}
     for i in range(k):  # G = 0: no such arm in this row
         data[f"G_arm{i + 1}_Pa"] = [r["arms"][i][0] if i < len(r["arms"]) else 0.0 for r in batch]
         data[f"tau_arm{i + 1}_s"] = [r["arms"][i][1] if i < len(r["arms"]) else 1.0 for r in batch]
