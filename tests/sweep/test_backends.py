@@ -309,3 +309,10 @@ def test_a_second_sweep_into_the_same_output_is_refused(tmp_path, main, capsys, 
     err = capsys.readouterr().err
     assert "another sweep is writing" in err and str(out) in err
     assert not out.with_name("t.parquet.lock").exists()  # released and removed
+
+
+def test_a_bad_output_key_in_the_spec_is_named_as_the_spec_key(tmp_path, main, capsys):
+    spec = write(tmp_path, 'output = "t.csv"\n' + GRID_SS)
+    assert main(["sweep", str(spec)]) == 2
+    err = capsys.readouterr().err
+    assert f"output (in {spec})" in err and "--out" not in err and err.count("\n") == 1

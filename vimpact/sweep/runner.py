@@ -436,6 +436,7 @@ def run_sweep(spec_path, out=None, resume: bool = False,
         says how to resume.
     """
     spec = load_spec(spec_path)
+    out_name = "--out" if out is not None else f"output (in {spec.path})"
     out = Path(out) if out is not None else spec.output
     layout = spec.table_layout
     if workers is not None and scheduler is not None:
@@ -449,7 +450,7 @@ def run_sweep(spec_path, out=None, resume: bool = False,
                              "0 <= I < N")
         if combine:
             raise ValueError("give --shard or --combine, not both")
-    store.check_output(out, layout)
+    store.check_output(out, layout, out_name)
     parts = store.parts_dir(out, layout)
     if shard is not None:  # shards run side by side (SLURM array): no output lock
         return _run(spec, spec_path, out, parts, True, progress, workers, scheduler, shard,

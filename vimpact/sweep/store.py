@@ -801,25 +801,26 @@ def _verify_written(out: Path, parts: Path) -> None:
 
 # ---- the output: checks and lock ----------------------------------------------------
 
-def check_output(out: Path, layout: str) -> None:
+def check_output(out: Path, layout: str, name: str = "--out") -> None:
     """Refuse an output that cannot be written, before any work: not ``.parquet``, a
     directory where a file is to go (or a file where a dataset is to go), or a place
-    without write permission."""
+    without write permission. ``name``: how the user gave the output (``--out``, or
+    the spec's ``output`` key), for the message."""
     out = Path(out)
     if out.suffix != ".parquet":
-        raise ValueError(f"--out = {str(out)!r} is not allowed: the table's name must end "
+        raise ValueError(f"{name} = {str(out)!r} is not allowed: the table's name must end "
                          "in .parquet")
     if layout == "file" and out.is_dir():
-        raise ValueError(f"--out = {str(out)!r} is not allowed: it is a directory, and this "
+        raise ValueError(f"{name} = {str(out)!r} is not allowed: it is a directory, and this "
                          "sweep writes one file (layout = \"file\")")
     if layout == "dataset" and out.exists() and not out.is_dir():
-        raise ValueError(f"--out = {str(out)!r} is not allowed: it is a file, and this sweep "
+        raise ValueError(f"{name} = {str(out)!r} is not allowed: it is a file, and this sweep "
                          "writes a dataset directory (layout = \"dataset\")")
     existing = out if (layout == "dataset" and out.is_dir()) else out.parent
     while not existing.exists():
         existing = existing.parent
     if not existing.is_dir() or not os.access(existing, os.W_OK | os.X_OK):
-        raise ValueError(f"--out = {str(out)!r} is not allowed: {existing} is not a "
+        raise ValueError(f"{name} = {str(out)!r} is not allowed: {existing} is not a "
                          "writable directory")
 
 
