@@ -71,7 +71,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from vimpact.model.numerics import Numerics
-from vimpact.model.scene import Scene
+from vimpact.model.scene import ScaleError, Scene
 from vimpact.model.toml_input import (ARM_KEYS, PHYSICAL_DEFAULTS,
                                       SWEEP_TOP_KEYS, TomlSource, friction_coefficient,
                                       impact_angle, input_keys, parse_header, parse_numerics,
@@ -149,9 +149,19 @@ def _scene(spec: TomlSource, text: str, data: dict) -> tuple[Scene, Numerics | N
                                   tangential_memory=header.tangential_memory,
                                   tangential=header.tangential, rotation=header.rotation,
                                   allow_large_contact=allow_large)
+    except ScaleError as exc:  # name the keys of this file that set the scales
+        keys = [k for name in exc.names for k in _SCALE_KEYS.get(name, (name,))
+                if k in values or name not in _SCALE_KEYS]
+        raise ValueError(f"{source}: scene: {exc} (keys here: {', '.join(keys)})") from None
     except ValueError as exc:
         raise ValueError(f"{source}: scene: {exc}") from None
     return scene, numerics
+
+
+#: Scene attributes that set the Hertz scales (ScaleError.names) -> the [scene] keys giving them.
+_SCALE_KEYS = {"G_inf": ("E_Pa", "G_Pa", "G1_Pa"), "R": ("R_m",), "m": ("m_kg",),
+               "v_z0": ("v_z0_m_s",), "v_x0": ("v_x0_m_s", "angle_deg"),
+               "omega0": ("omega0_rad_s",), "Theta": ("theta_ratio",), "eta0": ("eta_Pa_s",)}
 
 
 def _top_keys(spec: TomlSource, data: dict) -> None:
