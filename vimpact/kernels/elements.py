@@ -124,13 +124,12 @@ def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT, FRICTION,
     # faster than the step stay second order and stable
     IMPLICIT = INTEGRATOR == VERLET and ARMS
     kap, ca = arm_implicit_coefficients(g[:n_arms], tau[:n_arms], h)
-    # the arms' end stress takes the drift velocity with the weight cae = sum g tau (1 - E);
-    # the force at the step end (whether an element still pushes, and the line
-    # of a partial step) takes the end velocity instead, as the dashpot does
-    cae = 0.0
-    if IMPLICIT:
-        for i in range(n_arms):
-            cae += g[i] * h * (1.0 - phi[i])
+    # the arms' end stress on the straight drift path misses the path's curvature:
+    # on w0 + v t + a t^2 / 2 it is larger by sum g tau (1 + E - 2 (1 - E) / x) a h / 2,
+    # which is ca (ve - v_test): the force that decides whether an element still
+    # pushes at the step end (and the line of a partial step) takes it, as the
+    # dashpot takes the end velocity (ca -> g tau for a fast arm, h x / 6 for a slow one)
+    cae = ca if IMPLICIT else 0.0
 
     k_el = 2.0 * ELEMENT_STIFFNESS * dxi  # both halves of the symmetric row
     xi2 = np.empty(n_elem)
@@ -179,6 +178,7 @@ def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT, FRICTION,
     Ft_s = 0.0
     Ca = 0.0
     Cta = 0.0
+    Css = 0.0
     active = 0  # elements [0, active) have ever been touched
     t_exit = 0.0  # time the last element left (impact starts touching at t = 0)
     u_max = 0.0
@@ -206,7 +206,9 @@ def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT, FRICTION,
         duc = 0.0
         if TANGENTIAL:
             Ft_pos = Ft_s if IMPLICIT else Ft_el
-            if FRIC and DASHPOT:  # slipping elements: mu times their normal force, whose
+            if FRIC and IMPLICIT:  # slipping: mu times the normal force as the kick takes it
+                Ft_pos = Ft_pos + Css * v_test
+            elif FRIC and DASHPOT:  # slipping elements: mu times their normal force, whose
                 # dashpot part takes this step's normal velocity (as the normal kick)
                 Ft_pos = Ft_pos + Cs * (v if INTEGRATOR == EULER else v_test)
             if INTEGRATOR == EULER:
@@ -232,6 +234,7 @@ def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT, FRICTION,
         n_slip = 0
         sum_slip_r = 0.0  # sum of sign * (normal spring part) over slipping elements
         sum_slip_sign = 0.0
+        sum_slip_rs = 0.0  # IMPLICIT: ... of the normal start-of-step forms
         # Verlet's step impulse is the trapezoid h/2 (F_start + F_end) of the forces
         # as the half-kicks apply them (dashpots at the half-step velocity). An
         # element in contact for only part of the step (leaving after a fraction
@@ -255,6 +258,9 @@ def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT, FRICTION,
             ft_entry = 0.0
             fol = 0.0
             fa_entry = 0.0
+            fa_t = 0.0
+            rs = 0.0
+            r_end = 0.0
             arm_mean = 0.0
             arm_mean_t = 0.0
             if was_in:
@@ -328,7 +334,10 @@ def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT, FRICTION,
                                 T1t = 0.0
                             elif sg != 0.0:  # slipping: mu times the normal force
                                 T0t = ftp[j] + sg * mu_k / kappa * c0 * v
-                                A_t = ftp[j] + sg * mu_k / kappa * c0 * v_test
+                                if IMPLICIT:  # what the first half-kick applied
+                                    A_t = sg * mu_k / kappa * (fs[j] + (c0 + ca) * v_test)
+                                else:
+                                    A_t = ftp[j] + sg * mu_k / kappa * c0 * v_test
                                 T1t = sg * mu_k / kappa * T1
                             else:
                                 T0t = ftp[j] + c0 * vc
@@ -414,6 +423,10 @@ def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT, FRICTION,
                 if ARMS:
                     if was_in:
                         fol = _follow(s0, s1, p[j], g, E, omE, phi)
+                    elif IMPLICIT:  # the arms at their exact mean over the entering part
+                        fa_t = _arm_stress(s0, p[j], g)
+                        fol, arm_mean_t = _follow_over_impulse(s0, s1, p[j], g, tau, theta * h)
+                        ft_entry += 2.0 * arm_mean_t - fol - fa_t
                     else:
                         fol = _follow_over(s0, s1, p[j], g, tau, theta * h)
                 trial = s1 + fol
@@ -452,10 +465,12 @@ def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT, FRICTION,
                     s[j] = s_slip
                     sgn = math.copysign(1.0, trial)
                     sum_slip_r += sgn * r
+                    if IMPLICIT:
+                        sum_slip_rs += sgn * rs
                     sum_slip_sign += sgn
                     n_slip += 1
                     if PARTIAL:  # mu times the normal force, entering or not
-                        ftp[j] = sgn * mu_k / kappa * r
+                        ftp[j] = sgn * mu_k / kappa * r_end
                         fsgn[j] = sgn
                         if NCORR and not was_in:
                             corr_t += sgn * mu_k / kappa * entry_n
@@ -466,6 +481,7 @@ def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT, FRICTION,
         Ft_el1 = k_el * kappa * sum_rt
         Ct1 = k_el * kappa * c0 * n_c
         Cs1 = 0.0
+        Css1 = 0.0
         F_s1 = k_el * sum_rs
         Ft_s1 = k_el * kappa * sum_rts
         Ca1 = k_el * ca * n_c
@@ -475,8 +491,9 @@ def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT, FRICTION,
             Cta1 = k_el * kappa * ca * n_stick
             if n_slip > 0:  # (mu_k may be inf: only slipping elements carry it)
                 Ft_el1 += mu_k * k_el * sum_slip_r
-                Ft_s1 += mu_k * k_el * sum_slip_r  # slipping: the normal force as it is
-                Cs1 = mu_k * k_el * c0 * sum_slip_sign
+                Ft_s1 += mu_k * k_el * sum_slip_rs  # slipping: mu times the normal force
+                Cs1 = mu_k * k_el * c0 * sum_slip_sign  # as each half-kick takes it
+                Css1 = mu_k * k_el * (c0 + ca) * sum_slip_sign
             if n_slip == n_c and n_c > 0:
                 t_gross += h
             slip_now = n_slip * dxi
@@ -494,7 +511,7 @@ def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT, FRICTION,
         u = u1
         uc = uc1
         F_el, C, Ft_el, Ct, Cs = F_el1, C1, Ft_el1, Ct1, Cs1
-        F_s, Ft_s, Ca, Cta = F_s1, Ft_s1, Ca1, Cta1
+        F_s, Ft_s, Ca, Cta, Css = F_s1, Ft_s1, Ca1, Cta1, Css1
         step += 1
         t = step * h
         if not (math.isfinite(u) and math.isfinite(v) and math.isfinite(vc)):

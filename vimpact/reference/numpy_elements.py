@@ -235,7 +235,11 @@ def naive_impact(scene, steps, elements, row_width=1.05, max_time=100.0, mu=None
     arms_h = arm_update_coefficients(rheo.tau, h)  # full-step coefficients, per arm
     # arms in the kick: exact step impulse, damping part implicit (Rheology.kick_split)
     implicit = rheo.n_arms > 0
-    kap, arm_damping, arm_end = rheo.kick_split(h, arms_h) if implicit else (None, 0.0, 0.0)
+    kap, arm_damping, _ = rheo.kick_split(h, arms_h) if implicit else (None, 0.0, 0.0)
+    # the arms' end stress on the straight drift path misses its curvature a: on
+    # w0 + v t + a t^2/2 the stress is larger by arm_damping * a h / 2 = arm_damping
+    # (v_end - v_half), which the force at the step end takes (as eta0 takes v_end)
+    arm_end = arm_damping
     weighted = rheo.eta0 > 0.0 or implicit  # force can jump at entry: weigh partial steps
 
     # element state
@@ -255,6 +259,7 @@ def naive_impact(scene, steps, elements, row_width=1.05, max_time=100.0, mu=None
     Fz_spring, Cz = 0.0, 0.0
     Fx_spring, Cx = 0.0, 0.0
     Fz_start, Fx_start, Cz_arm, Cx_arm = 0.0, 0.0, 0.0, 0.0  # first half-kick: arms split
+    Fx_slip_start, Cx_slip_start = 0.0, 0.0  # ... slipping: mu times the normal force so
 
     memory = scene.tangential_memory
     if mu is None:
@@ -283,7 +288,8 @@ def naive_impact(scene, steps, elements, row_width=1.05, max_time=100.0, mu=None
         # F_x = Fx_spring + Cx (v_x+ + R omega+): a 2x2 linear system
         k = 0.5 * h * (Cx + Cx_arm)
         A = np.array([[m + k, k * R], [k * R, Theta + k * R * R]])
-        Fx_known = Fx_start + Fx_slip + Cx_slip * v_z_half
+        Fx_known = Fx_start + (Fx_slip_start + Cx_slip_start * v_z_half if implicit
+                               else Fx_slip + Cx_slip * v_z_half)
         b = np.array([m * v_x - 0.5 * h * Fx_known, Theta * omega - 0.5 * h * R * Fx_known])
         v_x_half, omega_half = np.linalg.solve(A, b)
         v_c_half = v_x_half + R * omega_half
@@ -383,9 +389,10 @@ def naive_impact(scene, steps, elements, row_width=1.05, max_time=100.0, mu=None
                                           else 0.0, dash_t * v_c_start)
             A_t = ft_pos[left] + np.where(sg != 0.0, sg * mu * dash_z * v_z_half if friction
                                           else 0.0, dash_t * v_c_half)
-            if implicit:  # sticking: what the first half-kick applied
-                A_t = np.where(sg != 0.0, A_t, ft_start[left]
-                               + (dash_t + c_t * weight * arm_damping) * v_c_half)
+            if implicit:  # what the first half-kick applied
+                A_t = np.where(sg != 0.0, sg * mu * (f_start[left] + (
+                    dash_z + c_n * weight * arm_damping) * v_z_half) if friction else 0.0,
+                               ft_start[left] + (dash_t + c_t * weight * arm_damping) * v_c_half)
             if friction:
                 T1t = np.where(sg != 0.0, sg * mu * T1, T1t)
             path = 2.0 * alpha * T0t + alpha**2 * (T1t - T0t) - A_t
@@ -416,7 +423,7 @@ def naive_impact(scene, steps, elements, row_width=1.05, max_time=100.0, mu=None
         stay = now_in & was_in
         arms_new = arm_update_coefficients(rheo.tau[None, :], (theta[new] * h)[:, None])
         arm_mean_t = np.zeros(n)
-        if implicit and not friction and memory != "seed":  # entering: the arms' exact mean
+        if implicit and memory != "seed":  # entering: the arms' exact mean
             arm_mean_t[new] = c_t * weight * rheo.arm_mean_stress(
                 s_start[new], s_new[new], p_start[new], theta[new] * h)
         p[stay] = advance_arms(p_start[stay], s_start[stay], s_new[stay], arms_h)
@@ -432,15 +439,15 @@ def naive_impact(scene, steps, elements, row_width=1.05, max_time=100.0, mu=None
         ft_end = t_spring + c_t * weight * rheo.eta0 * v_c_end_step
         if memory == "seed":  # the element jumps to the total displacement at entry
             ft_entry[new] = ft_end[new]
-        elif implicit and not friction:  # relaxed spring and dashpot on a line, arms exact
-            ft_entry[new] = (c_t * weight * (rheo.G_inf * (s_start[new] + s[new])
-                                             + rheo.eta0 * (v_c_entry[new] + v_c_end_step))
-                             + 2.0 * arm_mean_t[new] - ft_end[new])
         slip = np.zeros(n, dtype=bool)
         if friction:
             slip = now_in & (np.abs(f_t) > mu * force)
             cone_entry = mu * np.maximum(f_entry[new], 0.0)
             ft_entry[new] = np.clip(ft_entry[new], -cone_entry, cone_entry)
+        if implicit and memory != "seed":  # the arms at their exact mean over the entering part
+            arms_entry = rheo.spring_stress(s_start[new], p_start[new]) - rheo.G_inf * s_start[new]
+            arms_end = rheo.spring_stress(s[new], p[new]) - rheo.G_inf * s[new]
+            ft_entry[new] += 2.0 * arm_mean_t[new] - c_t * weight * (arms_entry + arms_end)
         stick_new = new & ~slip
         corr_x += float((theta[stick_new] * (ft_entry[stick_new] + ft_end[stick_new])
                          - f_t[stick_new]).sum())
@@ -470,7 +477,7 @@ def naive_impact(scene, steps, elements, row_width=1.05, max_time=100.0, mu=None
             w_friction += float((target * (s_new[idx] - s_slip)).sum())
             s[idx] = s_slip
             f_t[idx] = target
-            ft_pos[idx] = sg * mu * spring[idx]
+            ft_pos[idx] = sg * mu * spring_end[idx]
             slip_sign[idx] = sg
             # entering slipping: mu times the normal force over the whole part
             ent = ~was_in[idx] & weighted
@@ -497,7 +504,13 @@ def naive_impact(scene, steps, elements, row_width=1.05, max_time=100.0, mu=None
             Fx_start = float(ft_start[stick].sum())
             Cz_arm = c_n * weight * arm_damping * n_c
             Cx_arm = c_t * weight * arm_damping * int(stick.sum())
-        Fx_slip = float(ft_pos[slip].sum()) if slip.any() else 0.0
+        Fx_slip = float((slip_sign[slip] * mu * spring[slip]).sum()) if slip.any() else 0.0
+        if implicit and slip.any():
+            Fx_slip_start = float((slip_sign[slip] * mu * f_start[slip]).sum())
+            Cx_slip_start = float((slip_sign[slip] * mu * c_n * weight
+                                   * (rheo.eta0 + arm_damping)).sum())
+        else:
+            Fx_slip_start, Cx_slip_start = 0.0, 0.0
         Cx_slip = float((slip_sign[slip] * mu * c_n * weight * rheo.eta0).sum()) if slip.any() else 0.0
         if n_c > 0 and int(slip.sum()) == n_c:
             t_gross += h
