@@ -1,17 +1,21 @@
-"""Observed convergence orders of the element kernel and the e_x jitter, before/after.
+"""Observed convergence orders of the element kernel against the exact continuum kernel.
 
 Kernel level (own step ``h`` and spacing ``dxi``, no routing, no element-count
-rule): Verlet, default solid sphere (Theta = 2/5 m R^2).
+rule): Verlet, solid sphere (Theta = 2/5 m R^2), the tangential step refined
+as the default routing does. The reference of every case is the full-stick
+continuum kernel (:mod:`vimpact.kernels.continuum_maxwell`, rtol 1e-12: about
+1e-10), which the element path approaches as steps and elements are refined.
 
-- jitter: e_x and e_z over step counts 1330..1470 per t_H at 200 elements
-  per a_H (within +-5 % of the default 1400): their spread is the error that is
-  not smooth in h;
-- time-only orders (1/800 spacing, steps 150..1200 against 9600), space-only
-  orders (9600 steps, 25..200 elements against 1600), joint refinement;
-- Kelvin-Voigt e_z against the continuum closed form.
-
-"before" is the kernel of commit ``BEFORE`` (read with ``git show``, compiled
-from a temporary copy), when git is available.
+- time only (fine spacing), space only (fine steps) and joint refinement (1
+  element per a_H for every 6 steps per t_H): error and observed order of
+  e_z and e_x per level;
+- spacing sweep: e_z and e_x over non-integer elements per a_H around 200
+  (step fine): a spread beyond the smooth trend is the error that is not
+  continuous in the element count (the contact edge crossing element
+  centres);
+- "before": the kernel of commit ``BEFORE`` (read with ``git show``,
+  compiled from a temporary copy) on the arm cases, when git is available
+  (full run only).
 
     python -m benchmarks.element_orders [--quick]
 """
@@ -29,18 +33,22 @@ from pathlib import Path
 import numpy as np
 
 from benchmarks.machine import bench_main, machine_info, save_figure
-from vimpact.kernels.elements import (N_OUT, N_REC, OUT_VC_END, OUT_VZ_END, VERLET, KernelSpec,
-                                      element_kernel)
+from vimpact.kernels.elements import (N_OUT, N_REC, OUT_STATUS, OUT_VC_END, OUT_VZ_END,
+                                      STATUS_OK, VERLET, KernelSpec, element_kernel)
+
+TITLE = "element kernel: observed orders in steps and elements against the continuum kernel"
 
 HERTZ_TIME = 2.9432751843
 Q1_PER_TAU = math.sqrt(15.0 / 32.0)
-BEFORE = "2733180"  # main before the partial-contact weighting
+BEFORE = "308d824"  # main before the arms were taken implicitly in the kick
 #: the default step refinement of a solid sphere's tangential problem (routing)
 TANGENTIAL_FACTOR = math.sqrt(2.0 / 3.0 * 3.5)
+NU = 0.3
+THETA_RATIO = 0.4
 
 
-def run_rows(spec, *, h, dxi, tau0=0.0, g=(), tau=(), nu=0.3, theta_ratio=0.4, mu=math.inf,
-             row_width=1.05, max_time=20.0, kernel=None):
+def run_rows(spec, *, h, dxi, tau0=0.0, g=(), tau=(), nu=NU, theta_ratio=THETA_RATIO,
+             mu=math.inf, row_width=1.05, max_time=20.0, kernel=None):
     """Kernel rows built here (kernel units); returns the OUT rows."""
     h, dxi, tau0, mu = np.broadcast_arrays(
         *(np.atleast_1d(np.asarray(x, dtype=float)) for x in (h, dxi, tau0, mu)))
@@ -54,6 +62,20 @@ def run_rows(spec, *, h, dxi, tau0=0.0, g=(), tau=(), nu=0.3, theta_ratio=0.4, m
         h.copy(), np.ceil(row_width / dxi - 1e-9).astype(np.int64), dxi.copy(),
         np.ceil(max_time * HERTZ_TIME / h).astype(np.int64), np.zeros((n, 0, N_REC)), 1, out)
     return out
+
+
+def continuum(tau0=0.0, g=(), tau=(), nu=NU, theta_ratio=THETA_RATIO) -> tuple[float, float]:
+    """``(e_z, e_x)`` of the full-stick continuum kernel at rtol 1e-12."""
+    from vimpact.kernels import continuum_maxwell
+
+    k = len(g)
+    out = np.zeros((1, N_OUT))
+    continuum_maxwell.maxwell_stick_batch(
+        np.array([tau0]), np.array([list(g) or [0.0]]), np.array([list(tau) or [1.0]]),
+        np.array([k], dtype=np.int64), np.full(1, 2.0 * (1.0 - nu) / (2.0 - nu)),
+        np.full(1, 1.0 + 1.0 / theta_ratio), np.array([True]), 1e-12, 10_000_000, out)
+    assert out[0, OUT_STATUS] == STATUS_OK
+    return float(-out[0, OUT_VZ_END]), float(abs(out[0, OUT_VC_END]))
 
 
 def old_kernel():
@@ -78,66 +100,141 @@ def orders(err):
     return (np.log(err[:-1] / err[1:]) / np.log(2.0)).tolist()
 
 
-CASES = {  # name: (tau0, nu)
-    "kelvin_voigt_Q1_0.3": (0.3 / Q1_PER_TAU, 0.3),
-    "elastic_nu_0.5": (0.0, 0.5),
+def fitted_order(err) -> float:
+    """Least-squares slope of -log2(error) over factor-2 levels."""
+    err = np.asarray(err, dtype=float)
+    return float(-np.polyfit(np.arange(err.size), np.log2(err), 1)[0])
+
+
+#: name: (tau0, g, tau); Q1 = 0.3 throughout (standard solid: G2 = G1 / Q2, arm time Q2 tau)
+TAU_Q1 = 0.3 / Q1_PER_TAU
+CASES = {
+    "kelvin_voigt_Q1_0.3": (TAU_Q1, (), ()),
+    "elastic": (0.0, (), ()),
+    "standard_solid_Q2_1": (0.0, (1.0,), (TAU_Q1,)),
+    "standard_solid_Q2_1e-3": (0.0, (1e3,), (TAU_Q1 * 1e-3,)),
 }
 
 
 def run(quick: bool) -> dict:
-    from vimpact.reference.closed_forms import kelvin_voigt_continuum
-
-    before = old_kernel()
-    kernels = {"after": element_kernel, **({"before": before} if before else {})}
-    N_jit = np.arange(1330, 1471, 20 if quick else 5)
-    steps = np.array([150, 300, 600] if quick else [150, 300, 600, 1200])
+    steps = np.array([150, 300, 600] if quick else [150, 300, 600, 1200, 2400])
     fine_steps = 2400 if quick else 9600
-    elems = np.array([25, 50, 100] if quick else [25, 50, 100, 200])
+    elems = np.array([25, 50, 100] if quick else [25, 50, 100, 200, 400])
     fine_elems = 400 if quick else 1600
-    data = {"machine": machine_info(), "before_commit": BEFORE, "cases": {}}
-    for name, (tau0, nu) in CASES.items():
-        spec = KernelSpec(VERLET, True, 0, False, tau0 > 0.0)
-        case = {}
+    joint = np.array([150, 300, 600] if quick else [150, 300, 600, 1200, 2400])
+    sweep = np.arange(190.0, 210.01, 2.0 if quick else 0.5)
+    sweep_steps = 2400 if quick else 4800
+    before = None if quick else old_kernel()
+    data = {"machine": machine_info(), "before_commit": BEFORE if before else None,
+            "steps": steps.tolist(), "fine_steps": fine_steps, "elements": elems.tolist(),
+            "fine_elements": fine_elems, "joint_steps": joint.tolist(),
+            "joint_elements": (joint / 6.0).tolist(), "sweep_elements": sweep.tolist(),
+            "sweep_steps": sweep_steps, "cases": {}}
+    for name, (tau0, g, tau) in CASES.items():
+        spec = KernelSpec(VERLET, True, 0, len(g) > 0, tau0 > 0.0)
+        ez_ref, ex_ref = continuum(tau0, g, tau)
+        kernels = {"after": element_kernel}
+        if before is not None and len(g) > 0:
+            kernels["before"] = before
+        case = {"continuum_e_z": ez_ref, "continuum_e_x": ex_ref}
         for label, k in kernels.items():
             t0 = time.perf_counter()
-            out = run_rows(spec, h=HERTZ_TIME / N_jit / TANGENTIAL_FACTOR, dxi=1 / 200,
-                           tau0=tau0, nu=nu, kernel=k)
-            e_x, e_z = np.abs(out[:, OUT_VC_END]), -out[:, OUT_VZ_END]
-            r = {"jitter_steps": N_jit.tolist(), "e_x": e_x.tolist(), "e_z": e_z.tolist(),
-                 "e_x_spread": float(np.ptp(e_x)), "e_z_spread": float(np.ptp(e_z))}
-            # time only
-            out = run_rows(spec, h=HERTZ_TIME / np.append(steps, fine_steps) / TANGENTIAL_FACTOR,
-                           dxi=1 / (fine_elems // 2), tau0=tau0, nu=nu, kernel=k)
-            for key, col, sgn in (("e_x", OUT_VC_END, 1.0), ("e_z", OUT_VZ_END, -1.0)):
-                err = np.abs(sgn * out[:-1, col] - sgn * out[-1, col])
-                r[f"time_{key}_error"] = err.tolist()
-                r[f"time_{key}_order"] = orders(err)
-            # space only
-            out = run_rows(spec, h=HERTZ_TIME / fine_steps / TANGENTIAL_FACTOR,
-                           dxi=1.0 / np.append(elems, fine_elems), tau0=tau0, nu=nu, kernel=k)
-            for key, col, sgn in (("e_x", OUT_VC_END, 1.0), ("e_z", OUT_VZ_END, -1.0)):
-                err = np.abs(sgn * out[:-1, col] - sgn * out[-1, col])
-                r[f"space_{key}_error"] = err.tolist()
-                r[f"space_{key}_order"] = orders(err)
-            # joint: 1 element per a_H for every 6 steps per t_H
-            joint = np.append(steps, fine_steps // 2)
-            out = run_rows(spec, h=HERTZ_TIME / joint / TANGENTIAL_FACTOR, dxi=6.0 / joint,
-                           tau0=tau0, nu=nu, kernel=k)
-            for key, col, sgn in (("e_x", OUT_VC_END, 1.0), ("e_z", OUT_VZ_END, -1.0)):
-                err = np.abs(sgn * out[:-1, col] - sgn * out[-1, col])
-                r[f"joint_{key}_error"] = err.tolist()
-                r[f"joint_{key}_order"] = orders(err)
-            if tau0 > 0.0:  # against the continuum closed form
-                exact = kelvin_voigt_continuum(tau0 * Q1_PER_TAU).e_z
-                err = np.abs(-out[:-1, OUT_VZ_END] - exact)
-                r["joint_e_z_vs_continuum_error"] = err.tolist()
-                r["joint_e_z_vs_continuum_order"] = orders(err)
+            r = {}
+
+            def errors(out):
+                return (np.abs(-out[:, OUT_VZ_END] - ez_ref).tolist(),
+                        np.abs(np.abs(out[:, OUT_VC_END]) - ex_ref).tolist())
+
+            ladders = {
+                "time": dict(h=HERTZ_TIME / steps / TANGENTIAL_FACTOR, dxi=1.0 / fine_elems),
+                "space": dict(h=HERTZ_TIME / fine_steps / TANGENTIAL_FACTOR, dxi=1.0 / elems),
+                "joint": dict(h=HERTZ_TIME / joint / TANGENTIAL_FACTOR, dxi=6.0 / joint),
+            }
+            for lname, kw in ladders.items():
+                ez, ex = errors(run_rows(spec, tau0=tau0, g=g, tau=tau, kernel=k, **kw))
+                r[f"{lname}_e_z_error"], r[f"{lname}_e_x_error"] = ez, ex
+                r[f"{lname}_e_z_order"], r[f"{lname}_e_x_order"] = orders(ez), orders(ex)
+                r[f"{lname}_e_z_fitted_order"] = fitted_order(ez)
+                r[f"{lname}_e_x_fitted_order"] = fitted_order(ex)
+            if label == "after":
+                out = run_rows(spec, h=HERTZ_TIME / sweep_steps / TANGENTIAL_FACTOR,
+                               dxi=1.0 / sweep, tau0=tau0, g=g, tau=tau, kernel=k)
+                ez, ex = -out[:, OUT_VZ_END] - ez_ref, np.abs(out[:, OUT_VC_END]) - ex_ref
+                r["sweep_e_z_error"], r["sweep_e_x_error"] = ez.tolist(), ex.tolist()
+                # spread about the smooth trend c / n^2 (least squares): the jumps
+                for key, e in (("e_z", ez), ("e_x", ex)):
+                    basis = 1.0 / sweep**2
+                    c = float(basis @ e / (basis @ basis))
+                    r[f"sweep_{key}_jump"] = float(np.ptp(e - c * basis))
             r["seconds"] = time.perf_counter() - t0
             case[label] = r
         data["cases"][name] = case
-    data["steps"], data["fine_steps"] = steps.tolist(), fine_steps
-    data["elements"], data["fine_elements"] = elems.tolist(), fine_elems
+    data["error_model"] = error_model_points(quick)
     return data
+
+
+#: scenes of the error model (Q1, nu, Q2; Q2 None: Kelvin-Voigt), oblique, solid sphere;
+#: none of them is a scene of tests/engine/test_tolerance.py or test_presets.py
+MODEL_SCENES = [(0.01, 0.0, None), (0.1, 0.5, None), (1.0, 0.25, None), (5.0, 0.5, None),
+                (0.1, 0.5, 0.1), (1.0, 0.5, 10.0), (0.3, 0.3, 1e-3), (0.03, 0.5, 0.01)]
+
+
+def error_model_points(quick: bool) -> dict:
+    """Errors of ``Numerics(continuum=False, steps=S, elements=E)`` against the
+    continuum kernel on :data:`MODEL_SCENES`, max over the scenes of
+    ``max(|e_z err|, |e_x err|)``, on a grid of (S, E), and the envelope
+    ``a / S + b / E^2`` that bounds every point (the form of
+    ``vimpact.model.numerics.ERROR_MODEL``); the presets on the element path,
+    measured the same way."""
+    import vimpact as v
+    from vimpact.engine.columns import SceneColumns
+    from vimpact.engine.pack import arm_arrays
+    from vimpact.kernels import continuum_maxwell
+
+    S = [250, 500, 1000] if quick else [250, 500, 1000, 2000, 4000]
+    E = [50, 100, 200] if quick else [50, 100, 200, 400, 800]
+    specs = MODEL_SCENES[:3] if quick else MODEL_SCENES
+    scenes = [v.Scene.from_dimensionless(q1, nu, q2) for q1, nu, q2 in specs]
+    cols = SceneColumns.from_scenes(scenes)
+    g, tau, n_arms = arm_arrays(cols)
+    out = np.zeros((len(scenes), N_OUT))
+    continuum_maxwell.maxwell_stick_batch(cols.dashpot_time / cols.T, g, tau, n_arms, cols.kappa,
+                                          cols.contact_mass_factor, cols.computes_tangential,
+                                          1e-12, 10_000_000, out)
+    ez_ref, ex_ref = -out[:, OUT_VZ_END], np.abs(out[:, OUT_VC_END])
+    err = np.zeros((len(S), len(E)))
+    per_scene = {}
+    for i, s in enumerate(S):
+        for j, e in enumerate(E):
+            df = v.simulate_batch(scenes, v.Numerics(continuum=False, steps=s, elements=e))
+            assert (df.status == "ok").all(), df.status.tolist()
+            d = np.maximum(np.abs(df.e_z.to_numpy() - ez_ref), np.abs(df.e_x.to_numpy() - ex_ref))
+            err[i, j] = d.max()
+            per_scene[f"{s}x{e}"] = d.tolist()
+    # exponents from the finest row and column (informative: the coarse levels of
+    # one knob are floored by the other), and the envelope of the model's form
+    # with p = 1, q = 2: for each a the least b that bounds every point, keeping
+    # the (a, b) whose largest bound / error ratio is smallest
+    p_fit = -np.polyfit(np.log(S), np.log(err[:, -1]), 1)[0]
+    q_fit = -np.polyfit(np.log(E), np.log(err[-1, :]), 1)[0]
+    SS, EE = np.meshgrid(np.asarray(S, float), np.asarray(E, float), indexing="ij")
+    p, q = 1.0, 2.0
+    best = None
+    for a in np.logspace(-5, 2, 1400):
+        b = max(0.0, float(((err - a / SS**p) * EE**q).max()))
+        worst = float(((a / SS**p + b / EE**q) / err).max())
+        if best is None or worst < best[2]:
+            best = (float(a), b, worst)
+    presets = {}
+    for name in (("fast", "default") if quick else ("fast", "default", "precise")):
+        df = v.simulate_batch(scenes, v.Numerics.preset(name).with_(continuum=False))
+        d = np.maximum(np.abs(df.e_z.to_numpy() - ez_ref), np.abs(df.e_x.to_numpy() - ex_ref))
+        presets[name] = {"max_error": float(d.max()), "per_scene": d.tolist()}
+    return {"steps": S, "elements": E, "scenes": [list(x) for x in specs], "presets": presets,
+            "continuum_e_z": ez_ref.tolist(), "continuum_e_x": ex_ref.tolist(),
+            "max_error": err.tolist(), "per_scene": per_scene,
+            "fitted_exponents": {"p": float(p_fit), "q": float(q_fit)},
+            "fit": {"a": best[0], "p": p, "b": best[1], "q": q, "max_bound_over_error": best[2]}}
 
 
 def plot(data: dict, path) -> None:
@@ -147,26 +244,43 @@ def plot(data: dict, path) -> None:
     import matplotlib.pyplot as plt
 
     cases = data["cases"]
-    fig, axes = plt.subplots(len(cases), 3, figsize=(13, 4 * len(cases)), squeeze=False)
+    fig, axes = plt.subplots(len(cases), 4, figsize=(17, 3.6 * len(cases)), squeeze=False)
     for row, (name, case) in zip(axes, cases.items()):
-        for label, r in case.items():
+        for label in ("after", "before"):
+            if label not in case:
+                continue
+            r = case[label]
             ls = "-" if label == "after" else "--"
-            row[0].plot(r["jitter_steps"], np.array(r["e_x"]) - r["e_x"][len(r["e_x"]) // 2],
-                        ls, label=f"{label}: spread {r['e_x_spread']:.1e}")
-            for key, mk in (("e_x", "o"), ("e_z", "s")):
-                row[1].loglog(data["steps"], r[f"time_{key}_error"], ls + mk,
-                              label=f"{label} {key}")
-                row[2].loglog(data["elements"], r[f"space_{key}_error"], ls + mk,
-                              label=f"{label} {key}")
-        row[0].set(title=f"{name}: e_x - middle value, 200 el/a_H", xlabel="steps per t_H")
-        row[1].set(title="time only (vs finest)", xlabel="steps per t_H", ylabel="|error|")
-        row[2].set(title="space only (vs finest)", xlabel="elements per a_H")
+            for key, mk in (("e_z", "o"), ("e_x", "s")):
+                row[0].loglog(data["steps"], r[f"time_{key}_error"], ls + mk,
+                              label=f"{label} {key} ({r[f'time_{key}_fitted_order']:.1f})")
+                row[1].loglog(data["elements"], r[f"space_{key}_error"], ls + mk,
+                              label=f"{label} {key} ({r[f'space_{key}_fitted_order']:.1f})")
+                row[2].loglog(data["joint_steps"], r[f"joint_{key}_error"], ls + mk,
+                              label=f"{label} {key} ({r[f'joint_{key}_fitted_order']:.1f})")
+        r = case["after"]
+        for key, mk in (("e_z", "o"), ("e_x", "s")):
+            row[3].plot(data["sweep_elements"], r[f"sweep_{key}_error"], "-" + mk, ms=3,
+                        label=f"{key}: jump {r[f'sweep_{key}_jump']:.1e}")
+        row[0].set(title=f"{name}: time only ({data['fine_elements']} el/a_H)",
+                   xlabel="steps per t_H", ylabel="|error| vs continuum")
+        row[1].set(title=f"space only ({data['fine_steps']} steps/t_H)",
+                   xlabel="elements per a_H")
+        row[2].set(title="joint (6 steps per element)", xlabel="steps per t_H")
+        row[3].set(title=f"spacing sweep ({data['sweep_steps']} steps/t_H)",
+                   xlabel="elements per a_H", ylabel="error (signed)")
         for ax in row:
             ax.legend(fontsize=7)
     save_figure(fig, path)
 
 
 def main(argv=None):
+    from vimpact.bench import BENCHMARKS
+
+    if "element_orders" in BENCHMARKS:
+        from benchmarks.machine import repository_main
+
+        return repository_main("element_orders", argv)
     return bench_main(__doc__, run, plot, "element_orders", argv=argv)
 
 
