@@ -44,3 +44,36 @@ def test_presets_claim_on_the_continuum_path():
     ref = v.simulate_batch(scenes, REFERENCE)
     for name in ("e_z", "beta_x"):
         assert np.abs(got[name] - ref[name]).max() <= 1e-9, name
+
+
+def _continuum_kernel(scenes):
+    """``(e_z, e_x)`` of the full-stick continuum kernel at rtol 1e-12 called
+    directly: routing sends scenes with an arm faster than 1e-3 T to elements,
+    but the kernel itself is exact for them (tests/kernels/test_continuum_maxwell.py
+    checks it against scipy)."""
+    from vimpact.engine.columns import SceneColumns
+    from vimpact.engine.pack import arm_arrays
+    from vimpact.kernels import continuum_maxwell, layout
+
+    cols = SceneColumns.from_scenes(scenes)
+    g, tau, n_arms = arm_arrays(cols)
+    out = np.zeros((len(scenes), layout.N_OUT))
+    continuum_maxwell.maxwell_stick_batch(cols.dashpot_time / cols.T, g, tau, n_arms, cols.kappa,
+                                          cols.contact_mass_factor, cols.computes_tangential,
+                                          1e-12, 10_000_000, out)
+    assert (out[:, layout.OUT_STATUS] == layout.STATUS_OK).all()
+    return -out[:, layout.OUT_VZ_END], np.abs(out[:, layout.OUT_VC_END])
+
+
+@pytest.mark.parametrize("tolerance", [1e-4, 1e-5])
+def test_for_tolerance_reaches_its_target_on_the_element_path(tolerance):
+    """Standard solids with an arm faster than 1e-3 T run on elements; the error
+    model (ERROR_MODEL, fitted on other scenes: benchmarks/element_orders.py)
+    must give numerics that meet the tolerance against the exact continuum."""
+    specs = [(0.05, 0.1, 3e-4), (2.0, 0.45, 2e-4), (0.4, 0.35, 1e-3)]
+    scenes = [v.Scene.from_dimensionless(q1, nu, q2, theta_ratio=0.5) for q1, nu, q2 in specs]
+    got = v.simulate_batch(scenes, v.Numerics.for_tolerance(tolerance))
+    assert (got.status == "ok").all() and got.path.str.startswith("elements").all()
+    ez, ex = _continuum_kernel(scenes)
+    err = max(np.abs(got.e_z - ez).max(), np.abs(got.e_x - ex).max())
+    assert err <= tolerance, err

@@ -79,9 +79,11 @@ class Numerics:
         scenes against rtol 1e-13, tests/engine/test_tolerance.py); they cost
         microseconds to a fraction of a millisecond. The element path (friction,
         seed memory, stiff arms, hand-overs) gets steps and elements from the
-        error model measured by ``python -m benchmarks.accuracy``
-        (:data:`ERROR_MODEL`: an envelope ``a / steps^p + b / elements^q``),
-        half the tolerance to each knob, capped at :data:`MAX_STEPS` and
+        error model measured against the continuum kernel by ``python -m
+        benchmarks.element_orders`` (:data:`ERROR_MODEL`: an envelope ``a /
+        steps^p + b / elements^q``), half the tolerance to each knob, no coarser
+        than the model's measured grid (:data:`MIN_MODEL_STEPS`,
+        :data:`MIN_MODEL_ELEMENTS`) and capped at :data:`MAX_STEPS` and
         :data:`MAX_ELEMENTS`; a tolerance below what the capped element path
         reaches (:data:`ELEMENT_TOLERANCE_FLOOR`) is kept in ``tolerance`` and
         refused for the scenes that need elements (status
@@ -99,8 +101,9 @@ class Numerics:
         m = ERROR_MODEL
         steps = math.ceil((2.0 * m["a"] / tol) ** (1.0 / m["p"]))
         elements = math.ceil((2.0 * m["b"] / tol) ** (1.0 / m["q"]))
-        return cls(integrator=integrator, steps=int(min(max(steps, 100), MAX_STEPS)),
-                   elements=int(min(max(elements, 20), MAX_ELEMENTS)),
+        return cls(integrator=integrator,
+                   steps=int(min(max(steps, MIN_MODEL_STEPS), MAX_STEPS)),
+                   elements=int(min(max(elements, MIN_MODEL_ELEMENTS), MAX_ELEMENTS)),
                    rtol=min(max(tol * 1e-3, 1e-13), 1e-8), tolerance=tol)
 
     @property
@@ -110,10 +113,14 @@ class Numerics:
 
     @classmethod
     def preset(cls, name: str) -> "Numerics":
-        """Named settings (:data:`PRESETS`): ``fast`` (about 1e-3 on e_z, e_x),
-        ``default`` (about 1e-4), ``precise`` (1e-9 and better on the continuum
-        path; about 2e-6 on the element path, the best it verifiably reaches) and ``thesis`` (explicit Euler, 5000 steps per
-        t_H, 1000 elements across the contact diameter, as in the thesis)."""
+        """Named settings (:data:`PRESETS`): ``fast`` (3.6e-4 on e_z, e_x on the
+        element path), ``default`` (4.5e-5 there), ``precise`` (1e-9 and better
+        on the continuum paths; 3e-7 on the element path, the best it verifiably
+        reaches) and ``thesis`` (explicit Euler, 5000 steps per t_H, 1000
+        elements across the contact diameter, as in the thesis). The element
+        path figures are :data:`ERROR_MODEL` at the preset; measured largest
+        errors against the continuum kernel on its eight oblique scenes: 2.1e-4,
+        2.8e-5, 2.0e-7 (``python -m benchmarks.element_orders``)."""
         one_of("numerics preset", name, tuple(PRESETS))
         return PRESETS[name]
 
@@ -126,10 +133,18 @@ class Numerics:
         return INTEGRATORS[self.integrator]
 
 
-#: Error model of the Verlet element path, measured by ``benchmarks/accuracy.py``
-#: (an envelope bounding every measured setting over its 20 scenes, not a median
-#: fit): ``max(|e_z err|, |e_x err|) <= a / steps^p + b / elements^q``.
-ERROR_MODEL = {"a": 0.176, "p": 1.0, "b": 3.11, "q": 2.0}
+#: Error model of the Verlet element path: ``max(|e_z err|, |e_x err|) <= a /
+#: steps^p + b / elements^q``, the smallest envelope of this form over the errors
+#: against the continuum kernel (rtol 1e-12) of eight oblique scenes (Kelvin-Voigt
+#: Q1 0.01..5, standard solids with Q2 1e-3..10, nu 0..0.5) on the grid steps
+#: 250..4000 x elements 50..800 (``python -m benchmarks.element_orders``:
+#: ``error_model``; it bounds every point, at most 4.1 times the largest error
+#: measured at each). The element spacing dominates; the step error is second
+#: order but its largest values over the scenes fall like ``1 / steps`` on the grid.
+ERROR_MODEL = {"a": 0.0021, "p": 1.0, "b": 1.72, "q": 2.0}
+#: Coarsest settings :meth:`Numerics.for_tolerance` gives (the model's measured grid).
+MIN_MODEL_STEPS = 250
+MIN_MODEL_ELEMENTS = 50
 #: Caps of :meth:`Numerics.for_tolerance` on the element path (about 0.3 s per impact).
 MAX_STEPS = 16000
 #: Fewest time steps an impact's contact may span on the element path; a
@@ -142,7 +157,8 @@ MIN_CONTACT_STEPS = 20
 MAX_STEPS_PER_T_H = 1e7
 MAX_ELEMENTS_IN_ROW = 1e6
 MAX_ELEMENTS = 3200
-#: The smallest tolerance the element path verifiably reaches: the error model at the caps.
+#: The smallest tolerance the element path verifiably reaches: the error model at the
+#: caps (3.0e-7; the ``precise`` preset, these caps, measured 2.0e-7).
 ELEMENT_TOLERANCE_FLOOR = (ERROR_MODEL["a"] / MAX_STEPS ** ERROR_MODEL["p"]
                            + ERROR_MODEL["b"] / MAX_ELEMENTS ** ERROR_MODEL["q"])
 #: Largest accepted ``steps`` and ``elements`` settings (cost bounds).
@@ -150,9 +166,11 @@ MAX_SETTING = {"steps": 10_000_000, "elements": 1_000_000}
 
 PRESETS = {
     # chosen from the accuracy-versus-time front (benchmarks/results/accuracy.json)
-    "fast": Numerics(steps=500, elements=70),  # measured 3.1e-4 at 0.11 ms/impact
-    "default": Numerics(),  # 1400/200: measured 6.4e-5 at 0.56 ms/impact
-    # elements: the best the element path verifiably reaches (e_x ~2e-6, e_z ~1.4e-7);
+    # element path, largest error against the continuum kernel on the eight scenes of
+    # ERROR_MODEL (python -m benchmarks.element_orders):
+    "fast": Numerics(steps=500, elements=70),  # 2.1e-4 (model 3.6e-4)
+    "default": Numerics(),  # 1400/200: 2.8e-5 (model 4.5e-5)
+    # elements: the best the element path verifiably reaches (2.0e-7, model 3.0e-7);
     # continuum paths: rtol 1e-12 gives 1e-10 and better on beta_x (error up to ~125 rtol)
     "precise": Numerics(steps=16000, elements=3200, rtol=1e-12),
     "thesis": Numerics(integrator="euler", steps=5000, elements=500),
