@@ -37,6 +37,7 @@ BENCHMARKS: dict[str, str] = {
     "sweep_backends": "benchmarks.sweep_backends",
     "lookup": "benchmarks.lookup",
     "continuum_maxwell": "benchmarks.continuum_maxwell",
+    "element_orders": "benchmarks.element_orders",
 }
 
 
