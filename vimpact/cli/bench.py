@@ -69,9 +69,10 @@ def _cmd_bench(a) -> int:
 def _list() -> int:
     from vimpact.bench import BENCHMARKS, available, title
 
+    width = max(len(name) for name in BENCHMARKS)
     for name, module in BENCHMARKS.items():
         text = title(name) if available(name) else f"(needs {module}: run from a source checkout)"
-        print(f"{name:<12} {text}")
+        print(f"{name:<{width}}  {text}")
     return 0
 
 
