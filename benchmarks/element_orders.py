@@ -274,6 +274,26 @@ def plot(data: dict, path) -> None:
     save_figure(fig, path)
 
 
+
+def figures(data: dict) -> dict:
+    """Fitted observed orders (time-only and joint refinement, e_z and e_x) per case,
+    the element-count sweep's e_x jump, and each preset's max error on elements."""
+    from vimpact.bench.machine import figure
+
+    out = {}
+    for name, case in data["cases"].items():
+        after = case["after"]
+        for key in ("time_e_z_fitted_order", "time_e_x_fitted_order",
+                    "joint_e_z_fitted_order", "joint_e_x_fitted_order"):
+            if after.get(key) is not None:
+                out[f"{name}_{key}"] = figure(after[key], "-", better="higher", kind="accuracy")
+        if after.get("sweep_e_x_jump") is not None:
+            out[f"{name}_sweep_e_x_jump"] = figure(after["sweep_e_x_jump"], "-", kind="accuracy")
+    for preset, p in data.get("error_model", {}).get("presets", {}).items():
+        out[f"{preset}_max_error"] = figure(p["max_error"], "-", kind="accuracy")
+    return out
+
+
 def main(argv=None):
     from vimpact.bench import BENCHMARKS
 
