@@ -76,6 +76,32 @@ from vimpact.kernels.layout import (  # noqa: F401 - re-exported: the kernels' c
 
 
 @jit(inline="always")
+def _path_in_cone(L0, L1, C0, C1, alpha):
+    """Integral over ``t`` in ``[0, alpha]`` (in steps) of a sticking element's
+    tangential force on its way out: its stick path ``L0 + t (L1 - L0)``, clipped
+    to the cone ``|f_t| <= C0 + t (C1 - C0)``, which shrinks to 0 with the normal
+    force at ``t = alpha``. ``|L| - C`` is convex, so the element sticks on
+    ``[0, t*]`` and rides the cone (sign of ``L(alpha)``) down to 0 on
+    ``[t*, alpha]``. Without the clip a linear path to the cone's end value,
+    ``mu`` times a negative normal force, crosses it and, for ``mu v_z0 >> v_c0``,
+    pushes far beyond anything the element holds."""
+    if alpha <= 0.0:
+        return 0.0
+    dL = L1 - L0
+    La = L0 + alpha * dL
+    if La == 0.0:
+        return alpha * L0 + 0.5 * alpha * alpha * dL
+    sg = 1.0 if La > 0.0 else -1.0
+    dC = C1 - C0
+    if sg * L0 >= C0:
+        ts = 0.0
+    else:
+        ts = (C0 - sg * L0) / (sg * dL - dC)
+        ts = min(max(ts, 0.0), alpha)
+    return ts * L0 + 0.5 * ts * ts * dL + sg * 0.5 * (C0 + ts * dC) * (alpha - ts)
+
+
+@jit(inline="always")
 def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT, FRICTION,
             tau0, g, tau, kappa, mu_t, mu_k, h, n_elem, dxi, max_steps, rec, rec_every, out):
     """Advance one impact to its end and write the results into ``out``.
@@ -345,10 +371,14 @@ def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT, FRICTION,
                                     A_t = ftps[j] + (c0 + ca) * vc_test
                                 else:
                                     A_t = ftp[j] + c0 * vc_test
-                                if FRIC:  # the cone shrinks to 0 with the normal force
-                                    if mu_k < math.inf:
-                                        T1t = math.copysign(mu_k / kappa, T1t) * T1
-                            corr_t += (2.0 * alpha * T0t + alpha * alpha * (T1t - T0t) - A_t)
+                            if FRIC and sg == 0.0 and mu_k < math.inf:  # sticking: its
+                                # stick path inside the cone, which shrinks to 0 with
+                                # the normal force
+                                corr_t += 2.0 * _path_in_cone(
+                                    T0t, T1t, mu_k / kappa * T0, mu_k / kappa * T1, alpha) - A_t
+                            else:
+                                corr_t += (2.0 * alpha * T0t + alpha * alpha * (T1t - T0t)
+                                           - A_t)
                     else:
                         alpha = f[j] / (f[j] - fj)
                     t_leave = max(t_leave, (step + alpha) * h)

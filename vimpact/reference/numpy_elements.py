@@ -178,6 +178,25 @@ class Rheology:
 
 # ------------------------------------------------------------------ impact
 
+def stick_path_in_cone(L0, L1, C0, C1, alpha):
+    """Integral over ``t`` in ``[0, alpha]`` (fractions of the step) of a sticking
+    element's tangential force as it leaves: the stick path ``L0 + t (L1 - L0)``
+    clipped to the cone ``|f_t| <= C0 + t (C1 - C0)``, which reaches 0 with the
+    normal force at ``t = alpha``. ``|L| - C`` is convex: the element sticks up to
+    ``t*`` (where ``|L| = C``) and then follows the cone, with the sign of
+    ``L(alpha)``, down to 0. Arrays of one length; N s / h."""
+    L0, L1, C0, C1, alpha = np.broadcast_arrays(*(np.asarray(x, dtype=float)
+                                                  for x in (L0, L1, C0, C1, alpha)))
+    dL, dC = L1 - L0, C1 - C0
+    La = L0 + alpha * dL
+    sg = np.sign(La)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ts = np.where(sg * L0 >= C0, 0.0, (C0 - sg * L0) / (sg * dL - dC))
+    ts = np.where(sg == 0.0, alpha, np.clip(np.nan_to_num(ts, nan=0.0), 0.0, alpha))
+    out = ts * L0 + 0.5 * ts**2 * dL + sg * 0.5 * (C0 + ts * dC) * (alpha - ts)
+    return np.where(alpha > 0.0, out, 0.0)
+
+
 def naive_impact(scene, steps, elements, row_width=1.05, max_time=100.0, mu=None,
                  check_cone=True, flat_punch=None):
     """Simulate ``scene`` (a :class:`vimpact.Scene`) in SI units with the
@@ -381,8 +400,7 @@ def naive_impact(scene, steps, elements, row_width=1.05, max_time=100.0, mu=None
             p_l = advance_arms(p[left], s[left], s_l, arms_h)  # trial only, not kept
             T1t = c_t * weight * (rheo.spring_stress(s_l, p_l) + rheo.eta0 * v_c_end_step
                                   + arm_end * (v_c_end_step - v_c_half))
-            if friction:  # the cone shrinks to zero with the normal force
-                T1t = np.copysign(mu, T1t) * T1
+            trial_t = T1t
             sg = slip_sign[left]
             dash_t = c_t * weight * rheo.eta0
             T0t = ft_pos[left] + np.where(sg != 0.0, sg * mu * dash_z * v_z_start if friction
@@ -396,6 +414,9 @@ def naive_impact(scene, steps, elements, row_width=1.05, max_time=100.0, mu=None
             if friction:
                 T1t = np.where(sg != 0.0, sg * mu * T1, T1t)
             path = 2.0 * alpha * T0t + alpha**2 * (T1t - T0t) - A_t
+            if friction:  # sticking: the stick path inside the cone, which shrinks to 0
+                path = np.where(sg == 0.0, 2.0 * stick_path_in_cone(  # with the normal force
+                    T0t, trial_t, mu * T0, mu * T1, alpha) - A_t, path)
             if not weighted:  # slipping: mu times the normal force, not corrected
                 path = np.where(sg != 0.0, 0.0, path)
             corr_x += float(path.sum())
