@@ -317,3 +317,18 @@ def test_friction_at_a_small_contact_point_speed_tends_to_full_stick():
         gaps.append(abs(res.beta_x[0] - res.beta_x[1]))
     assert all(a > b for a, b in zip(gaps, gaps[1:]))  # monotone towards stick
     assert gaps[-1] < 1e-6
+
+
+@pytest.mark.parametrize("mu", [1e20, 1e50, 1e300])
+def test_an_enormous_friction_coefficient_is_full_stick(mu):
+    """mu so large that psi < 1e-12: friction would move beta_x by ~psi/4, below
+    rounding, while mu v_z0 / |v_c0| only feeds round-off (mu = 1e50 ended as
+    unstable, NaN). Such a row is full stick, on the stick path, with the mu = inf
+    numbers exactly; explain says why."""
+    rows = pd.DataFrame([{**FRICTION, "v_x0_m_s": 0.5, "mu": m} for m in (mu, math.inf)])
+    res = v.simulate_batch(rows, FAST)
+    assert (res.status == "ok").all() and res.path[0] == res.path[1]
+    assert res.beta_x[0] == res.beta_x[1] and res.e_z[0] == res.e_z[1]
+    scene = v.Scene(material=v.Material.kelvin_voigt(nu=0.3, G=3.8e8, eta=10.0), R=0.01,
+                    m=0.004, v_z0=1.0, v_x0=0.5, mu=mu)
+    assert "psi is below 1e-12" in v.choose_path(scene, FAST).explain()

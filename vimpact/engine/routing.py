@@ -36,6 +36,21 @@ ELEMENTS = "elements"
 #: element path (exact arm update) takes the scene instead.
 STIFF_ARM_TIME = 1e-3
 
+#: Below this incidence psi = 2 (1 - nu) / (mu (2 - nu)) |v_c0| / v_z0 a finite mu is
+#: full stick to rounding: friction moves beta_x by about psi / 4 (measured: 1.0e-4,
+#: 3.6e-6 and 7e-13 at psi = 2.7e-4, 2.7e-6 and 2.7e-12), and mu v_z0 / |v_c0| beyond
+#: ~1e12 only feeds round-off (mu = 1e50 gave NaN); such rows run the stick kernels.
+PSI_FULL_STICK = 1e-12
+
+
+def friction_rows(cols: SceneColumns) -> np.ndarray:
+    """Rows whose Coulomb friction the kernels must model: a tangential problem, a
+    finite ``mu`` and an incidence ``psi`` of at least :data:`PSI_FULL_STICK`."""
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        psi = (2.0 * (1.0 - cols.nu) / (cols.mu * (2.0 - cols.nu))
+               * np.abs(cols.v_c0) / cols.v_z0)
+    return cols.computes_tangential & np.isfinite(cols.mu) & (psi >= PSI_FULL_STICK)
+
 
 @dataclass(frozen=True)
 class Path:
@@ -79,9 +94,6 @@ class Path:
 
 _INTEGRATOR_NAMES = {code: name for name, code in INTEGRATORS.items()}
 
-
-_INTEGRATOR_NAMES = {code: name for name, code in INTEGRATORS.items()}
-
 #: path of the Kelvin-Voigt/elastic normal-only continuum kernel
 CONTINUUM_KV = Path(CONTINUUM, None, ())
 #: path of the full-stick continuum kernel (every rheology, docs/physics.md#continuum-limit)
@@ -108,7 +120,7 @@ def route(cols: SceneColumns, numerics: Numerics) -> Routes:
     tangential = cols.computes_tangential & valid
     arms = cols.has_arms
     dashpot = cols.eta0 > 0.0
-    friction = tangential & np.isfinite(cols.mu)
+    friction = tangential & friction_rows(cols)
     memory = np.where(tangential, cols.memory, 0)
     continuum = ~arms & ~tangential & numerics.continuum
     stick = continuum_stick(cols, numerics) & ~continuum
@@ -140,7 +152,7 @@ def continuum_stick(cols: SceneColumns, numerics: Numerics) -> np.ndarray:
     :data:`STIFF_ARM_TIME` T. Its run-time assumptions (one contact interval, no
     re-entry) are checked by the kernel, which hands a row back otherwise."""
     tangential = cols.computes_tangential
-    friction = tangential & np.isfinite(cols.mu)
+    friction = friction_rows(cols)
     incremental = cols.memory == TANGENTIAL_MEMORY.index("incremental")
     real = cols.G_arm > 0.0
     fast_arm = (real & (cols.tau_arm < STIFF_ARM_TIME * cols.T[:, None])).any(axis=1)
@@ -174,6 +186,9 @@ def choose_path(scene: Scene, numerics: Numerics) -> Path:
                else "without rotation (Theta -> inf)")
         contact = ("full stick" if path.spec is None or not path.spec.friction
                    else f"Coulomb friction mu = {scene.mu:g}")
+        if np.isfinite(scene.mu) and not friction_rows(cols)[0]:
+            contact = (f"full stick (mu = {scene.mu:g}, but the incidence psi is below "
+                       f"{PSI_FULL_STICK:g}: friction changes beta_x by less than rounding)")
         reasons.append(f"tangential {contact}, {scene.tangential_memory} memory, {rot}")
         if mat.nu != 0.5:
             reasons.append(f"nu = {mat.nu:g}: the tangential MDR mapping is exact only at "
@@ -194,7 +209,7 @@ def choose_path(scene: Scene, numerics: Numerics) -> Path:
                        "re-enter, the element kernel takes over")
         return Path(CONTINUUM_STICK, None, tuple(reasons))
     if numerics.continuum and (arms or tangential):
-        if tangential and np.isfinite(scene.mu):
+        if path.spec is not None and path.spec.friction:
             reasons.append("Coulomb friction (slip) needs the element row")
         elif tangential and scene.tangential_memory != "incremental":
             reasons.append("seed tangential memory needs the element row")
