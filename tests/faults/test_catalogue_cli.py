@@ -221,14 +221,14 @@ def test_sweep_spec_missing(tmp_path, capsys):
 
 
 #: Other subcommands (table validation is tests/lookup's): what the line must name.
-#: plot names its options without the dashes ("out = 'x.txt'"): the value is checked here.
 OTHER_ERRORS = [
     ("plot-unknown-figure", ["plot", "fig9", "--out", "x.png"], ["'fig9'"]),
-    ("plot-out-txt", ["plot", "fig3_2", "--out", "x.txt"], ["'x.txt'", ".png"]),
-    ("plot-out-no-folder", ["plot", "fig3_2", "--out", "no/such/x.png"], ["'no/such/x.png'"]),
+    ("plot-out-txt", ["plot", "fig3_2", "--out", "x.txt"], ["--out = 'x.txt'", ".png"]),
+    ("plot-out-no-folder", ["plot", "fig3_2", "--out", "no/such/x.png"],
+     ["--out = 'no/such/x.png'"]),
     ("plot-table-needed", ["plot", "fig5_1", "--out", "x.png"], ["--table"]),
     ("plot-table-missing", ["plot", "fig5_1", "--out", "x.png", "--table", "none.parquet"],
-     ["'none.parquet'"]),
+     ["--table = 'none.parquet'"]),
     ("dem-file-missing", ["dem", "none.toml", "--for", "lammps"], ["none.toml"]),
     ("dem-code-unknown", ["dem", "none.toml", "--for", "gromacs"], ["--for", "gromacs"]),
     ("bench-unknown", ["bench", "nosuch"], ["'nosuch'"]),

@@ -34,6 +34,13 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 def _cmd_plot(a) -> int:
     from vimpact.plots.figures import plot_figure
 
-    path = plot_figure(a.name, a.out, table=a.table)
+    try:
+        path = plot_figure(a.name, a.out, table=a.table)
+    except ValueError as exc:  # name the options as typed, not the API's arguments
+        text = str(exc)
+        for api, flag in (("out = ", "--out = "), ("table = ", "--table = ")):
+            if text.startswith(api):
+                raise ValueError(flag + text[len(api):]) from None
+        raise
     print(f"wrote {path}")
     return 0
