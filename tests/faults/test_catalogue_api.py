@@ -321,7 +321,7 @@ def test_friction_at_a_small_contact_point_speed_tends_to_full_stick():
 
 @pytest.mark.parametrize("mu", [1e20, 1e50, 1e300])
 def test_an_enormous_friction_coefficient_is_full_stick(mu):
-    """mu so large that psi < 1e-12: friction would move beta_x by ~psi/4, below
+    """mu so large that psi < 1e-12: friction would move beta_x by at most ~psi, below
     rounding, while mu v_z0 / |v_c0| only feeds round-off (mu = 1e50 ended as
     unstable, NaN). Such a row is full stick, on the stick path, with the mu = inf
     numbers exactly; explain says why."""

@@ -37,9 +37,10 @@ ELEMENTS = "elements"
 STIFF_ARM_TIME = 1e-3
 
 #: Below this incidence psi = 2 (1 - nu) / (mu (2 - nu)) |v_c0| / v_z0 a finite mu is
-#: full stick to rounding: friction moves beta_x by about psi / 4 (measured: 1.0e-4,
-#: 3.6e-6 and 7e-13 at psi = 2.7e-4, 2.7e-6 and 2.7e-12), and mu v_z0 / |v_c0| beyond
-#: ~1e12 only feeds round-off (mu = 1e50 gave NaN); such rows run the stick kernels.
+#: full stick to rounding: friction moves beta_x by at most about psi (measured on a
+#: Kelvin-Voigt scene: 1.0e-4, 3.6e-6, 7e-8 and 7e-13 at psi = 2.7e-4, 2.7e-6, 2.7e-7
+#: and 2.7e-12), and mu v_z0 / |v_c0| beyond ~1e12 only feeds round-off (mu = 1e50
+#: gave NaN); such rows run the stick kernels.
 PSI_FULL_STICK = 1e-12
 
 
