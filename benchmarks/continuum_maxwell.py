@@ -30,10 +30,7 @@ Writes ``continuum_maxwell[_quick].json`` and a PNG of error versus time.
 
 from __future__ import annotations
 
-import importlib.util
-import subprocess
 import sys
-import tempfile
 import time
 from pathlib import Path
 
@@ -42,7 +39,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from benchmarks.machine import (bench_main, figure, load_average,  # noqa: E402
+from benchmarks.machine import (bench_main, figure, load_average, module_at_commit,  # noqa: E402
                                 machine_info, repository_main, save_figure, use_agg)
 
 TITLE = "Continuum full-stick kernel: time per impact to 1e-6/1e-8/1e-10, before vs after"
@@ -74,24 +71,9 @@ def _kappa(nu):
 
 def kernel_before():
     """The batch kernel as of :data:`BEFORE_COMMIT`, or ``None`` without git
-    (not a source checkout). The module is written under the temporary folder
-    with a stable name, so that numba's cache beside it survives the run."""
-    try:
-        src = subprocess.run(["git", "show", f"{BEFORE_COMMIT}:{KERNEL_PATH}"], cwd=ROOT,
-                             capture_output=True, text=True, check=True).stdout
-    except (OSError, subprocess.CalledProcessError):
-        return None
-    folder = Path(tempfile.gettempdir()) / "vimpact_bench_before"
-    folder.mkdir(exist_ok=True)
-    name = f"continuum_maxwell_{BEFORE_COMMIT[:10]}"
-    path = folder / f"{name}.py"
-    if not path.exists() or path.read_text() != src:
-        path.write_text(src)
-    spec = importlib.util.spec_from_file_location(name, path)
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[name] = module  # numba's cache finds the module again by name
-    spec.loader.exec_module(module)
-    return module.maxwell_stick_batch
+    (not a source checkout)."""
+    module = module_at_commit(BEFORE_COMMIT, KERNEL_PATH)
+    return None if module is None else module.maxwell_stick_batch
 
 
 def _reach(per: list[dict], key: str) -> dict:

@@ -22,17 +22,12 @@ continuum kernel (:mod:`vimpact.kernels.continuum_maxwell`, rtol 1e-12: about
 
 from __future__ import annotations
 
-import importlib.util
 import math
-import subprocess
-import sys
-import tempfile
 import time
-from pathlib import Path
 
 import numpy as np
 
-from benchmarks.machine import bench_main, machine_info, save_figure
+from benchmarks.machine import bench_main, machine_info, module_at_commit, save_figure
 from vimpact.kernels.elements import (N_OUT, N_REC, OUT_STATUS, OUT_VC_END, OUT_VZ_END,
                                       STATUS_OK, VERLET, KernelSpec, element_kernel)
 
@@ -80,19 +75,8 @@ def continuum(tau0=0.0, g=(), tau=(), nu=NU, theta_ratio=THETA_RATIO) -> tuple[f
 
 def old_kernel():
     """``element_kernel`` of commit BEFORE, or None without git."""
-    root = Path(__file__).resolve().parent.parent
-    try:
-        src = subprocess.run(["git", "show", f"{BEFORE}:vimpact/kernels/elements.py"], cwd=root,
-                             capture_output=True, text=True, check=True).stdout
-    except (OSError, subprocess.CalledProcessError):
-        return None
-    path = Path(tempfile.mkdtemp()) / "elements_before.py"
-    path.write_text(src)
-    spec = importlib.util.spec_from_file_location("elements_before", path)
-    mod = importlib.util.module_from_spec(spec)
-    sys.modules["elements_before"] = mod
-    spec.loader.exec_module(mod)
-    return mod.element_kernel
+    module = module_at_commit(BEFORE, "vimpact/kernels/elements.py")
+    return None if module is None else module.element_kernel
 
 
 def orders(err):
