@@ -17,6 +17,7 @@ import vimpact as v
 from vimpact import cli
 from vimpact.sweep import load_spec, parts_dir, read_metadata, run_sweep, runner, store
 from vimpact.sweep.parameters import chunk_parameters
+from tests.sweep import write
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -49,12 +50,6 @@ Q1 = { start = 0.01, stop = 1.0, num = 4 }
 Q2 = [0.1, 10.0]
 nu = [0.0, 0.5]
 """
-
-
-def write(tmp_path, text, name="spec.toml"):
-    path = tmp_path / name
-    path.write_text(text)
-    return path
 
 
 @pytest.fixture(scope="module")

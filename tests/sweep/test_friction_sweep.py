@@ -11,6 +11,7 @@ import pytest
 import vimpact as v
 from vimpact.sweep import load_spec, run_sweep
 from vimpact.sweep.parameters import engine_columns
+from tests.sweep import write
 
 SWEEPS = Path(__file__).resolve().parents[2] / "sweeps"
 EXAMPLE = SWEEPS / "friction_psi.toml"
@@ -34,12 +35,6 @@ angle_deg = [0.0, 80.0]
 mu = { choice = [0.0, 0.25, "inf"] }
 omega0_rad_s = [-30.0, 30.0]
 """
-
-
-def write(tmp_path, text, name="spec.toml"):
-    path = tmp_path / name
-    path.write_text(text)
-    return path
 
 
 def stick_version(text: str) -> str:

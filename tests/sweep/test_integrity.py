@@ -22,7 +22,7 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 import pytest
 
-from tests.sweep import faults
+from tests.sweep import faults, write
 from vimpact import cli
 from vimpact.model.validation import InputError
 from vimpact.sweep import parts_dir, run_sweep, store
@@ -41,12 +41,6 @@ elements = 20
 Q1 = [0.01, 0.1, 1.0]
 nu = [0.3, 0.5]
 """
-
-
-def write(tmp_path, text, name="spec.toml"):
-    path = tmp_path / name
-    path.write_text(text)
-    return path
 
 
 @pytest.fixture(scope="module")

@@ -13,6 +13,7 @@ import vimpact as v
 from vimpact import cli
 from vimpact.sweep import runner, spec as sweep
 from vimpact.sweep import SweepInterrupted, load_spec, parts_dir, read_metadata, run_sweep
+from tests.sweep import write
 
 SWEEPS = Path(__file__).resolve().parents[2] / "sweeps"
 TINY = v.Numerics(steps=100, elements=20)
@@ -45,12 +46,6 @@ Q1 = { start = 0.01, stop = 1.0, per_decade = 1 }
 Q2 = [0.1, 10.0]
 nu = [0.0, 0.5]
 """
-
-
-def write(tmp_path, text, name="spec.toml"):
-    path = tmp_path / name
-    path.write_text(text)
-    return path
 
 
 def finished_rows_have_no_nan(df):
