@@ -124,7 +124,7 @@ def route(cols: SceneColumns, numerics: Numerics) -> Routes:
     friction = tangential & friction_rows(cols)
     memory = np.where(tangential, cols.memory, 0)
     continuum = ~arms & ~tangential & numerics.continuum
-    stick = continuum_stick(cols, numerics) & ~continuum
+    stick = continuum_stick(cols, numerics, friction) & ~continuum
     kind = np.where(continuum, 1, np.where(stick, 2, 0))
     key = (kind.astype(np.int64) << 5 | tangential << 4 | memory << 3 | arms << 2
            | dashpot << 1 | friction)
@@ -147,13 +147,13 @@ def route(cols: SceneColumns, numerics: Numerics) -> Routes:
     return Routes(group, tuple(paths))
 
 
-def continuum_stick(cols: SceneColumns, numerics: Numerics) -> np.ndarray:
+def continuum_stick(cols: SceneColumns, numerics: Numerics, friction: np.ndarray) -> np.ndarray:
     """Rows the full-stick continuum kernel can take: continuum allowed, no
-    friction, incremental memory (or no tangential problem), no arm faster than
+    friction (``friction``: :func:`friction_rows`, as :func:`route` has it),
+    incremental memory (or no tangential problem), no arm faster than
     :data:`STIFF_ARM_TIME` T. Its run-time assumptions (one contact interval, no
     re-entry) are checked by the kernel, which hands a row back otherwise."""
     tangential = cols.computes_tangential
-    friction = friction_rows(cols)
     incremental = cols.memory == TANGENTIAL_MEMORY.index("incremental")
     real = cols.G_arm > 0.0
     fast_arm = (real & (cols.tau_arm < STIFF_ARM_TIME * cols.T[:, None])).any(axis=1)
