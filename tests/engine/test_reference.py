@@ -133,8 +133,16 @@ def test_naive_uses_physics_hertz_scales():
         assert_close("hertz t_H", hz.t_H, HERTZ_TIME * T, 1e-10)
 
 
-@pytest.mark.parametrize("memory", ["incremental", "seed"])
-@pytest.mark.parametrize("rheology", RHEOLOGIES)
+#: (rheology, memory) pairs whose kernel no other test of the default run compiles:
+#: the seed memory with a dashpot (Kelvin-Voigt; Prony draws one in half its scenes),
+#: about 80 s of compiling on a fresh clone. The seed memory stays checked against the
+#: reference in the default run on the elastic and standard-solid (arms) kernels.
+SLOW_PAIRS = {("kelvin_voigt", "seed"), ("prony", "seed")}
+
+
+@pytest.mark.parametrize("rheology, memory", [
+    pytest.param(r, m, id=f"{r}-{m}", marks=[pytest.mark.slow] if (r, m) in SLOW_PAIRS else [])
+    for m in ("incremental", "seed") for r in RHEOLOGIES])
 def test_kernel_matches_naive(rheology, memory):
     rng = np.random.default_rng([11, RHEOLOGIES.index(rheology), memory == "seed"])
     for _ in range(4):
@@ -144,9 +152,11 @@ def test_kernel_matches_naive(rheology, memory):
 
 
 def test_batch_with_mixed_arm_counts_matches_naive():
-    """``simulate_batch`` pads the arm arrays of a mixed batch (0, 1, 2 arms)."""
+    """``simulate_batch`` pads the arm arrays of a mixed batch (0, 1, 2 arms) and
+    groups its rows by kernel (both memories; the seed memory without a dashpot,
+    see :data:`SLOW_PAIRS`)."""
     rng = np.random.default_rng(23)
-    scenes = [random_scene(rng, RHEOLOGIES[i % 4], ("incremental", "seed")[i // 4 % 2])
+    scenes = [random_scene(rng, RHEOLOGIES[i % 4], "seed" if i in (4, 6) else "incremental")
               for i in range(8)]
     table = simulate_batch(scenes, NUM)
     for scene, (_, row) in zip(scenes, table.iterrows()):
