@@ -71,6 +71,16 @@ def test_every_setting_ran_on_the_element_path(data):
             assert r["error"] == max(r["e_z_error_max"], r["e_x_error_max"])
             assert r["e_z_error_median"] <= r["e_z_error_max"]
             assert r["seconds_per_impact"] > 0
+    # presets and for_tolerance: on the element path, as the settings
+    for r in list(data["presets"].values()) + data["for_tolerance"]:
+        assert all(p.startswith("elements[") for p in r["paths"]) and r["failed"] == 0
+        assert sum(r["rows_per_path"].values()) == len(data["scenes"])
+    assert set(data["presets_as_routed"]) == set(v.PRESETS)
+    scan = data["for_tolerance_scan"]
+    for r in scan["rows"]:
+        assert r["error"] == max(r["e_z_error_max"], r["e_x_error_max"])
+        assert r["met"] == (r["error_over_tolerance"] <= 1.0)
+    assert scan["missed"] == sum(not r["met"] for r in scan["rows"])
     for c in data["continuum"]:
         assert c["failed"] == 0 and all(p.startswith("continuum") for p in c["paths"])
     # the continuum path is accurate at a tight rtol
