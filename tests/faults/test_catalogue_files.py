@@ -216,6 +216,8 @@ SPEC_ERRORS = [
     ("grid-Q1-too-many-points", {}, {"Q1": "{ start = 0.1, stop = 1e300, per_decade = 1e6 }"},
      True, ["grid.Q1", "points"]),
     ("grid-Q2-zero", {}, {"Q2": "0"}, True, ["grid.Q2 = 0"]),
+    # G2 = G1 / Q2 overflows: refused at load time, not as rows with G2 = inf
+    ("grid-Q2-1e-300", {}, {"Q2": "[1.0, 1e-300]"}, True, ["grid.Q2 = 1e-300", "G2"]),
     ("grid-nu-0.7", {}, {"nu": "0.7"}, True, ["grid.nu = 0.7"]),
     ("grid-tolerance-1", {}, {"tolerance": "1"}, True, ["grid.tolerance = 1"]),
 ]

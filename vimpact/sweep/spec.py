@@ -722,6 +722,13 @@ def _grid(spec: TomlSource, model: str, table) -> tuple[dict[str, np.ndarray], f
         for x in values:
             if not (math.isfinite(x) and check(x)):
                 raise spec.bad(f"grid.{key}", float(x), allowed)
+            if key == "Q2":  # the grid's rows are Scene.from_dimensionless scenes: its own
+                # rule on Q2 (G2 = G1 / Q2 finite; nu = 0 has the largest G1), at load time
+                try:
+                    Scene.from_dimensionless(0.0, 0.0, float(x))
+                except ValueError as e:
+                    raise spec.bad(f"grid.{key}", float(x),
+                                   str(e).split("must be ", 1)[-1]) from None
         axes[key] = values
     return axes, tolerance, mu
 
