@@ -119,3 +119,15 @@ def test_a_negative_value_is_read_as_a_value_and_refused_by_name(capsys):
                  "--vz0", "1"])
     err = capsys.readouterr().err
     assert code == 2 and err.count("\n") == 1 and err.startswith("vimpact simulate: error: --E = ")
+
+
+def test_building_the_parser_loads_neither_numba_nor_pandas():
+    """``vimpact --help`` and every bad-flag exit only build the parser: they must not
+    pay for numba (about 0.9 s) or pandas (about 1.5 s), which the subcommands load
+    when they run."""
+    code = ("import importlib, sys; importlib.import_module('vimpact.cli.main').build_parser(); "
+            "print(sorted({m.split('.')[0] for m in sys.modules} & "
+            "{'numba', 'pandas', 'pyarrow', 'matplotlib', 'scipy', 'dask'}))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True).stdout
+    assert out.strip() == "[]", out

@@ -9,11 +9,11 @@ import textwrap
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
     """Register ``vimpact plot NAME --out FILE [--table TABLE]`` on ``subparsers``."""
-    from vimpact.plots.figures import FIGURES
+    from vimpact.plots.catalogue import CATALOGUE  # titles only: no drawing code yet
 
-    lines = [f"  {name:<7} {fig.title}" + (f"\n          (needs --table, made by {fig.spec})"
-                                            if fig.spec else "")
-             for name, fig in FIGURES.items()]
+    lines = [f"  {name:<7} {title}" + (f"\n          (needs --table, made by {spec})"
+                                       if spec else "")
+             for name, (title, spec) in CATALOGUE.items()]
     plot = subparsers.add_parser(
         "plot", help="redraw a thesis figure from our own runs or tables",
         formatter_class=argparse.RawDescriptionHelpFormatter,

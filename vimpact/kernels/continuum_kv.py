@@ -92,8 +92,8 @@ from vimpact.kernels.layout import (
     STATUS_NON_FINITE,
     STATUS_OK,
     STATUS_TIME_LIMIT,
-    _record,
 )
+from vimpact.kernels.record import _record
 
 __all__ = [
     "ATOL_PER_RTOL",

@@ -131,7 +131,8 @@ from vimpact.kernels.jit import jit
 from vimpact.kernels.layout import (
     ELEMENT_STIFFNESS, N_REC, OUT_B_MAX, OUT_N_REC, OUT_STATUS, OUT_STEPS, OUT_T_CONTACT,
     OUT_T_GROSS_SLIP, OUT_U_MAX, OUT_VC_END, OUT_VZ_END, OUT_W_FRICTION, STATUS_ASSUMPTION,
-    STATUS_NON_FINITE, STATUS_OK, STATUS_TIME_LIMIT, _record)
+    STATUS_NON_FINITE, STATUS_OK, STATUS_TIME_LIMIT)
+from vimpact.kernels.record import _record
 
 __all__ = ["maxwell_stick_impact", "maxwell_stick_batch", "GN"]
 

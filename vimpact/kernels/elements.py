@@ -71,7 +71,8 @@ from vimpact.kernels.layout import (  # noqa: F401 - re-exported: the kernels' c
     ELEMENT_STIFFNESS, EULER, N_OUT, N_REC, OUT_B_MAX, OUT_N_REC, OUT_STATUS, OUT_STEPS,
     OUT_T_CONTACT, OUT_T_GROSS_SLIP, OUT_U_MAX, OUT_VC_END, OUT_VZ_END, OUT_W_FRICTION, REC_B,
     REC_FX, REC_FZ, REC_SLIP, REC_T, REC_U, REC_V, REC_VC, STATUS_NON_FINITE, STATUS_OK, STATUS_ROW_EXCEEDED, STATUS_TIME_LIMIT, SYMPLECTIC_EULER,
-    VERLET, _record)
+    VERLET)
+from vimpact.kernels.record import _record
 
 
 

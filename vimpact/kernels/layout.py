@@ -1,13 +1,13 @@
 """Layouts shared by every kernel: integrator codes, status codes, the columns
-of the per-impact output row and of a trajectory record, and the record writer.
+of the per-impact output row and of a trajectory record.
 
 Kernel units are described in :mod:`vimpact.kernels.elements`. Everything here
-is plain numbers and one ``@jit`` helper; nothing imports the API side.
+is plain numbers (no numba: the command line's parser and the value objects
+read these codes without loading numba); the record writer is
+:func:`vimpact.kernels.record._record`. Nothing imports the API side.
 """
 
 from __future__ import annotations
-
-from vimpact.kernels.jit import jit
 
 EULER = 0
 SYMPLECTIC_EULER = 1
@@ -48,20 +48,3 @@ N_REC = 8
 
 #: Element stiffness per unit length in kernel units (both halves of the row counted by the caller).
 ELEMENT_STIFFNESS = 15.0 / 16.0
-
-
-@jit()
-def _record(rec, i, t, u, v, vc, Fz, Fx, b):
-    """Write one trajectory row if there is room; return the next row index."""
-    if i >= rec.shape[0]:
-        return i
-    rec[i, REC_T] = t
-    rec[i, REC_U] = u
-    rec[i, REC_V] = v
-    rec[i, REC_VC] = vc
-    rec[i, REC_FZ] = Fz
-    rec[i, REC_FX] = Fx
-    rec[i, REC_B] = b
-    return i + 1
-
-

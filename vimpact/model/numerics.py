@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, replace
 
-from vimpact.kernels.elements import EULER, SYMPLECTIC_EULER, VERLET
+from vimpact.kernels.layout import EULER, SYMPLECTIC_EULER, VERLET
 from vimpact.model.validation import one_of, positive, require
 
 #: Integrators by name (see :mod:`vimpact.kernels.elements`) and their nominal order.

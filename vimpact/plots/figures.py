@@ -25,6 +25,7 @@ import numpy as np
 import pandas as pd
 
 from vimpact.model.material import Material
+from vimpact.plots.catalogue import CATALOGUE, FIGURE_NAMES, figure_name  # noqa: F401 - re-exported
 from vimpact.model.numerics import Numerics
 from vimpact.model.scene import Scene
 from vimpact.engine.simulate import simulate, simulate_batch
@@ -475,43 +476,17 @@ def _friction(name: str) -> Callable:
     return draw
 
 
-FIGURES: dict[str, Figure] = {
-    "fig3_2": Figure(fig3_2, "linear model: e and omega0 t* over zeta", None),
-    "fig4_2": Figure(fig4_2, "v_z, v_x, omega during one impact", None),
-    "fig4_4": Figure(fig4_4, "explicit Euler phase plane vs. exact elastic curve", None),
-    "fig5_1": Figure(fig5_1, "e_z, e_x over Q1, random physical draws", "sweeps/fig5_1_kelvin_voigt_random.toml"),
-    "fig5_2": Figure(fig5_2, "e_z over Q1, Kelvin-Voigt, with linear model and continuum",
-                     "sweeps/fig5_2_3_kelvin_voigt_nu.toml"),
-    "fig5_3": Figure(fig5_3, "e_x over Q1, Kelvin-Voigt, nu = 0, 0.25, 0.5",
-                     "sweeps/fig5_2_3_kelvin_voigt_nu.toml"),
-    "fig5_4": Figure(fig5_4, "e_z over Q1, standard solid, family of Q2",
-                     "sweeps/fig5_4_5_standard_solid_q2.toml (+ sweeps/fig5_4_5_kelvin_voigt.toml)"),
-    "fig5_5": Figure(fig5_5, "e_x over Q1, standard solid, family of Q2",
-                     "sweeps/fig5_4_5_standard_solid_q2.toml (+ sweeps/fig5_4_5_kelvin_voigt.toml)"),
-    "fig_mbf": Figure(_friction("fig_mbf"), "friction: exit psi2 over incidence psi1, elastic "
-                      "sphere, several chi (Maw, Barber and Fawcett)", None),
-    "fig_beta_psi": Figure(_friction("fig_beta_psi"), "friction: beta_x over psi for several Q1",
-                           None),
-    "fig_chung_ooi": Figure(_friction("fig_chung_ooi"), "friction: rebound angle and spin over "
-                            "the impact angle (Chung and Ooi 2011, test 4)", None),
+#: drawing function of each figure of :data:`vimpact.plots.catalogue.CATALOGUE`
+_DRAW: dict[str, Callable] = {
+    "fig3_2": fig3_2, "fig4_2": fig4_2, "fig4_4": fig4_4, "fig5_1": fig5_1, "fig5_2": fig5_2,
+    "fig5_3": fig5_3, "fig5_4": fig5_4, "fig5_5": fig5_5,
+    "fig_mbf": _friction("fig_mbf"), "fig_beta_psi": _friction("fig_beta_psi"),
+    "fig_chung_ooi": _friction("fig_chung_ooi"),
 }
-
-#: Names accepted by :func:`plot_figure` (also ``"5.2"``, ``"fig5.2"``, ``"fig5_2"``).
-FIGURE_NAMES = tuple(FIGURES)
-
-
-def figure_name(name: str) -> str:
-    """Canonical figure name: ``"5.2"``, ``"fig5.2"``, ``"Fig 5-2"`` -> ``"fig5_2"``."""
-    key = str(name).strip().lower().replace(" ", "")
-    for prefix in ("figure", "fig"):
-        if key.startswith(prefix):
-            key = key[len(prefix):]
-            break
-    key = "fig" + key.replace(".", "_").replace("-", "_")
-    if key not in FIGURES:
-        raise ValueError(f"figure = {name!r} is not allowed: must be one of "
-                         + ", ".join(FIGURE_NAMES))
-    return key
+if set(_DRAW) != set(CATALOGUE):  # the catalogue (titles, specs) and the drawings agree
+    raise ImportError(f"figures without a drawing or a catalogue entry: "
+                      f"{sorted(set(_DRAW) ^ set(CATALOGUE))}")
+FIGURES: dict[str, Figure] = {name: Figure(_DRAW[name], *CATALOGUE[name]) for name in CATALOGUE}
 
 
 def plot_figure(name: str, out, table=None) -> Path:
