@@ -75,6 +75,7 @@ def test_every_setting_ran_on_the_element_path(data):
     for r in list(data["presets"].values()) + data["for_tolerance"]:
         assert all(p.startswith("elements[") for p in r["paths"]) and r["failed"] == 0
         assert sum(r["rows_per_path"].values()) == len(data["scenes"])
+        assert max(r["error_by_path"].values()) == r["error"]
     assert set(data["presets_as_routed"]) == set(v.PRESETS)
     scan = data["for_tolerance_scan"]
     for r in scan["rows"]:

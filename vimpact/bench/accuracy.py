@@ -529,6 +529,8 @@ def evaluate(scenes, numerics, ref, timer: Timer) -> dict:
         "max_energy_gain_of_unstable_rows": gain,
         "paths": sorted(set(df.path)),
         "rows_per_path": {str(k): int(c) for k, c in df.path.value_counts().sort_index().items()},
+        "error_by_path": {str(k): _f(np.maximum(dz, dx)[(df.path == k).to_numpy()].max())
+                          for k in sorted(set(df.path))},
     })
     return row
 
