@@ -48,3 +48,14 @@ N_REC = 8
 
 #: Element stiffness per unit length in kernel units (both halves of the row counted by the caller).
 ELEMENT_STIFFNESS = 15.0 / 16.0
+
+
+def __getattr__(name: str):
+    """``_record`` moved to :mod:`vimpact.kernels.record`; kernels of earlier commits
+    (the before/after benchmarks compile them from ``git show``) still import it
+    from here, which loads numba only then."""
+    if name == "_record":
+        from vimpact.kernels.record import _record
+
+        return _record
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
