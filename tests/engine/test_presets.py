@@ -41,7 +41,7 @@ def exact():
                                     pytest.param("precise", marks=pytest.mark.slow)])
 def test_element_path_meets_the_error_model(exact, preset):
     """e_z and e_x of the element path within the error model's bound at the
-    preset (fast 3.6e-4, default 4.5e-5, precise 3.0e-7)."""
+    preset (fast 2.3e-4, default 3.1e-5, precise 4.9e-7)."""
     numerics = v.Numerics.preset(preset).with_(continuum=False)
     df = v.simulate_batch(SCENES, numerics)
     assert (df.status == "ok").all() and df.path.str.startswith("elements").all()
