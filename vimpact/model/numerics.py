@@ -122,8 +122,9 @@ class Numerics:
         element path), ``default`` (3.1e-5 there), ``precise`` (1e-9 and better
         on the continuum paths; 4.9e-7 on the element path at its caps, the best
         it reaches; :meth:`for_tolerance` refuses less than twice that there,
-        :data:`ELEMENT_TOLERANCE_FLOOR`) and ``thesis`` (explicit Euler, 5000 steps per t_H, 1000
-        elements across the contact diameter, as in the thesis). The element
+        :data:`ELEMENT_TOLERANCE_FLOOR`) and ``thesis`` (explicit Euler, 5000
+        steps per t_H, 1000 elements across the contact diameter, as in the
+        thesis). The element
         path figures are :data:`ERROR_MODEL` at the preset; measured largest
         errors against the continuum kernel on its eleven oblique scenes: 2.1e-4,
         2.8e-5, 2.0e-7 (``python -m benchmarks.element_orders``)."""
@@ -145,8 +146,9 @@ class Numerics:
 #: Q1 0.01..10, standard solids with Q1 0.03..30 and Q2 1e-3..10, nu 0..0.5) on the
 #: grid steps 250..4000 x elements 50..3200 (``python -m benchmarks.element_orders``:
 #: ``error_model``; it bounds every point, at most 9.8 times the largest error
-#: measured at each: the time error floors the finest elements). The element spacing dominates; the step error is second
-#: order but its largest values over the scenes fall like ``1 / steps`` on the grid.
+#: measured at each: the time error floors the finest elements). The element
+#: spacing dominates; the step error is second order but its largest values over
+#: the scenes fall like ``1 / steps`` on the grid.
 #: (Fitted on eight scenes with Q1 <= 5 it was a = 0.0021, b = 1.72, and
 #: ``for_tolerance(1e-5)`` gave 2.5e-5 on random scenes with Q1 up to 30: the step
 #: error of a glassy standard solid at Q1 = 10 is about 6e-3 / steps.)
@@ -156,9 +158,10 @@ ERROR_MODEL = {"a": 0.0062, "p": 1.0, "b": 1.08, "q": 2.0}
 #: the element count (the contact edge crossing element centres) and above 800
 #: elements this jitter outgrows the smooth 1/elements^2 trend: on 40 random scenes
 #: (Q1 1e-3..30, two seeds, tests/engine/test_tolerance.py's calibration) the error
-#: reached 1.5 times the envelope at tolerance 1e-6 (12000 steps, 1470 elements) and
-#: 1.03 times at 3e-6; below 3e-6 the margin was 1.2x-2x. A factor 2 covers what was
-#: measured; the validation scenes of that test are drawn from a third seed.
+#: reached 1.5 times the tolerance at 1e-6 (12000 steps, 1470 elements; aimed with
+#: no safety) and 1.03 times at 3e-6, while at 1e-5..1e-4 it stayed at 0.5-0.84 of
+#: it. A factor 2 covers what was measured; the validation scenes of that test are
+#: drawn from a third seed.
 ERROR_MODEL_SAFETY = 2.0
 #: Coarsest settings :meth:`Numerics.for_tolerance` gives (the model's measured grid).
 MIN_MODEL_STEPS = 250
