@@ -131,3 +131,15 @@ def test_building_the_parser_loads_neither_numba_nor_pandas():
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          check=True).stdout
     assert out.strip() == "[]", out
+
+
+@pytest.mark.parametrize("argv", [["simulate", "--Q1", "-1", "--nu", "0.3"],
+                                  ["plot", "nosuch", "--out", "x.png"]])
+def test_bad_input_is_refused_before_the_engine_loads(argv):
+    """A bad value exits 2 without loading numba or pandas (2.5-4 s before)."""
+    code = ("import sys; from vimpact.cli.main import main; "
+            f"rc = main({argv!r}); "
+            "print(rc, sorted({m.split('.')[0] for m in sys.modules} & {'numba', 'pandas'}))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True).stdout
+    assert out.strip() == "2 []", out

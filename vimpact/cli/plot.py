@@ -32,6 +32,9 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 
 
 def _cmd_plot(a) -> int:
+    from vimpact.plots.catalogue import figure_name
+
+    figure_name(a.name)  # a bad name is refused before the drawing code loads (about 2.5 s)
     from vimpact.plots.figures import plot_figure
 
     try:

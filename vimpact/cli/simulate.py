@@ -249,9 +249,6 @@ def _check_output(flag: str, path: str, suffixes: tuple[str, ...]) -> Path:
 
 def run(a) -> int:
     """Handler of ``vimpact simulate``; returns the exit code."""
-    from vimpact.engine.routing import choose_path  # the engine loads numba: only when run
-    from vimpact.engine.simulate import simulate
-
     if a.trajectory:
         _check_output("--trajectory", a.trajectory, (".csv", ".parquet"))
     if a.scene is not None:
@@ -259,6 +256,10 @@ def run(a) -> int:
     else:
         scene, file_numerics = scene_from_args(a), None
     numerics = numerics_from_args(a, file_numerics)
+    # the engine loads numba and pandas (about 2.5 s): only once the inputs are valid
+    from vimpact.engine.routing import choose_path
+    from vimpact.engine.simulate import simulate
+
     path = choose_path(scene, numerics)
     if a.explain and not a.json:
         print(path.explain())
