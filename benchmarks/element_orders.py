@@ -175,9 +175,7 @@ def error_model_points(quick: bool) -> dict:
     ``vimpact.model.numerics.ERROR_MODEL``); the presets on the element path,
     measured the same way."""
     import vimpact as v
-    from vimpact.engine.columns import SceneColumns
-    from vimpact.engine.pack import arm_arrays
-    from vimpact.kernels import continuum_maxwell
+    from vimpact.bench.accuracy import continuum_restitution
 
     S = [250, 500, 1000] if quick else [250, 500, 1000, 2000, 4000]
     # elements up to the cap of for_tolerance (3200): the error's jitter in the element
@@ -186,13 +184,7 @@ def error_model_points(quick: bool) -> dict:
     E = [50, 100, 200] if quick else [50, 100, 200, 400, 800, 1600, 3200]
     specs = MODEL_SCENES[:3] if quick else MODEL_SCENES
     scenes = [v.Scene.from_dimensionless(q1, nu, q2) for q1, nu, q2 in specs]
-    cols = SceneColumns.from_scenes(scenes)
-    g, tau, n_arms = arm_arrays(cols)
-    out = np.zeros((len(scenes), N_OUT))
-    continuum_maxwell.maxwell_stick_batch(cols.dashpot_time / cols.T, g, tau, n_arms, cols.kappa,
-                                          cols.contact_mass_factor, cols.computes_tangential,
-                                          1e-12, 10_000_000, out)
-    ez_ref, ex_ref = -out[:, OUT_VZ_END], np.abs(out[:, OUT_VC_END])
+    ez_ref, ex_ref = continuum_restitution(scenes, 1e-12)
     err = np.zeros((len(S), len(E)))
     per_scene = {}
     for i, s in enumerate(S):

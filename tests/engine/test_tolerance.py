@@ -47,22 +47,12 @@ def test_presets_claim_on_the_continuum_path():
 
 
 def _continuum_kernel(scenes):
-    """``(e_z, e_x)`` of the full-stick continuum kernel at rtol 1e-12 called
-    directly: routing sends scenes with an arm faster than 1e-3 T to elements,
-    but the kernel itself is exact for them (tests/kernels/test_continuum_maxwell.py
-    checks it against scipy)."""
-    from vimpact.engine.columns import SceneColumns
-    from vimpact.engine.pack import arm_arrays
-    from vimpact.kernels import continuum_maxwell, layout
+    """``(e_z, e_x)`` of the full-stick continuum kernel at rtol 1e-12, called
+    directly (:func:`vimpact.bench.accuracy.continuum_restitution`; it raises
+    unless every row ends ok)."""
+    from vimpact.bench.accuracy import continuum_restitution
 
-    cols = SceneColumns.from_scenes(scenes)
-    g, tau, n_arms = arm_arrays(cols)
-    out = np.zeros((len(scenes), layout.N_OUT))
-    continuum_maxwell.maxwell_stick_batch(cols.dashpot_time / cols.T, g, tau, n_arms, cols.kappa,
-                                          cols.contact_mass_factor, cols.computes_tangential,
-                                          1e-12, 10_000_000, out)
-    assert (out[:, layout.OUT_STATUS] == layout.STATUS_OK).all()
-    return -out[:, layout.OUT_VZ_END], np.abs(out[:, layout.OUT_VC_END])
+    return continuum_restitution(scenes, 1e-12)
 
 
 @pytest.mark.parametrize("tolerance", [1e-4, 1e-5])

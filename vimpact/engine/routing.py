@@ -48,8 +48,7 @@ def friction_rows(cols: SceneColumns) -> np.ndarray:
     """Rows whose Coulomb friction the kernels must model: a tangential problem, a
     finite ``mu`` and an incidence ``psi`` of at least :data:`PSI_FULL_STICK`."""
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        psi = (2.0 * (1.0 - cols.nu) / (cols.mu * (2.0 - cols.nu))
-               * np.abs(cols.v_c0) / cols.v_z0)
+        psi = cols.kappa / cols.mu * np.abs(cols.v_c0) / cols.v_z0  # kappa = 2(1-nu)/(2-nu)
     return cols.computes_tangential & np.isfinite(cols.mu) & (psi >= PSI_FULL_STICK)
 
 
