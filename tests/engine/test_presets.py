@@ -16,7 +16,7 @@ import pytest
 
 import vimpact as v
 from tests.engine.test_tolerance import _continuum_kernel
-from vimpact.model.numerics import ERROR_MODEL
+from vimpact.model.numerics import element_error_bound
 from vimpact.reference.closed_forms import kelvin_voigt_continuum
 
 RNG = np.random.default_rng(20261121)
@@ -28,8 +28,7 @@ SCENES = ([v.Scene.from_dimensionless(q, n) for q, n in zip(Q1, NU)]
 
 
 def model_bound(numerics: v.Numerics) -> float:
-    m = ERROR_MODEL
-    return m["a"] / numerics.steps ** m["p"] + m["b"] / numerics.elements ** m["q"]
+    return element_error_bound(numerics.steps, numerics.elements)
 
 
 @pytest.fixture(scope="module")

@@ -163,6 +163,15 @@ ERROR_MODEL = {"a": 0.0062, "p": 1.0, "b": 1.08, "q": 2.0}
 #: it. A factor 2 covers what was measured; the validation scenes of that test are
 #: drawn from a third seed.
 ERROR_MODEL_SAFETY = 2.0
+
+
+def element_error_bound(steps: float, elements: float) -> float:
+    """:data:`ERROR_MODEL`'s bound on ``max(|e_z err|, |e_x err|)`` of the Verlet element
+    path at ``steps`` per t_H and ``elements`` per a_H (dimensionless)."""
+    m = ERROR_MODEL
+    return m["a"] / steps ** m["p"] + m["b"] / elements ** m["q"]
+
+
 #: Coarsest settings :meth:`Numerics.for_tolerance` gives (the model's measured grid).
 MIN_MODEL_STEPS = 250
 MIN_MODEL_ELEMENTS = 50
@@ -181,9 +190,7 @@ MAX_ELEMENTS = 3200
 #: The smallest tolerance the element path verifiably reaches: the error model at the
 #: caps times the safety (9.9e-7; the envelope there is 4.9e-7, and the ``precise``
 #: preset, these caps, measured 2.0e-7 on the model's scenes).
-ELEMENT_TOLERANCE_FLOOR = ERROR_MODEL_SAFETY * (
-    ERROR_MODEL["a"] / MAX_STEPS ** ERROR_MODEL["p"]
-    + ERROR_MODEL["b"] / MAX_ELEMENTS ** ERROR_MODEL["q"])
+ELEMENT_TOLERANCE_FLOOR = ERROR_MODEL_SAFETY * element_error_bound(MAX_STEPS, MAX_ELEMENTS)
 #: Largest accepted ``steps`` and ``elements`` settings (cost bounds).
 MAX_SETTING = {"steps": 10_000_000, "elements": 1_000_000}
 
