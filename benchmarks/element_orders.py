@@ -13,6 +13,18 @@ continuum kernel (:mod:`vimpact.kernels.continuum_maxwell`, rtol 1e-12: about
   (step fine): a spread beyond the smooth trend is the error that is not
   continuous in the element count (the contact edge crossing element
   centres);
+- worst case under joint refinement: at each joint level the largest error
+  over ``ENVELOPE_SHIFTS`` element counts ``N + k / ENVELOPE_SHIFTS`` (the
+  largest contact radius falls at every position within an element), and the
+  order fitted to that envelope. A single ladder samples the edge error at
+  one position per level (the elastic ladder at a_max / dx integer on every
+  level, the others at pseudo-random ones), so its fitted order is not the
+  method's; the envelope's is. Besides the full-stick cases against the
+  continuum kernel, the effects that run on the element path in use
+  (``ELEMENT_PATH_CASES``: Coulomb friction, the thesis's seed memory), each
+  against a fine element run whose spread over three spacings is its
+  uncertainty; and ``Numerics.for_tolerance`` on scenes with those effects
+  (``CHECK_SCENES``) against an 8x finer run;
 - "before": the kernel of commit ``BEFORE`` (read with ``git show``,
   compiled from a temporary copy) on the arm cases, when git is available
   (full run only).
@@ -100,6 +112,92 @@ CASES = {
 }
 
 
+#: element counts per joint level of the worst-case ladder (N + k / ENVELOPE_SHIFTS)
+ENVELOPE_SHIFTS = 8
+#: the element path's own cases: name: (tau0, g, tau, memory, psi / chi; 0: full stick)
+ELEMENT_PATH_CASES = {
+    "friction_psi_3chi_elastic": (0.0, (), (), 0, 3.0),
+    "friction_psi_3chi_kelvin_voigt": (TAU_Q1, (), (), 0, 3.0),
+    "friction_psi_3chi_prony_dashpot": (0.05, (1.0, 0.5), (0.3, 3.0), 0, 3.0),
+    "friction_psi_0.5chi_elastic": (0.0, (), (), 0, 0.5),
+    "friction_psi_0.5chi_kelvin_voigt": (TAU_Q1, (), (), 0, 0.5),
+    "friction_psi_0.5chi_prony_dashpot": (0.05, (1.0, 0.5), (0.3, 3.0), 0, 0.5),
+    "seed_elastic": (0.0, (), (), 1, 0.0),
+    "seed_kelvin_voigt": (TAU_Q1, (), (), 1, 0.0),
+    "seed_prony_dashpot": (0.05, (1.0, 0.5), (0.3, 3.0), 1, 0.0),
+}
+
+
+def mu_for(psi_over_chi: float, nu: float = NU, theta_ratio: float = THETA_RATIO) -> float:
+    """Kernel-unit friction coefficient ``mu v_z0 / |v_c0|`` for ``psi = that x chi``
+    (``psi = kappa / mu``, ``chi = kappa (1 + m R^2 / Theta) / 2``); ``inf`` for 0."""
+    if psi_over_chi == 0.0:
+        return math.inf
+    chi = (1.0 - nu) / (2.0 - nu) * (1.0 + 1.0 / theta_ratio)
+    return 2.0 * (1.0 - nu) / (2.0 - nu) / (psi_over_chi * chi)
+
+
+def envelope(spec, ez_ref, ex_ref, levels, **material) -> dict:
+    """Largest |error| of e_z and e_x over ``ENVELOPE_SHIFTS`` element counts at
+    each joint level (``N + k / ENVELOPE_SHIFTS`` elements per a_H, ``6 N`` steps
+    per t_H) and the orders fitted to them; e_x is compared signed (beta_x)."""
+    ez_env, ex_env = [], []
+    for n in levels:
+        counts = n + np.arange(ENVELOPE_SHIFTS) / ENVELOPE_SHIFTS
+        out = run_rows(spec, h=HERTZ_TIME / (6.0 * n) / TANGENTIAL_FACTOR, dxi=1.0 / counts,
+                       **material)
+        assert (out[:, OUT_STATUS] == STATUS_OK).all(), out[:, OUT_STATUS]
+        ez_env.append(float(np.abs(-out[:, OUT_VZ_END] - ez_ref).max()))
+        ex_env.append(float(np.abs(out[:, OUT_VC_END] - ex_ref).max()))
+    return {"e_z_error": ez_env, "e_x_error": ex_env,
+            "e_z_fitted_order": fitted_order(ez_env), "e_x_fitted_order": fitted_order(ex_env)}
+
+
+def element_reference(spec, **material) -> tuple[float, float, float]:
+    """``(e_z, beta_x, uncertainty)`` of a fine element run (9600 steps per t_H,
+    1600 elements per a_H and two spacings 0.02 % and 0.04 % apart: their mean,
+    and the spread of beta_x over the three)."""
+    out = run_rows(spec, h=HERTZ_TIME / 9600 / TANGENTIAL_FACTOR,
+                   dxi=1.0 / (1600.0 + np.array([0.0, 0.37, 0.71])), **material)
+    assert (out[:, OUT_STATUS] == STATUS_OK).all()
+    return (float(-out[:, OUT_VZ_END].mean()), float(out[:, OUT_VC_END].mean()),
+            float(np.ptp(out[:, OUT_VC_END])))
+
+
+#: scenes of the tolerance check off the error model's memory (Q1, nu, Q2, mu): none is
+#: a scene of MODEL_SCENES; seed memory at full stick, incremental with friction
+CHECK_SCENES = [(0.3, 0.3, None, 0.3), (1.0, 0.5, 1.0, 0.1), (0.05, 0.0, None, 1.0),
+                (3.0, 0.25, 0.1, 0.5), (0.01, 0.5, 10.0, 0.2), (0.1, 0.4, 0.01, 0.4)]
+
+
+def tolerance_check(tolerances) -> dict:
+    """``Numerics.for_tolerance(tol)`` with its tolerance check switched off (plain
+    steps and elements) on :data:`CHECK_SCENES` with the seed memory and with
+    friction, against an 8x finer run (steps and elements; 4x gives the reference's
+    uncertainty): largest error on e_z and beta_x over the tolerance, per scene."""
+    import vimpact as v
+
+    sets = {"seed": [v.Scene.from_dimensionless(q1, nu, q2, tangential_memory="seed")
+                     for q1, nu, q2, _ in CHECK_SCENES],
+            "friction": [v.Scene.from_dimensionless(q1, nu, q2, mu=mu)
+                         for q1, nu, q2, mu in CHECK_SCENES]}
+    out = {}
+    for name, scenes in sets.items():
+        out[name] = {}
+        for tol in tolerances:
+            n = v.Numerics.for_tolerance(tol).with_(tolerance=None)
+            runs = [v.simulate_batch(scenes, n.with_(steps=k * n.steps, elements=k * n.elements))
+                    for k in (1, 4, 8)]
+            assert all((r.status == "ok").all() for r in runs)
+            ref = runs[2]
+            err = np.maximum(np.abs(runs[0].e_z - ref.e_z), np.abs(runs[0].beta_x - ref.beta_x))
+            out[name][f"{tol:g}"] = {
+                "steps": n.steps, "elements": n.elements,
+                "error_over_tolerance": (err.to_numpy() / tol).tolist(),
+                "reference_uncertainty": float(np.abs(runs[1].beta_x - ref.beta_x).max())}
+    return out
+
+
 def run(quick: bool) -> dict:
     steps = np.array([150, 300, 600] if quick else [150, 300, 600, 1200, 2400])
     fine_steps = 2400 if quick else 9600
@@ -109,11 +207,13 @@ def run(quick: bool) -> dict:
     sweep = np.arange(190.0, 210.01, 2.0 if quick else 0.5)
     sweep_steps = 2400 if quick else 4800
     before = None if quick else old_kernel()
+    levels = elems
     data = {"machine": machine_info(), "before_commit": BEFORE if before else None,
             "steps": steps.tolist(), "fine_steps": fine_steps, "elements": elems.tolist(),
             "fine_elements": fine_elems, "joint_steps": joint.tolist(),
             "joint_elements": (joint / 6.0).tolist(), "sweep_elements": sweep.tolist(),
-            "sweep_steps": sweep_steps, "cases": {}}
+            "sweep_steps": sweep_steps, "envelope_elements": levels.tolist(),
+            "envelope_shifts": ENVELOPE_SHIFTS, "cases": {}, "element_path_cases": {}}
     for name, (tau0, g, tau) in CASES.items():
         spec = KernelSpec(VERLET, True, 0, len(g) > 0, tau0 > 0.0)
         ez_ref, ex_ref = continuum(tau0, g, tau)
@@ -150,9 +250,23 @@ def run(quick: bool) -> dict:
                     basis = 1.0 / sweep**2
                     c = float(basis @ e / (basis @ basis))
                     r[f"sweep_{key}_jump"] = float(np.ptp(e - c * basis))
+                # the continuum's e_x is |beta_x|: the element run's sign is that of beta_x
+                sign = float(np.sign(out[0, OUT_VC_END])) or 1.0
+                r["envelope"] = envelope(spec, ez_ref, sign * ex_ref, levels, tau0=tau0, g=g,
+                                         tau=tau)
             r["seconds"] = time.perf_counter() - t0
             case[label] = r
         data["cases"][name] = case
+    for name, (tau0, g, tau, memory, psi) in ELEMENT_PATH_CASES.items():
+        spec = KernelSpec(VERLET, True, memory, len(g) > 0, tau0 > 0.0, psi > 0.0)
+        material = dict(tau0=tau0, g=g, tau=tau, mu=mu_for(psi))
+        t0 = time.perf_counter()
+        ez_ref, bx_ref, spread = element_reference(spec, **material)
+        case = envelope(spec, ez_ref, bx_ref, levels, **material)
+        case.update(reference_e_z=ez_ref, reference_beta_x=bx_ref,
+                    reference_uncertainty=spread, seconds=time.perf_counter() - t0)
+        data["element_path_cases"][name] = case
+    data["tolerance_check"] = tolerance_check([1e-3, 1e-4] if quick else [1e-3, 1e-4, 1e-5])
     data["error_model"] = error_model_points(quick)
     return data
 
@@ -227,7 +341,9 @@ def plot(data: dict, path) -> None:
     import matplotlib.pyplot as plt
 
     cases = data["cases"]
-    fig, axes = plt.subplots(len(cases), 4, figsize=(17, 3.6 * len(cases)), squeeze=False)
+    extra = data.get("element_path_cases", {})
+    fig, axes = plt.subplots(len(cases) + bool(extra), 4, figsize=(17, 3.6 * (len(cases) + 1)),
+                             squeeze=False)
     for row, (name, case) in zip(axes, cases.items()):
         for label in ("after", "before"):
             if label not in case:
@@ -242,6 +358,11 @@ def plot(data: dict, path) -> None:
                 row[2].loglog(data["joint_steps"], r[f"joint_{key}_error"], ls + mk,
                               label=f"{label} {key} ({r[f'joint_{key}_fitted_order']:.1f})")
         r = case["after"]
+        if "envelope" in r:
+            for key, mk in (("e_z", "o"), ("e_x", "s")):
+                row[2].loglog(np.asarray(data["envelope_elements"]) * 6, r["envelope"][f"{key}_error"],
+                              ":" + mk, mfc="none",
+                              label=f"worst {key} ({r['envelope'][f'{key}_fitted_order']:.2f})")
         for key, mk in (("e_z", "o"), ("e_x", "s")):
             row[3].plot(data["sweep_elements"], r[f"sweep_{key}_error"], "-" + mk, ms=3,
                         label=f"{key}: jump {r[f'sweep_{key}_jump']:.1e}")
@@ -254,6 +375,20 @@ def plot(data: dict, path) -> None:
                    xlabel="elements per a_H", ylabel="error (signed)")
         for ax in row:
             ax.legend(fontsize=7)
+    if extra:
+        row = axes[-1]
+        groups = (("friction_psi_3chi", 0), ("friction_psi_0.5chi", 1), ("seed", 2))
+        for name, c in extra.items():
+            k = next(i for prefix, i in groups if name.startswith(prefix))
+            row[k].loglog(np.asarray(data["envelope_elements"]) * 6, c["e_x_error"], "s-",
+                          label=f"{name} ({c['e_x_fitted_order']:.2f})")
+        titles = ("friction psi = 3 chi", "friction psi = 0.5 chi", "seed memory, full stick")
+        for ax, title in zip(row[:3], titles):
+            ax.set(title=f"worst beta_x: {title}",
+                   xlabel="steps per t_H (6 per element per a_H)",
+                   ylabel="|error| vs fine element run")
+            ax.legend(fontsize=7)
+        row[3].axis("off")
     save_figure(fig, path)
 
 
@@ -270,8 +405,20 @@ def figures(data: dict) -> dict:
                     "joint_e_z_fitted_order", "joint_e_x_fitted_order"):
             if after.get(key) is not None:
                 out[f"{name}_{key}"] = figure(after[key], "-", better="higher", kind="accuracy")
+        for key in ("e_z", "e_x"):
+            if "envelope" in after:
+                out[f"{name}_worst_{key}_fitted_order"] = figure(
+                    after["envelope"][f"{key}_fitted_order"], "-", better="higher",
+                    kind="accuracy")
         if after.get("sweep_e_x_jump") is not None:
             out[f"{name}_sweep_e_x_jump"] = figure(after["sweep_e_x_jump"], "-", kind="accuracy")
+    for name, c in data.get("element_path_cases", {}).items():
+        out[f"{name}_worst_beta_x_fitted_order"] = figure(c["e_x_fitted_order"], "-",
+                                                          better="higher", kind="accuracy")
+    for name, by_tol in data.get("tolerance_check", {}).items():
+        for tol, c in by_tol.items():
+            out[f"{name}_for_tolerance_{tol}_worst_error_over_tolerance"] = figure(
+                max(c["error_over_tolerance"]), "-", kind="accuracy")
     for preset, p in data.get("error_model", {}).get("presets", {}).items():
         out[f"{preset}_max_error"] = figure(p["max_error"], "-", kind="accuracy")
     return out
