@@ -20,7 +20,7 @@ import math
 import numpy as np
 import pytest
 
-from tests.kernels.test_elements_accuracy import HERTZ_TIME, observed_order, run_rows
+from tests.kernels.test_elements_accuracy import HERTZ_TIME, run_rows
 from vimpact.kernels.elements import (N_OUT, OUT_T_CONTACT, OUT_T_GROSS_SLIP, OUT_VC_END,
                                       OUT_VZ_END, OUT_W_FRICTION, REC_SLIP, VERLET, KernelSpec,
                                       element_kernel)
@@ -127,19 +127,31 @@ def test_friction_never_adds_energy():
         assert np.all(np.isfinite(out))
 
 
-def test_friction_converges_second_order():
-    """Microslip (psi near 3 chi): beta_x with friction under joint refinement
-    of steps and elements, against a 4x finer run."""
+@pytest.mark.parametrize("rheology", FAST)
+def test_friction_converges_second_order_at_every_edge_position(rheology):
+    """Near stick (psi = chi / 2), beta_x with friction under joint refinement
+    of steps and elements: the largest error over 8 element counts per level
+    (the largest contact radius at every position within an element; a single
+    ladder samples one) falls at order >= 1.8 against a 4x finer run. Full
+    stick with a dashpot does not: its edge stress jump makes the worst case
+    about order 1.5 (benchmarks/element_orders.py); the cone removes the jump."""
     nu, theta = 0.3, 0.4
     kappa, mu_t = 2.0 * (1.0 - nu) / (2.0 - nu), 1.0 + 1.0 / theta
     chi = kappa * mu_t / 2.0
-    mu_k = kappa / (3.0 * chi)  # psi = kappa / mu_k
-    N = np.array([100, 200, 400, 1600])
-    out, _ = run("elastic", mu=mu_k, h=HERTZ_TIME / N / 1.87, dxi=4.0 / N, nu=nu,
-                 theta_ratio=theta)
-    order, err = observed_order(out[:3, OUT_VC_END], out[3, OUT_VC_END])
-    assert err[-1] < 1e-3, err
-    assert order[-1] >= 1.5, (order, err)
+    mu_k = kappa / (0.5 * chi)  # psi = kappa / mu_k
+    levels = np.array([25, 50, 100, 400])
+    shifts = np.arange(8) / 8.0
+    n = (levels[:, None] + shifts).ravel()
+    out, _ = run(rheology, mu=mu_k,
+                 h=HERTZ_TIME / np.repeat(6.0 * levels, shifts.size) / 1.87, dxi=1.0 / n,
+                 nu=nu, theta_ratio=theta)
+    beta = out[:, OUT_VC_END].reshape(levels.size, shifts.size)
+    reference = beta[-1].mean()
+    assert np.ptp(beta[-1]) < 2e-6, np.ptp(beta[-1])  # the reference's own spread
+    worst = np.abs(beta[:-1] - reference).max(axis=1)
+    order = -np.polyfit(np.log2(levels[:-1]), np.log2(worst), 1)[0]
+    assert worst[-1] < 3e-5, worst
+    assert order >= 1.8, (order, worst)
 
 
 @pytest.mark.slow
