@@ -167,3 +167,17 @@ def test_a_tiny_radius_is_blamed_on_the_radius():
 def test_string_inputs_are_refused_at_the_boundary():
     with pytest.raises(v.InputError, match="v_z0 = '1'"):
         v.Scene(v.Material.elastic(nu=0.5, G=1e6), R=0.01, m=0.004, v_z0="1")
+
+
+def test_tolerance_is_refused_for_the_seed_memory():
+    """The error model is measured with the incremental memory; the seed memory's
+    beta_x converges more slowly (benchmarks/element_orders.py), so no tolerance is
+    claimed for it: refused with the reason, while explicit numerics still run."""
+    seed = v.Scene.from_dimensionless(0.0, 0.3, tangential_memory="seed")  # elastic
+    numerics = v.Numerics.for_tolerance(1e-3)
+    with pytest.raises(v.InputError, match="seed memory"):
+        v.simulate(seed, numerics)
+    df = v.simulate_batch([seed, v.Scene.from_dimensionless(0.0, 0.3)], numerics)
+    assert df.status.tolist() == ["tolerance_unreachable", "ok"]
+    assert "tolerance = 0.001" in df.error[0] and math.isnan(df.beta_x[0])
+    assert v.simulate(seed, FAST).status == "ok"

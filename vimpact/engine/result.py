@@ -61,7 +61,8 @@ STATUSES = {
                   "(numerics.MAX_STEPS_PER_T_H, MAX_ELEMENTS_IN_ROW) for this scene; outputs NaN "
                   "(reason in the error column)",
     "tolerance_unreachable": "the numerics' tolerance is below what the element path this scene "
-                             "needs can reach (floor in the error column); outputs NaN",
+                             "needs can reach, or its error is not bounded there (the seed "
+                             "memory); reason in the error column; outputs NaN",
     "invalid": "the row's inputs are not a valid scene (reason in the error column); outputs NaN",
 }
 
