@@ -131,7 +131,9 @@ class Numerics:
         thesis). The element
         path figures are :data:`ERROR_MODEL` at the preset; measured largest
         errors against the continuum kernel on its eleven oblique scenes: 2.1e-4,
-        2.8e-5, 2.0e-7 (``python -m benchmarks.element_orders``)."""
+        2.8e-5, 2.0e-7 (``python -m benchmarks.element_orders``). They hold for
+        the incremental memory, with or without friction; the seed memory
+        converges more slowly (:data:`SEED_MEMORY_UNVERIFIED`)."""
         one_of("numerics preset", name, tuple(PRESETS))
         return PRESETS[name]
 
