@@ -360,8 +360,8 @@ def plot(data: dict, path) -> None:
         r = case["after"]
         if "envelope" in r:
             for key, mk in (("e_z", "o"), ("e_x", "s")):
-                row[2].loglog(np.asarray(data["envelope_elements"]) * 6, r["envelope"][f"{key}_error"],
-                              ":" + mk, mfc="none",
+                row[2].loglog(np.asarray(data["envelope_elements"]) * 6,
+                              r["envelope"][f"{key}_error"], ":" + mk, mfc="none",
                               label=f"worst {key} ({r['envelope'][f'{key}_fitted_order']:.2f})")
         for key, mk in (("e_z", "o"), ("e_x", "s")):
             row[3].plot(data["sweep_elements"], r[f"sweep_{key}_error"], "-" + mk, ms=3,

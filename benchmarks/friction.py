@@ -20,7 +20,7 @@ import time
 import numba
 import numpy as np
 
-from benchmarks.element_orders import HERTZ_TIME, TANGENTIAL_FACTOR, run_rows
+from benchmarks.element_orders import HERTZ_TIME, TANGENTIAL_FACTOR, mu_for, run_rows
 from benchmarks.machine import figure, machine_info, median_time, repository_main, save_figure
 from vimpact.kernels.elements import OUT_T_CONTACT, OUT_T_GROSS_SLIP, OUT_VC_END, VERLET, KernelSpec
 
@@ -40,15 +40,7 @@ def interleaved_medians(fns: dict, repeats: int) -> dict:
 
 
 NU, THETA = 0.3, 0.4
-KAPPA = 2.0 * (1.0 - NU) / (2.0 - NU)
-MU_T = 1.0 + 1.0 / THETA
-CHI = KAPPA * MU_T / 2.0  # (1 - nu)(1 + m R^2/Theta)/(2 - nu)
 MATERIALS = {"elastic": (0.0, (), ()), "standard_solid_Q2_0.5": (0.0, (2.0,), (0.5,))}
-
-
-def mu_for(psi_over_chi: float) -> float:
-    """Kernel-unit friction coefficient ``mu v_z0/|v_c0|`` giving psi = that x chi."""
-    return KAPPA / (psi_over_chi * CHI)
 
 
 def run(quick: bool) -> dict:
