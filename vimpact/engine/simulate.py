@@ -22,9 +22,8 @@ from vimpact.engine.routing import CONTINUUM_STICK, choose_path, route
 from vimpact.engine.unpack import unpack
 from vimpact.kernels import layout
 from vimpact.model.hertz import HERTZ_TIME_FACTOR
-from vimpact.model.numerics import (ELEMENT_TOLERANCE_FLOOR, MAX_ELEMENTS_IN_ROW,
-                                    MAX_STEPS_PER_T_H, SEED_MEMORY_UNVERIFIED, Numerics)
-from vimpact.model.scene import HALF_SPACE_LIMIT, Scene
+from vimpact.model.numerics import MAX_ELEMENTS_IN_ROW, MAX_STEPS_PER_T_H, Numerics
+from vimpact.model.scene import HALF_SPACE_LIMIT, TANGENTIAL_MEMORY, Scene
 from vimpact.model.validation import InputError, message, require
 
 #: Rows of a recorded trajectory at most (the last row always holds the end state).
@@ -82,17 +81,11 @@ def run_columns(cols: SceneColumns, numerics: Numerics, n_rec: int = 0, rec_ever
                     f"{numerics.row_width / arrays['dxi'][j]:.3g} elements (refined for its "
                     "stiffest mode): more than "
                     f"the limits {MAX_STEPS_PER_T_H:.0e} and {MAX_ELEMENTS_IN_ROW:.0e}")
-            if not numerics.element_tolerance_reachable:
+            why = numerics.element_refusal(path.name, path.spec.tangential
+                                           and path.spec.memory == TANGENTIAL_MEMORY.index("seed"))
+            if why is not None:
                 for j in np.flatnonzero(~costly):
-                    refused[idx[j]] = ("tolerance_unreachable",
-                        f"tolerance = {numerics.tolerance:g} is not reachable on the element "
-                        f"path this scene needs ({path.name}): the smallest it reaches is "
-                        f"{ELEMENT_TOLERANCE_FLOOR:.2g}")
-                costly[:] = True
-            elif numerics.tolerance is not None and path.spec.tangential and path.spec.memory == 1:
-                for j in np.flatnonzero(~costly):
-                    refused[idx[j]] = ("tolerance_unreachable", SEED_MEMORY_UNVERIFIED.format(
-                        tolerance=numerics.tolerance))
+                    refused[idx[j]] = ("tolerance_unreachable", why)
                 costly[:] = True
             explicit_euler[idx] = path.spec.integrator == layout.EULER
             steps_per_T[idx] = 1.0 / arrays["h"]

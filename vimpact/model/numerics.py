@@ -120,6 +120,19 @@ class Numerics:
         """The element path reaches ``tolerance`` (always, without one)."""
         return self.tolerance is None or self.tolerance >= ELEMENT_TOLERANCE_FLOOR
 
+    def element_refusal(self, path_name: str, seed_memory: bool) -> str | None:
+        """Why the element path ``path_name`` must refuse these numerics' tolerance
+        (one line, for the error column), or ``None`` (no tolerance, or one the error
+        model bounds there). ``seed_memory``: the path runs the tangential problem
+        with the thesis's seed memory, which the model does not bound."""
+        if not self.element_tolerance_reachable:
+            return (f"tolerance = {self.tolerance:g} is not reachable on the element path "
+                    f"this scene needs ({path_name}): the smallest it reaches is "
+                    f"{ELEMENT_TOLERANCE_FLOOR:.2g}")
+        if self.tolerance is not None and seed_memory:
+            return SEED_MEMORY_UNVERIFIED.format(tolerance=self.tolerance)
+        return None
+
     @classmethod
     def preset(cls, name: str) -> "Numerics":
         """Named settings (:data:`PRESETS`): ``fast`` (2.3e-4 on e_z, e_x on the
