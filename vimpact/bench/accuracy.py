@@ -501,6 +501,15 @@ def reference(specs, scenes) -> dict:
     }
 
 
+def _errors(ez, ex, finished, ref) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``|e_z - ref|``, ``|e_x - ref|`` per scene, ``inf`` where a row did not
+    finish (``finished`` false) or gave no finite value; and the rows that count."""
+    ok = finished & np.isfinite(ez) & np.isfinite(ex)
+    dz = np.where(ok, np.abs(ez - ref["e_z"]), np.inf)
+    dx = np.where(ok, np.abs(ex - ref["e_x"]), np.inf)
+    return dz, dx, ok
+
+
 def evaluate(scenes, numerics, ref, timer: Timer) -> dict:
     """Errors over the scenes and (first sample of the) wall time per impact."""
     row = {"integrator": numerics.integrator, "steps": numerics.steps,
@@ -515,11 +524,7 @@ def evaluate(scenes, numerics, ref, timer: Timer) -> dict:
         ez, ex = ez.copy(), ex.copy()
         ez[idx], ex[idx] = rz, rx
         gain = _f(np.nanmax(energy) - 1.0)
-    ok = (df.status.isin(FINISHED).to_numpy() | unstable) & np.isfinite(ez) & np.isfinite(ex)
-    dz = np.abs(ez - ref["e_z"])
-    dx = np.abs(ex - ref["e_x"])
-    dz[~ok] = np.inf
-    dx[~ok] = np.inf
+    dz, dx, ok = _errors(ez, ex, df.status.isin(FINISHED).to_numpy() | unstable, ref)
     row.update({
         "e_z_error_max": _f(dz.max()), "e_z_error_median": _f(np.median(dz)),
         "e_x_error_max": _f(dx.max()), "e_x_error_median": _f(np.median(dx)),
@@ -545,10 +550,9 @@ def for_tolerance_scan(scenes, ref, tol_max: float, tol_min: float, n: int) -> d
     for tol in np.geomspace(tol_max, tol_min, n):
         num = v.Numerics.for_tolerance(float(tol)).with_(continuum=False)
         df = v.simulate_batch(scenes, num)
-        dz = np.abs(df.e_z.to_numpy() - ref["e_z"])
-        dx = np.abs(df.e_x.to_numpy() - ref["e_x"])
-        ok = df.status.isin(FINISHED).to_numpy() & np.isfinite(dz) & np.isfinite(dx)
-        err = float(max(dz.max(), dx.max())) if ok.all() else math.inf
+        dz, dx, _ = _errors(df.e_z.to_numpy(), df.e_x.to_numpy(),
+                            df.status.isin(FINISHED).to_numpy(), ref)
+        err = float(max(dz.max(), dx.max()))
         rows.append({"tolerance": float(tol), "steps": num.steps, "elements": num.elements,
                      "error": _f(err), "e_z_error_max": _f(dz.max()),
                      "e_x_error_max": _f(dx.max()),
