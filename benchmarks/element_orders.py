@@ -207,13 +207,11 @@ def run(quick: bool) -> dict:
     sweep = np.arange(190.0, 210.01, 2.0 if quick else 0.5)
     sweep_steps = 2400 if quick else 4800
     before = None if quick else old_kernel()
-    levels = elems
     data = {"machine": machine_info(), "before_commit": BEFORE if before else None,
             "steps": steps.tolist(), "fine_steps": fine_steps, "elements": elems.tolist(),
             "fine_elements": fine_elems, "joint_steps": joint.tolist(),
             "joint_elements": (joint / 6.0).tolist(), "sweep_elements": sweep.tolist(),
-            "sweep_steps": sweep_steps, "envelope_elements": levels.tolist(),
-            "envelope_shifts": ENVELOPE_SHIFTS, "cases": {}, "element_path_cases": {}}
+            "sweep_steps": sweep_steps, "envelope_shifts": ENVELOPE_SHIFTS, "cases": {}, "element_path_cases": {}}
     for name, (tau0, g, tau) in CASES.items():
         spec = KernelSpec(VERLET, True, 0, len(g) > 0, tau0 > 0.0)
         ez_ref, ex_ref = continuum(tau0, g, tau)
@@ -252,7 +250,7 @@ def run(quick: bool) -> dict:
                     r[f"sweep_{key}_jump"] = float(np.ptp(e - c * basis))
                 # the continuum's e_x is |beta_x|: the element run's sign is that of beta_x
                 sign = float(np.sign(out[0, OUT_VC_END])) or 1.0
-                r["envelope"] = envelope(spec, ez_ref, sign * ex_ref, levels, tau0=tau0, g=g,
+                r["envelope"] = envelope(spec, ez_ref, sign * ex_ref, elems, tau0=tau0, g=g,
                                          tau=tau)
             r["seconds"] = time.perf_counter() - t0
             case[label] = r
@@ -262,7 +260,7 @@ def run(quick: bool) -> dict:
         material = dict(tau0=tau0, g=g, tau=tau, mu=mu_for(psi))
         t0 = time.perf_counter()
         ez_ref, bx_ref, spread = element_reference(spec, **material)
-        case = envelope(spec, ez_ref, bx_ref, levels, **material)
+        case = envelope(spec, ez_ref, bx_ref, elems, **material)
         case.update(reference_e_z=ez_ref, reference_beta_x=bx_ref,
                     reference_uncertainty=spread, seconds=time.perf_counter() - t0)
         data["element_path_cases"][name] = case
@@ -360,7 +358,7 @@ def plot(data: dict, path) -> None:
         r = case["after"]
         if "envelope" in r:
             for key, mk in (("e_z", "o"), ("e_x", "s")):
-                row[2].loglog(np.asarray(data["envelope_elements"]) * 6,
+                row[2].loglog(np.asarray(data["elements"]) * 6,
                               r["envelope"][f"{key}_error"], ":" + mk, mfc="none",
                               label=f"worst {key} ({r['envelope'][f'{key}_fitted_order']:.2f})")
         for key, mk in (("e_z", "o"), ("e_x", "s")):
@@ -380,7 +378,7 @@ def plot(data: dict, path) -> None:
         groups = (("friction_psi_3chi", 0), ("friction_psi_0.5chi", 1), ("seed", 2))
         for name, c in extra.items():
             k = next(i for prefix, i in groups if name.startswith(prefix))
-            row[k].loglog(np.asarray(data["envelope_elements"]) * 6, c["e_x_error"], "s-",
+            row[k].loglog(np.asarray(data["elements"]) * 6, c["e_x_error"], "s-",
                           label=f"{name} ({c['e_x_fitted_order']:.2f})")
         titles = ("friction psi = 3 chi", "friction psi = 0.5 chi", "seed memory, full stick")
         for ax, title in zip(row[:3], titles):

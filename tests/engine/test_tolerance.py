@@ -91,7 +91,7 @@ def _random_element_scenes(n, seed):
     1e-4, 1e-5, pytest.param(1e-6, marks=pytest.mark.slow)])
 def test_for_tolerance_on_the_element_path_of_random_scenes(tolerance):
     """Every full-stick scene forced onto elements (``continuum=False``, as with
-    friction or the seed memory) meets the tolerance against the exact continuum."""
+    friction or a stiff arm) meets the tolerance against the exact continuum."""
     scenes = _random_element_scenes(10, seed=[20261123, 3])
     got = v.simulate_batch(scenes, v.Numerics.for_tolerance(tolerance).with_(continuum=False))
     assert (got.status == "ok").all() and got.path.str.startswith("elements").all()
