@@ -10,8 +10,8 @@ SI numbers too (``eta`` over 30 decades around the scene's own ``G_inf T``), so
 ``Q1`` itself spans dozens of decades; the arm moduli of the standard solid and
 the Prony series are drawn relative to ``G_inf`` over [1e-3, 1e3] and their times
 relative to ``T`` over [1.3e-3, 1e4] in the default run (the full-stick continuum
-path) and over [1e-4, 1e4] in the ``slow`` run (arms faster than 1e-3 T take the
-element path, and Coulomb friction ``mu`` in [1e-3, 10] besides full stick; further
+path) and over [1e-4, 1e4] in the ``slow`` run (with Coulomb friction ``mu`` in
+[1e-3, 10] besides full stick, which takes the element path; further
 out it is refused as too costly or runs for minutes: cost, not correctness, which
 the catalogues cover with single extreme rows).
 
@@ -68,8 +68,8 @@ def _signed(lo: float, hi: float):
 @st.composite
 def rows(draw, fast_arms: bool = False) -> dict:
     """One scene as a dict of input columns (SI units); arm times from 1e-4 T with
-    ``fast_arms`` (element path), else from 1.3e-3 T (the full-stick continuum path takes
-    arms slower than 1e-3 T: no element kernel to compile in the default run)."""
+    ``fast_arms`` (with friction: the element path), else from 1.3e-3 T (full stick
+    only: no element kernel to compile in the default run)."""
     tau_lo = -4.0 if fast_arms else -2.9
     model = draw(st.sampled_from(v.MODELS))
     nu = draw(st.one_of(st.sampled_from((0.0, 0.5)), st.floats(0.0, 0.5)))
@@ -173,5 +173,5 @@ def test_extreme_admissible_inputs_end_in_a_valid_number_or_a_status(batch):
 @pytest.mark.slow  # compiles the element kernel for four sets of effects (minutes when cold)
 @settings(max_examples=40, **SETTINGS)
 @given(st.lists(rows(fast_arms=True), min_size=ROWS, max_size=ROWS))
-def test_extreme_inputs_with_fast_arms_on_the_element_path(batch):
+def test_extreme_inputs_with_fast_arms_and_friction(batch):
     check(batch)

@@ -40,11 +40,15 @@ class ContinuumReference:
 
 
 def maxwell_continuum_reference(tau0: float, g, tau, kappa: float, mu_t: float,
-                                tangential: bool = True, rtol: float = 1e-12) -> ContinuumReference:
+                                tangential: bool = True, rtol: float = 1e-12,
+                                method: str = "DOP853") -> ContinuumReference:
     """Full-stick continuum impact of section 11 in kernel units (slow, ~seconds).
 
     ``tau0`` dashpot time, ``g``/``tau`` arm moduli and times (``tau > 0``),
     ``kappa = 2 (1 - nu) / (2 - nu)``, ``mu_t = 1 + m R^2 / Theta``.
+    ``method`` is the scipy integrator of both phases: ``"DOP853"`` (explicit),
+    or ``"Radau"`` / ``"BDF"`` / ``"LSODA"`` for arms much faster than the
+    contact (stiff; their Jacobian by finite differences).
     Returns ``e_z``, ``beta_x = -v_c,end`` (NaN without ``tangential``),
     ``t_contact``, ``u_max``, ``t_turn``.
     """
@@ -86,7 +90,7 @@ def maxwell_continuum_reference(tau0: float, g, tau, kappa: float, mu_t: float,
     y0 = np.zeros(6 + 4 * n)
     y0[1] = 1.0
     y0[4 + 2 * n] = 1.0 if tangential else 0.0
-    ld = solve_ivp(load, (0.0, 1e3), y0, method="DOP853", rtol=rtol, atol=atol,
+    ld = solve_ivp(load, (0.0, 1e3), y0, method=method, rtol=rtol, atol=atol,
                    events=turn, dense_output=True)
     if ld.status != 1:
         raise RuntimeError("no turning point")
@@ -143,7 +147,7 @@ def maxwell_continuum_reference(tau0: float, g, tau, kappa: float, mu_t: float,
 
     z0 = np.concatenate([[b_max ** 2, 0.0], yt[3:3 + n], [yt[3 + 2 * n], yt[4 + 2 * n]],
                          yt[6 + 2 * n:6 + 3 * n]])
-    ul = solve_ivp(unload, (t_turn, t_turn + 1e3), z0, method="DOP853", rtol=rtol, atol=atol,
+    ul = solve_ivp(unload, (t_turn, t_turn + 1e3), z0, method=method, rtol=rtol, atol=atol,
                    events=end)
     if ul.status != 1:
         raise RuntimeError("no end of contact")

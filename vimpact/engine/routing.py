@@ -31,11 +31,6 @@ CONTINUUM = "continuum"
 CONTINUUM_STICK = "continuum_stick"
 ELEMENTS = "elements"
 
-#: The full-stick continuum kernel integrates the arms explicitly: an arm faster
-#: than this fraction of the time unit T would cost ~T/tau_i steps, and the
-#: element path (exact arm update) takes the scene instead.
-STIFF_ARM_TIME = 1e-3
-
 #: Below this incidence psi = 2 (1 - nu) / (mu (2 - nu)) |v_c0| / v_z0 a finite mu is
 #: full stick to rounding: friction moves beta_x by at most about psi (measured on a
 #: Kelvin-Voigt scene: 1.0e-4, 3.6e-6, 7e-8 and 7e-13 at psi = 2.7e-4, 2.7e-6, 2.7e-7
@@ -149,15 +144,13 @@ def route(cols: SceneColumns, numerics: Numerics) -> Routes:
 def continuum_stick(cols: SceneColumns, numerics: Numerics, friction: np.ndarray) -> np.ndarray:
     """Rows the full-stick continuum kernel can take: continuum allowed, no
     friction (``friction``: :func:`friction_rows`, as :func:`route` has it),
-    incremental memory (or no tangential problem), no arm faster than
-    :data:`STIFF_ARM_TIME` T. Its run-time assumptions (one contact interval, no
-    re-entry) are checked by the kernel, which hands a row back otherwise."""
+    incremental memory (or no tangential problem), whatever the arms (it updates
+    each arm exactly over a step, docs/physics.md#arms-of-any-relaxation-time). Its
+    run-time assumptions (one contact interval, no re-entry) are checked by the
+    kernel, which hands a row back otherwise."""
     tangential = cols.computes_tangential
     incremental = cols.memory == TANGENTIAL_MEMORY.index("incremental")
-    real = cols.G_arm > 0.0
-    fast_arm = (real & (cols.tau_arm < STIFF_ARM_TIME * cols.T[:, None])).any(axis=1)
-    return (numerics.continuum & cols.valid & ~friction & (incremental | ~tangential)
-            & ~fast_arm)
+    return numerics.continuum & cols.valid & ~friction & (incremental | ~tangential)
 
 
 def handover_reason(status: int) -> str:
@@ -213,9 +206,6 @@ def choose_path(scene: Scene, numerics: Numerics) -> Path:
             reasons.append("Coulomb friction (slip) needs the element row")
         elif tangential and scene.tangential_memory != "incremental":
             reasons.append("seed tangential memory needs the element row")
-        else:
-            reasons.append(f"an arm faster than {STIFF_ARM_TIME:g} T would make the continuum "
-                           "kernel stiff; the element row updates arms exactly")
     if not numerics.continuum:
         reasons.append("continuum path switched off (Numerics.continuum = False)")
     else:
