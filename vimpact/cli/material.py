@@ -41,7 +41,7 @@ def add_parser(sub) -> None:
                      help="Poisson ratio, dimensionless, in [0, 0.5] (required)")
     fit.add_argument("--out", required=True, metavar="FILE.toml",
                      help="the material file to write (TOML)")
-    fit.add_argument("--per-decade", type=float, default=2.0, metavar="N",
+    fit.add_argument("--per-decade", type=float, default=None, metavar="N",
                      help="relaxation times per decade of the data's span (default 2)")
     fit.add_argument("--dashpot", action="store_true",
                      help="DMA data: also fit a parallel dashpot eta0 (a loss growing like "
@@ -96,7 +96,7 @@ def _shift(a):
 
 def run_fit(a: argparse.Namespace) -> int:
     """Handler of ``vimpact material fit``; returns the exit code."""
-    from vimpact.model.fit import load_measurements
+    from vimpact.model.fit import DEFAULT_PER_DECADE, load_measurements
     from vimpact.model.material import Material, shear_modulus
     from vimpact.model.material_file import material_toml
     from vimpact.model.validation import poisson_ratio
@@ -112,6 +112,8 @@ def run_fit(a: argparse.Namespace) -> int:
     except ValueError as exc:
         raise ValueError(str(exc)) from None
     shift = _shift(a)
+    if a.per_decade is None:
+        a.per_decade = DEFAULT_PER_DECADE
     kind, cols = load_measurements(a.data)
     scale = shear_modulus(1.0, nu) if a.tensile else 1.0
     if kind == "dma":

@@ -121,7 +121,7 @@ class Material:
 
     @classmethod
     def from_dma(cls, frequency_Hz, storage_Pa, loss_Pa, nu: float, *,
-                 per_decade: float = 1.0, dashpot: bool = False,
+                 per_decade: float = 2.0, dashpot: bool = False,
                  shift: ShiftLaw | None = None) -> "PronyFit":
         """A Prony material fitted to a dynamic (DMA) master curve of the shear moduli.
 
@@ -134,7 +134,8 @@ class Material:
         frequency_Hz : frequencies ``f`` (Hz, > 0; ``omega = 2 pi f``)
         storage_Pa, loss_Pa : shear storage and loss moduli ``G'``, ``G''`` at ``f``, Pa
         nu : Poisson ratio, dimensionless, in [0, 0.5]
-        per_decade : relaxation times per decade of the data's span
+        per_decade : relaxation times per decade of the data's span (default 2,
+            :data:`vimpact.model.fit.DEFAULT_PER_DECADE`)
         dashpot : fit a parallel dashpot ``eta0`` (a loss ``G'' ~ eta0 omega``) too
         shift : the material's temperature shift law (``T_ref``: the master curve's)
         """
@@ -143,7 +144,7 @@ class Material:
                        dashpot=dashpot, shift=shift)
 
     @classmethod
-    def from_relaxation(cls, time_s, modulus_Pa, nu: float, *, per_decade: float = 1.0,
+    def from_relaxation(cls, time_s, modulus_Pa, nu: float, *, per_decade: float = 2.0,
                         shift: ShiftLaw | None = None) -> "PronyFit":
         """A Prony material fitted to a shear relaxation modulus ``G(t)`` (Pa at ``t`` in s).
 
