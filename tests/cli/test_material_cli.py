@@ -101,6 +101,8 @@ def _rows_with(i, cell):
     (lambda p: _csv(p, _rows_with(4, "1.0,nan,1e5")), [], "line 7: storage_Pa = 'nan'"),
     (lambda p: _csv(p, _rows_with(1, "1.0,1e6,abc")), [], "line 4: loss_Pa = 'abc'"),
     (lambda p: _csv(p, _dma_rows(2)), [], "frequency_Hz (number of distinct values) = 2"),
+    (lambda p: _csv(p, _dma_rows(20, step=9)), ["--per-decade", "4"], "data.csv: frequency_Hz (number "
+     "of points) = 3 is not allowed: must be enough for 10 unknown moduli"),
     (lambda p: _csv(p, header="frequency,storage,loss"), [], "columns = 'frequency, storage"),
     (lambda p: _csv(p), ["--T-ref", "0", "--wlf", "17.44", "51.6"], "--T-ref = 0.0"),
     (lambda p: _csv(p), ["--wlf", "17.44", "51.6"], "--wlf needs the reference temperature"),
@@ -117,9 +119,10 @@ def test_bad_fit_input_exits_2_with_one_line(tmp_path, capsys, make, args, words
     assert not (tmp_path / "m.toml").exists()
 
 
-def _dma_rows(n):
-    storage, loss = _dma(FREQ[:n])
-    return [f"{f:.17g},{s:.17g},{l:.17g}" for f, s, l in zip(FREQ[:n], storage, loss)]
+def _dma_rows(n, step=1):
+    f = FREQ[:n:step]
+    storage, loss = _dma(f)
+    return [f"{a:.17g},{s:.17g},{l:.17g}" for a, s, l in zip(f, storage, loss)]
 
 
 def _material(tmp_path, shift='law = "wlf"\nT_ref_K = 250.0\nC1 = 17.44\nC2_K = 51.6'):

@@ -147,6 +147,7 @@ def test_unordered_data_are_fitted_like_ordered_data():
     (lambda f, s, l: (f, s, -l), "loss_Pa[0]"),
     (lambda f, s, l: (f[:2], s[:2], l[:2]), "frequency_Hz (number of distinct values)"),
     (lambda f, s, l: (np.full_like(f, 3.0), s, l), "frequency_Hz (number of distinct values)"),
+    (lambda f, s, l: (f[::8], s[::8], l[::8]), "frequency_Hz (number of points)"),
     (lambda f, s, l: (f[None, :], s, l), "frequency_Hz"),
     (lambda f, s, l: ("abc", s, l), "frequency_Hz"),
 ])

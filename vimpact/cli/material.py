@@ -151,8 +151,8 @@ def _named(data: str, fit, *args, **kwargs):
         return fit(*args, **kwargs)
     except ValueError as exc:
         text = str(exc).replace("per_decade =", "--per-decade =")
-        raise ValueError(text if text.startswith("per_decade") or "--per-decade" in text
-                         else f"{data}: {text}") from None
+        raise ValueError(text if text.startswith("--per-decade") else f"{data}: {text}") \
+            from None
 
 
 def run_show(a: argparse.Namespace) -> int:

@@ -20,6 +20,12 @@ Closed forms fitted (shear moduli, ``omega = 2 pi f``)::
 The residual reported is the root mean square of the relative misfits
 ``(model - data) / data`` over every fitted value (``G'`` and ``G''`` both count
 for a DMA curve), dimensionless.
+
+Why SciPy's ``nnls`` and not a fitting package: the maintained one on PyPI,
+pyvisco, solves the same non-negative problem with the same SciPy routine, but
+it requires a Jupyter/Voila user-interface stack (jupyterlab, notebook,
+voila, ipywidgets, ipympl) and works on its own DataFrame formats; the fit
+itself is a few lines on top of a dependency vimpact already has.
 """
 
 from __future__ import annotations
@@ -107,6 +113,7 @@ def fit_dma(frequency_Hz, storage_Pa, loss_Pa, nu: float, *,
         top = np.hstack([top, np.zeros((len(w), 1))])
         bottom = np.hstack([bottom, w[:, None]])
     A = np.vstack([top / storage[:, None], bottom / loss[:, None]])
+    _enough(A, "frequency_Hz", per_decade)
     x, residual = _nnls(A)
     return PronyFit(_material(nu, x, taus, dashpot, shift, "the lowest frequencies"), residual)
 
@@ -124,6 +131,7 @@ def fit_relaxation(time_s, modulus_Pa, nu: float, *,
     per_decade = _per_decade(per_decade)
     taus = relaxation_times(t.min(), t.max(), per_decade)
     A = np.hstack([np.ones((len(t), 1)), np.exp(-t[:, None] / taus[None, :])]) / G[:, None]
+    _enough(A, "time_s", per_decade)
     x, residual = _nnls(A)
     return PronyFit(_material(nu, x, taus, False, shift, "the longest times"), residual)
 
@@ -156,6 +164,15 @@ def _columns(data: dict) -> tuple[np.ndarray, ...]:
     require(f"{first} (number of distinct values)", n, n >= MIN_POINTS, f">= {MIN_POINTS}")
     order = np.argsort(out[0], kind="stable")
     return tuple(x[order] for x in out)
+
+
+def _enough(A: np.ndarray, name: str, per_decade: float) -> None:
+    """Refuse a fit with more unknowns than fitted values (it would match any data)."""
+    values, unknowns = A.shape
+    require(f"{name} (number of points)", values // (2 if name == "frequency_Hz" else 1),
+            values >= unknowns, f"enough for {unknowns} unknown moduli ({values} fitted values "
+            f"now); give more points or fewer relaxation times per decade (per_decade = "
+            f"{per_decade:g})")
 
 
 def _nnls(A: np.ndarray) -> tuple[np.ndarray, float]:

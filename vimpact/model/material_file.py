@@ -210,7 +210,7 @@ def inline_material(source: str, data: dict, table: str, base: Path | None,
         ok = isinstance(T, (int, float)) and not isinstance(T, bool) and 0.0 < T < math.inf
         if not ok:
             raise _err(source, f"{table}.temperature_K", T,
-                       "an absolute temperature in kelvin, a finite number > 0")
+                       "an absolute temperature in kelvin, one finite number > 0")
         mat = at_temperature(mat, float(T), f"{table}.temperature_K", source)
     model = data.get("model", mat.model)
     if model != mat.model:
