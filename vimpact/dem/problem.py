@@ -44,6 +44,7 @@ import numpy as np
 
 from vimpact.model.material import Material
 from vimpact.model.material_file import at_temperature, resolve_material
+from vimpact.model.material_file import bad_value as _err, toml_number as _num
 from vimpact.model.material_file import material_from_table  # noqa: F401 (its former home)
 from vimpact.model.pair import Body, Wall, pair_material
 from vimpact.model.scene import DEFAULT_THETA_RATIO
@@ -172,16 +173,6 @@ class DemProblem:
             if (c.first.name, c.second.name) in ((a, b), (b, a)):
                 return c
         raise InputError(message("contact", f"{a}-{b}", "a pair of known type or wall names"))
-
-
-def _err(source: str, what: str, value, allowed: str) -> InputError:
-    return InputError(f"{source}: " + message(what, value, allowed))
-
-
-def _num(source: str, where: str, value) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise _err(source, where, value, "a number")
-    return float(value)
 
 
 def problem_from_toml(text: str, source: str = "<string>", *, base: Path | None = None,

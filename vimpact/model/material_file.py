@@ -32,7 +32,7 @@ from pathlib import Path
 
 from vimpact.model.material import Material, shear_modulus
 from vimpact.model.temperature import LAWS, ShiftLaw
-from vimpact.model.toml_input import read_toml
+from vimpact.model.toml_input import MATERIAL_KEYS, read_toml
 from vimpact.model.validation import InputError, message, positive, require
 
 #: Keys of a material table, per model.
@@ -47,14 +47,19 @@ SHIFT_KEYS = {"wlf": ("law", "T_ref_K", "C1", "C2_K"),
               "arrhenius": ("law", "T_ref_K", "E_a_J_mol")}
 
 
-def _err(source: str, what: str, value, allowed: str) -> InputError:
+def bad_value(source: str, what: str, value, allowed: str) -> InputError:
+    """The error of a bad TOML value: ``SOURCE: what = value is not allowed: must be ...``."""
     return InputError(f"{source}: " + message(what, value, allowed))
 
 
-def _num(source: str, where: str, value) -> float:
+def toml_number(source: str, where: str, value) -> float:
+    """A TOML integer or float (not a bool) as a float; else :func:`bad_value`."""
     if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise _err(source, where, value, "a number")
+        raise bad_value(source, where, value, "a number")
     return float(value)
+
+
+_err, _num = bad_value, toml_number
 
 
 def shift_from_table(table, where: str = "shift", source: str = "<string>") -> ShiftLaw:
@@ -178,14 +183,15 @@ def table_values(material: Material) -> tuple[dict, list]:
     return values, arms
 
 
-def inline_material(source: str, data: dict, table: str, base: Path | None,
-                    material_keys) -> tuple[dict, str]:
+def inline_material(source: str, data: dict, table: str,
+                    base: Path | None) -> tuple[dict, str]:
     """``data`` (a parsed scene file or sweep spec) with the material file named by
     ``[table] material`` (shifted to ``[table] temperature_K``) written out as the
     table's value keys, and ``model`` set to the file's; unchanged without ``material``.
 
     Returns the new data and the text of the material file read ("" without one).
-    ``material_keys`` are the keys the file replaces (given beside it: an error).
+    The material keys of every model (:data:`~vimpact.model.toml_input.MATERIAL_KEYS`),
+    ``nu`` and ``arms`` beside ``material`` are an error: the file gives them.
     """
     values = data.get(table)
     if not isinstance(values, dict) or ("material" not in values
@@ -195,7 +201,8 @@ def inline_material(source: str, data: dict, table: str, base: Path | None,
         raise InputError(f"{source}: {table}.temperature_K = {values['temperature_K']!r} is "
                          "not allowed: must come with a material file ({table}.material), "
                          "whose shift law it applies")
-    given = sorted(k for k in values if k in set(material_keys) | {"nu", "arms"})
+    replaced = {k for keys in MATERIAL_KEYS.values() for k in keys} | {"nu", "arms"}
+    given = sorted(k for k in values if k in replaced)
     if given:
         raise InputError(f"{source}: {table}.{given[0]} cannot be combined with "
                          f"{table}.material: the material file gives the whole material")
@@ -253,5 +260,5 @@ def material_toml(material: Material, comment: str = "") -> str:
 
 
 __all__ = ["MATERIAL_FILE_KEYS", "MATERIAL_TABLE_KEYS", "SHIFT_KEYS", "at_temperature",
-           "inline_material", "load_material", "material_from_table", "material_toml",
-           "resolve_material", "shift_from_table", "table_values"]
+           "bad_value", "inline_material", "load_material", "material_from_table", "material_toml",
+           "resolve_material", "shift_from_table", "table_values", "toml_number"]

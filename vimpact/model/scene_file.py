@@ -80,7 +80,7 @@ from pathlib import Path
 from vimpact.model.material_file import inline_material
 from vimpact.model.numerics import Numerics
 from vimpact.model.scene import ScaleError, Scene
-from vimpact.model.toml_input import (ARM_KEYS, MATERIAL_KEYS, PHYSICAL_DEFAULTS,
+from vimpact.model.toml_input import (ARM_KEYS, PHYSICAL_DEFAULTS,
                                       SWEEP_TOP_KEYS, TomlSource, friction_coefficient,
                                       impact_angle, input_keys, parse_header, parse_numerics,
                                       parse_toml, read_toml, required_keys, scene_from_values)
@@ -143,8 +143,7 @@ def _scene(spec: TomlSource, text: str, data: dict,
     source = spec.path
     _top_keys(spec, data)
     # [scene] material = "FILE.toml" (and temperature_K): the file's values, written out
-    data, _ = inline_material(str(source), data, "scene", base,
-                              {k for keys in MATERIAL_KEYS.values() for k in keys})
+    data, _ = inline_material(str(source), data, "scene", base)
     header = parse_header(spec, data)
     allow_large = spec.flag(data, "allow_large_contact", False)
     numerics = parse_numerics(spec, data["numerics"]) if "numerics" in data else None

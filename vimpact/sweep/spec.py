@@ -606,8 +606,7 @@ def load_spec(path) -> SweepSpec:
     spec = TomlSource(path)
     spec.unknown(data, SWEEP_TOP_KEYS)
     # [random] material = "FILE.toml" (and temperature_K): the file's values, fixed
-    data, material_text = inline_material(str(path), data, "random", path.parent,
-                                          {k for keys in MATERIAL_KEYS.values() for k in keys})
+    data, material_text = inline_material(str(path), data, "random", path.parent)
     header = parse_header(spec, data)
     model = header.model
     chunk_size = spec.integer("chunk_size", data.get("chunk_size", DEFAULT_CHUNK_SIZE), 1)
