@@ -162,3 +162,30 @@ def test_dem_temperature_option_is_checked(tmp_path, capsys):
     code, _, err = _run(["dem", str(ROOT / "sweeps/dem/synthetic_rubber.toml"), "--for", "lammps",
                          "--temperature", "0", "--out", str(tmp_path)], capsys)
     assert code == 2 and err.count("\n") == 1 and "--temperature = 0.0 is not allowed" in err
+
+
+def test_a_sweep_of_a_material_file_at_a_temperature(tmp_path, capsys):
+    """``vimpact sweep``: [random] names the material file and temperature_K; the table's
+    arm columns are the file's times times a_T, and its e_z is simulate()'s."""
+    import pandas as pd
+
+    from vimpact.model.material_file import material_toml
+
+    law = v.ShiftLaw.wlf(250.0, 17.44, 51.6)
+    material = v.Material.prony(nu=0.49, G_inf=G_INF, arms=ARMS).with_shift(law)
+    (tmp_path / "m.toml").write_text(material_toml(material), encoding="utf-8")
+    spec = tmp_path / "sweep.toml"
+    spec.write_text('seed = 3\n[numerics]\npreset = "fast"\n[random]\nrows = 2\n'
+                    'material = "m.toml"\ntemperature_K = 262.0\nR_m = 0.01\nm_kg = 0.004\n'
+                    'v_z0_m_s = [0.2, 0.5]\n', encoding="utf-8")
+    out = tmp_path / "t.parquet"
+    code, _, err = _run(["sweep", str(spec), "--out", str(out)], capsys)
+    assert code == 0, err
+    table = pd.read_parquet(out)
+    shifted = material.at_temperature(262.0)
+    for k, (G, tau) in enumerate(shifted.arms, start=1):
+        assert (table[f"G_arm{k}_Pa"] == G).all() and (table[f"tau_arm{k}_s"] == tau).all()
+    for row in table.itertuples():
+        res = v.simulate(v.Scene(shifted, R=0.01, m=0.004, v_z0=row.v_z0_m_s),
+                         v.Numerics.preset("fast"))
+        assert row.e_z == pytest.approx(res.e_z, abs=1e-12)
