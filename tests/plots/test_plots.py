@@ -43,9 +43,12 @@ def tables(tmp_path_factory):
 #: the friction figures simulate ~100 oblique impacts each: drawn in
 #: tests/plots/test_friction_figures.py (slow), their data checked there
 FRICTION = ("fig_mbf", "fig_beta_psi", "fig_chung_ooi")
+#: e_z(v) of the example polymer at five temperatures (45 impacts on the element path):
+#: drawn in tests/plots/test_temperature_figure.py (slow)
+TEMPERATURE = ("fig_temperature",)
 
 
-@pytest.mark.parametrize("name", [n for n in FIGURE_NAMES if n not in FRICTION])
+@pytest.mark.parametrize("name", [n for n in FIGURE_NAMES if n not in FRICTION + TEMPERATURE])
 def test_every_figure_renders_png(name, tables, tmp_path):
     out = tmp_path / f"{name}.png"
     path = plot_figure(name, out, table=tables.get(name))
@@ -97,7 +100,7 @@ def test_figure_errors(tables, tmp_path):
 
 def test_figure_names():
     assert set(FIGURE_NAMES) == {"fig3_2", "fig4_2", "fig4_4", "fig5_1", "fig5_2", "fig5_3",
-                                 "fig5_4", "fig5_5", *FRICTION}
+                                 "fig5_4", "fig5_5", *FRICTION, *TEMPERATURE}
     assert figure_name("5.2") == figure_name("Fig 5.2") == figure_name("fig5_2") == "fig5_2"
     assert all(FIGURES[n].spec for n in FIGURE_NAMES if n.startswith("fig5"))
 

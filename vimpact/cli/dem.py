@@ -20,6 +20,10 @@ def add_parser(sub) -> None:
     p.add_argument("--for", dest="code", required=True, choices=CODES, help="the DEM code")
     p.add_argument("--out", default=None,
                    help="output directory (default: vimpact-dem-<code> in the current directory)")
+    p.add_argument("--temperature", type=float, default=None, metavar="K",
+                   help="temperature of the DEM run, kelvin (> 0): every viscoelastic "
+                        "material is shifted to it by its shift law (overrides the set-up's "
+                        "temperature_K)")
     p.add_argument("--preset", default="fast", choices=("fast", "default", "precise"),
                    help="vimpact numerics for the restitution curves (default: fast)")
     p.set_defaults(func=run)
@@ -30,7 +34,7 @@ def run(args: argparse.Namespace) -> int:
     from vimpact.dem.problem import load_problem
     from vimpact.model.numerics import Numerics
 
-    problem = load_problem(args.file)
+    problem = load_problem(args.file, temperature=args.temperature)
     out = args.out or f"vimpact-dem-{args.code}"
     result = export(problem, args.code, out, Numerics.preset(args.preset))
     for f in result.fits:

@@ -17,7 +17,7 @@ import sys
 from vimpact import __version__
 
 #: Subcommands in the order ``vimpact --help`` lists them; module ``vimpact.cli.<name>``.
-SUBCOMMANDS = ("simulate", "sweep", "table", "plot", "bench", "dem")
+SUBCOMMANDS = ("simulate", "sweep", "table", "plot", "bench", "dem", "material")
 
 
 class _Parser(argparse.ArgumentParser):

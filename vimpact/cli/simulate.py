@@ -38,6 +38,12 @@ def add_parser(sub) -> argparse.ArgumentParser:
     g = sim.add_argument_group("material (physical input)")
     g.add_argument("--model", choices=MODELS, help="rheology (default: inferred)")
     add_material_arguments(g, prony=True)
+    g.add_argument("--material", metavar="FILE",
+                   help="read the material from a material file (TOML, e.g. written by "
+                        "vimpact material fit) instead of the options above")
+    g.add_argument("--temperature", type=float, metavar="K",
+                   help="temperature, kelvin (> 0): the relaxation times of --material are "
+                        "shifted by its shift law's a_T (a scene file: temperature_K)")
     g = sim.add_argument_group("sphere and impact (physical input)")
     g.add_argument("--R", type=float, metavar="M", help="sphere radius, m")
     g.add_argument("--m", type=float, metavar="KG", help="sphere mass, kg")
@@ -160,7 +166,8 @@ def _scene_from_args(a) -> Scene:
                          f"{a.theta_ratio:g}: give one of them")
     ratio = a.theta_ratio if a.theta_ratio is not None else DEFAULT_THETA_RATIO
     if a.Q1 is not None:
-        given = [f"--{n}" for n in _PHYSICAL if getattr(a, n) is not None]
+        given = [f"--{n}" for n in _PHYSICAL + ("material", "temperature")
+                 if getattr(a, n) is not None]
         given += [f"--{n}" for n in ("vx0", "omega0") if getattr(a, n) != 0.0]
         if given:
             raise ValueError(f"{', '.join(given)} cannot be combined with --Q1: give either "
@@ -173,7 +180,10 @@ def _scene_from_args(a) -> Scene:
         return Scene.from_dimensionless(a.Q1, a.nu, a.Q2, theta_ratio=ratio, **effects)
     if a.Q2 is not None:
         raise missing("Q1", "--Q2 is part of the dimensionless input --Q1 --Q2 --nu")
-    material = material_from_args(a)
+    if a.temperature is not None and a.material is None:
+        raise ValueError(f"--temperature = {a.temperature:g} needs --material FILE: a material "
+                         "file with a temperature shift law (vimpact material fit)")
+    material = _material_file(a) if a.material is not None else material_from_args(a)
     for name, what in (("R", "sphere radius, m"), ("m", "sphere mass, kg"),
                        ("vz0", "normal impact speed, m/s")):
         if getattr(a, name) is None:
@@ -185,12 +195,35 @@ def _scene_from_args(a) -> Scene:
                  allow_large_contact=a.allow_large_contact, **effects)
 
 
+def _material_file(a):
+    """The material of ``--material FILE`` (at ``--temperature``); material options
+    beside it are refused."""
+    from vimpact.model.material_file import load_material  # TOML reading: only when asked
+
+    given = [f"--{n}" for n in ("model", "E", "G", "eta", "G1", "G2", "prony", "nu")
+             if getattr(a, n) is not None]
+    if given:
+        raise ValueError(f"{', '.join(given)} cannot be combined with --material: the file "
+                         "describes the whole material")
+    return _at_temperature(load_material(a.material), a.temperature)
+
+
+def _at_temperature(material, T):
+    """``material`` at ``--temperature`` (unchanged without the option)."""
+    if T is None:
+        return material
+    try:
+        return material.at_temperature(T)
+    except InputError as exc:
+        raise InputError(str(exc).replace("temperature (K) =", "--temperature =", 1)) from None
+
+
 def _scene_file(a) -> tuple[Scene, Numerics | None]:
     """Scene and numerics of ``--scene FILE``; scene options beside it are refused."""
     from vimpact.model.scene_file import load_scene  # TOML reading: only when asked
 
-    given = [f"--{n.replace('_', '-')}" for n in _PHYSICAL + ("Q1", "Q2", "nu") + tuple(_EFFECTS)
-             if getattr(a, n) is not None]
+    given = [f"--{n.replace('_', '-')}" for n in _PHYSICAL + ("Q1", "Q2", "nu", "material")
+             + tuple(_EFFECTS) if getattr(a, n) is not None]
     given += [f"--{n.replace('_', '-')}" for n, default in
               (("vx0", 0.0), ("omega0", 0.0), ("theta_ratio", None), ("mu", None),
                ("no_rotation", False))
@@ -198,6 +231,10 @@ def _scene_file(a) -> tuple[Scene, Numerics | None]:
     if given:
         raise ValueError(f"{', '.join(given)} cannot be combined with --scene: the file "
                          "describes the whole scene")
+    if a.temperature is not None:
+        raise ValueError(f"--temperature = {a.temperature:g} cannot be combined with --scene: "
+                         "give temperature_K (kelvin) in the scene file's [scene] table, "
+                         "beside its material file")
     scene, numerics = load_scene(a.scene)
     if a.allow_large_contact:
         scene = dataclasses.replace(scene, allow_large_contact=True)

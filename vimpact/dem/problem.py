@@ -17,8 +17,14 @@ Read from a TOML file (example: ``sweeps/dem/two_rubbers.toml``)::
     E = 5e6                  # Pa (or G); kelvin_voigt: eta (Pa s)
     eta = 20.0               # standard_solid: G1, G2 (or E1, E2), eta; prony: G_inf
                              # (or E_inf), arms = [[G_i, tau_i], ...], eta0
+                             # optional [types.soft.material.shift]: temperature
+                             # shift law (docs/howto/dma.md); or material = "FILE.toml",
+                             # a material file (vimpact material fit), relative to this file
     [walls.floor]
-    material = "rigid"       # or a material table as above
+    material = "rigid"       # or a material table as above, or a material file
+
+    temperature_K = 296.0    # optional (top level): the temperature of the DEM run, K;
+                             # every viscoelastic material then needs a shift law
 
     [friction]               # Coulomb coefficients, by "type-type" or "type-wall"
     default = 0.5
@@ -36,20 +42,19 @@ from pathlib import Path
 
 import numpy as np
 
-from vimpact.model.material import Material, shear_modulus
+from vimpact.model.material import Material
+from vimpact.model.material_file import at_temperature, resolve_material
+from vimpact.model.material_file import bad_value as _err, toml_number as _num
+from vimpact.model.material_file import material_from_table  # noqa: F401 (its former home)
 from vimpact.model.pair import Body, Wall, pair_material
 from vimpact.model.scene import DEFAULT_THETA_RATIO
-from vimpact.model.validation import InputError, message, positive, require
+from vimpact.model.validation import InputError, message
 
+#: top-level keys of a DEM set-up
+_TOP_KEYS = ("speeds", "types", "walls", "friction", "temperature_K")
 #: speed points when ``[speeds] n`` is not given
 DEFAULT_SPEED_POINTS = 24
 
-_MATERIAL_KEYS = {
-    "elastic": {"model", "nu", "E", "G"},
-    "kelvin_voigt": {"model", "nu", "E", "G", "eta"},
-    "standard_solid": {"model", "nu", "G1", "G2", "E1", "E2", "eta"},
-    "prony": {"model", "nu", "G_inf", "E_inf", "arms", "eta0"},
-}
 
 
 @dataclass(frozen=True)
@@ -170,65 +175,37 @@ class DemProblem:
         raise InputError(message("contact", f"{a}-{b}", "a pair of known type or wall names"))
 
 
-def _err(source: str, what: str, value, allowed: str) -> InputError:
-    return InputError(f"{source}: " + message(what, value, allowed))
+def problem_from_toml(text: str, source: str = "<string>", *, base: Path | None = None,
+                      temperature: float | None = None) -> DemProblem:
+    """Parse a DEM set-up (module doc) from TOML text.
 
-
-def _num(source: str, where: str, value) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise _err(source, where, value, "a number")
-    return float(value)
-
-
-def material_from_table(table, where: str = "material", source: str = "<string>") -> Material:
-    """A :class:`vimpact.Material` from a TOML table (keys in the module doc)."""
-    if not isinstance(table, dict):
-        raise _err(source, where, table, 'a table with "model" and its moduli')
-    model = table.get("model")
-    require(f"{source}: {where}.model", model, model in _MATERIAL_KEYS,
-            "one of " + ", ".join(map(repr, _MATERIAL_KEYS)))
-    unknown = sorted(set(table) - _MATERIAL_KEYS[model])
-    if unknown:
-        raise _err(source, f"{where} key", unknown[0],
-                   f"one of {sorted(_MATERIAL_KEYS[model])} for model {model!r}")
-    v = {k: (_num(source, f"{where}.{k}", x) if k not in ("model", "arms") else x)
-         for k, x in table.items()}
-    if "nu" not in v:
-        raise _err(source, f"{where}.nu", None, "given (Poisson ratio in [0, 0.5])")
-    nu = v["nu"]
-    try:
-        if model == "elastic":
-            return Material.elastic(nu=nu, G=v.get("G"), E=v.get("E"))
-        if model == "kelvin_voigt":
-            require(f"{where}.eta", None, "eta" in v, "given (Pa s)")
-            return Material.kelvin_voigt(nu=nu, eta=v["eta"], G=v.get("G"), E=v.get("E"))
-        if model == "standard_solid":
-            G1 = v["G1"] if "G1" in v else shear_modulus(positive("E1", v.get("E1")), nu)
-            G2 = v["G2"] if "G2" in v else shear_modulus(positive("E2", v.get("E2")), nu)
-            require(f"{where}.eta", None, "eta" in v, "given (Pa s)")
-            return Material.standard_solid(nu=nu, G1=G1, G2=G2, eta=v["eta"])
-        G_inf = v["G_inf"] if "G_inf" in v else shear_modulus(positive("E_inf", v.get("E_inf")), nu)
-        arms = v.get("arms", [])
-        require(f"{where}.arms", arms, isinstance(arms, list) and all(
-            isinstance(a, list) and len(a) == 2 for a in arms), "a list of [G_i (Pa), tau_i (s)]")
-        arms = [(_num(source, f"{where}.arms", a[0]), _num(source, f"{where}.arms", a[1]))
-                for a in arms]
-        return Material.prony(nu=nu, G_inf=G_inf, arms=arms, eta0=v.get("eta0", 0.0))
-    except InputError as exc:
-        if str(exc).startswith(source):
-            raise
-        raise InputError(f"{source}: {where}: {exc}") from None
-
-
-def problem_from_toml(text: str, source: str = "<string>") -> DemProblem:
-    """Parse a DEM set-up (module doc) from TOML text."""
+    Parameters
+    ----------
+    text : the TOML text; ``source`` names it in error messages
+    base : directory against which material file paths are resolved (default: the
+        current directory)
+    temperature : the temperature of the DEM run, K; overrides the file's
+        ``temperature_K``; every viscoelastic material is shifted to it
+    """
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise InputError(f"{source}: not valid TOML: {exc}") from None
-    unknown = sorted(set(data) - {"speeds", "types", "walls", "friction"})
+    unknown = sorted(set(data) - set(_TOP_KEYS))
     if unknown:
-        raise _err(source, "top-level key", unknown[0], "one of speeds, types, walls, friction")
+        raise _err(source, "top-level key", unknown[0], "one of " + ", ".join(_TOP_KEYS))
+    where_T = "--temperature" if temperature is not None else "temperature_K"
+    T = temperature if temperature is not None else data.get("temperature_K")
+    if T is not None:
+        T = _num(source, where_T, T)
+        if not (0.0 < T < math.inf):
+            raise _err(source, where_T, T, "an absolute temperature in kelvin, a finite number > 0")
+
+    def material(value, where):
+        mat = resolve_material(value, where, source, base)
+        if T is None or (not mat.arms and mat.eta0 == 0.0):  # elastic: no times to shift
+            return mat
+        return at_temperature(mat, T, f"{where} at {where_T} = {T!r} K", source)
     sp = data.get("speeds")
     if not isinstance(sp, dict) or "min" not in sp or "max" not in sp:
         raise _err(source, "[speeds]", sp, "a table with min and max (m/s)")
@@ -280,7 +257,7 @@ def problem_from_toml(text: str, source: str = "<string>") -> DemProblem:
         theta = _num(source, f"{where}.theta_ratio", t.get("theta_ratio", DEFAULT_THETA_RATIO))
         if not (0.0 < theta < math.inf):
             raise _err(source, f"{where}.theta_ratio", theta, "a finite number > 0")
-        mat = material_from_table(t["material"], f"{where}.material", source)
+        mat = material(t["material"], f"{where}.material")
         types.append(ParticleType(name, i, mat, radii, rho, theta))
 
     walls = []
@@ -292,7 +269,7 @@ def problem_from_toml(text: str, source: str = "<string>") -> DemProblem:
             raise _err(source, where, w, 'a table with only "material" ("rigid" or a material table)')
         m = w["material"]
         walls.append(WallType(name, k, None if m == "rigid" else
-                              material_from_table(m, f"{where}.material", source)))
+                              material(m, f"{where}.material")))
 
     fr = data.get("friction", {})
     if not isinstance(fr, dict):
@@ -328,7 +305,9 @@ def problem_from_toml(text: str, source: str = "<string>") -> DemProblem:
                       tuple(float(a) for a in angles), source)
 
 
-def load_problem(path) -> DemProblem:
-    """Read a DEM set-up TOML file (module doc)."""
+def load_problem(path, temperature: float | None = None) -> DemProblem:
+    """Read a DEM set-up TOML file (module doc); ``temperature`` (K) overrides its
+    ``temperature_K``."""
     path = Path(path)
-    return problem_from_toml(path.read_text(encoding="utf-8"), str(path))
+    return problem_from_toml(path.read_text(encoding="utf-8"), str(path), base=path.parent,
+                             temperature=temperature)

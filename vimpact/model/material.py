@@ -3,14 +3,22 @@
 Every material is a generalized Maxwell solid with an optional parallel
 dashpot, ``G(t) = G_inf + sum_i G_i exp(-t/tau_i) (+ eta0 delta(t))``, and a
 constant Poisson ratio ``nu``. The named rheologies are constructors that
-fill in this one form.
+fill in this one form. A material may carry a temperature shift law
+(:class:`~vimpact.model.temperature.ShiftLaw`, docs/physics.md#temperature):
+:meth:`Material.at_temperature` gives the material at another temperature.
 """
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
+from vimpact.model.temperature import ShiftLaw
 from vimpact.model.validation import non_negative, poisson_ratio, positive, require
+
+if TYPE_CHECKING:  # the fit loads scipy: only when asked
+    from vimpact.model.fit import PronyFit
 
 MODELS = ("elastic", "kelvin_voigt", "standard_solid", "prony")
 
@@ -36,6 +44,8 @@ class Material:
     G_inf : relaxed (long-time) shear modulus, Pa
     arms : Maxwell arms ``((G_i [Pa], tau_i [s]), ...)``
     eta0 : parallel dashpot viscosity, Pa s
+    shift : how its times shift with temperature (its reference temperature ``T_ref``
+        in K, WLF or Arrhenius), or ``None`` (no temperature dependence given)
     """
 
     model: str
@@ -43,6 +53,7 @@ class Material:
     G_inf: float
     arms: tuple[tuple[float, float], ...] = ()
     eta0: float = 0.0
+    shift: ShiftLaw | None = None
 
     def __post_init__(self):
         require("model", self.model, self.model in MODELS, "one of " + ", ".join(MODELS))
@@ -65,6 +76,8 @@ class Material:
         ok, what = fits[self.model]
         require("model", self.model, ok, f"a rheology with {what} (given {len(self.arms)} "
                 f"arms, eta0 = {self.eta0:g} Pa s)")
+        require("shift", self.shift, self.shift is None or isinstance(self.shift, ShiftLaw),
+                "None or a ShiftLaw (vimpact.model.temperature)")
 
     # ---- constructors -------------------------------------------------
     @classmethod
@@ -105,6 +118,68 @@ class Material:
             checked.append((positive(f"G_{i} (arm {i} modulus, Pa)", arm[0]),
                             positive(f"tau_{i} (arm {i} relaxation time, s)", arm[1])))
         return cls("prony", nu, positive("G_inf", G_inf), tuple(checked), non_negative("eta0", eta0))
+
+    @classmethod
+    def from_dma(cls, frequency_Hz, storage_Pa, loss_Pa, nu: float, *,
+                 per_decade: float = 2.0, dashpot: bool = False,
+                 shift: ShiftLaw | None = None) -> "PronyFit":
+        """A Prony material fitted to a dynamic (DMA) master curve of the shear moduli.
+
+        Non-negative least squares on log-spaced relaxation times
+        (:func:`vimpact.model.fit.fit_dma`); returns ``(material, residual)``, the
+        residual being the RMS relative misfit of ``G'`` and ``G''`` (dimensionless).
+
+        Parameters
+        ----------
+        frequency_Hz : frequencies ``f`` (Hz, > 0; ``omega = 2 pi f``)
+        storage_Pa, loss_Pa : shear storage and loss moduli ``G'``, ``G''`` at ``f``, Pa
+        nu : Poisson ratio, dimensionless, in [0, 0.5]
+        per_decade : relaxation times per decade of the data's span (default 2,
+            :data:`vimpact.model.fit.DEFAULT_PER_DECADE`)
+        dashpot : fit a parallel dashpot ``eta0`` (a loss ``G'' ~ eta0 omega``) too
+        shift : the material's temperature shift law (``T_ref``: the master curve's)
+        """
+        from vimpact.model.fit import fit_dma
+        return fit_dma(frequency_Hz, storage_Pa, loss_Pa, nu, per_decade=per_decade,
+                       dashpot=dashpot, shift=shift)
+
+    @classmethod
+    def from_relaxation(cls, time_s, modulus_Pa, nu: float, *, per_decade: float = 2.0,
+                        shift: ShiftLaw | None = None) -> "PronyFit":
+        """A Prony material fitted to a shear relaxation modulus ``G(t)`` (Pa at ``t`` in s).
+
+        Non-negative least squares on log-spaced relaxation times
+        (:func:`vimpact.model.fit.fit_relaxation`); returns ``(material, residual)``,
+        the residual being the RMS relative misfit of ``G(t)`` (dimensionless).
+        Other parameters as :meth:`from_dma`.
+        """
+        from vimpact.model.fit import fit_relaxation
+        return fit_relaxation(time_s, modulus_Pa, nu, per_decade=per_decade, shift=shift)
+
+    # ---- temperature --------------------------------------------------
+    def with_shift(self, shift: ShiftLaw | None) -> "Material":
+        """This material with the temperature shift law ``shift`` (its ``T_ref`` is the
+        temperature of this material's times)."""
+        return dataclasses.replace(self, shift=shift)
+
+    def at_temperature(self, T: float) -> "Material":
+        """This material at the temperature ``T`` (K): every relaxation time and the
+        dashpot viscosity times the shift factor ``a_T`` of :attr:`shift`, moduli
+        unchanged; the result's shift law is referenced to ``T``.
+
+        Raises :class:`~vimpact.model.validation.InputError` for ``T <= 0 K``, a
+        ``T`` outside the law's range, or a material without a shift law.
+        """
+        require("temperature (K)", T, self.shift is not None,
+                "used only with a material that has a temperature shift law (T_ref and "
+                "WLF or Arrhenius constants)")
+        a_T = self.shift.shift_factor(T)
+        arms = tuple((G, a_T * tau) for G, tau in self.arms)
+        for i, (_, tau) in enumerate(arms, start=1):
+            positive(f"tau_{i} at temperature {T!r} K (arm {i} relaxation time a_T tau_i, s; "
+                     f"a_T = {a_T:.4g})", tau)
+        return dataclasses.replace(self, arms=arms, eta0=a_T * self.eta0,
+                                   shift=self.shift.referenced_to(T))
 
     # ---- derived ------------------------------------------------------
     @property

@@ -47,6 +47,7 @@ Everything else raises :class:`vimpact.InputError` saying why.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, field
 from collections.abc import Sequence
@@ -129,8 +130,8 @@ def _same(a: float, b: float) -> bool:
 
 def _scaled(mat: Material, factor: float) -> Material:
     """``mat`` with every modulus and viscosity times ``factor`` (same times and ``nu``)."""
-    return Material(mat.model, mat.nu, mat.G_inf * factor,
-                    tuple((G * factor, tau) for G, tau in mat.arms), mat.eta0 * factor)
+    return dataclasses.replace(mat, G_inf=mat.G_inf * factor, eta0=mat.eta0 * factor,
+                               arms=tuple((G * factor, tau) for G, tau in mat.arms))
 
 
 def _proportion(m1: Material, m2: Material) -> float | None:

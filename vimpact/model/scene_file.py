@@ -50,6 +50,13 @@ or a preset name as a string) and ``scene`` (required).
   default 0) and one ``[[scene.arms]]`` table per Maxwell arm with ``G_Pa``
   and ``tau_s`` (or ``arms = [{G_Pa = ..., tau_s = ...}, ...]``)
 
+Instead of the material keys and ``nu``, ``[scene]`` may name a material file
+(:mod:`vimpact.model.material_file`, e.g. written by ``vimpact material fit``):
+``material = "rubber.toml"`` (relative to the scene file's directory) and,
+optionally, ``temperature_K`` (the temperature in kelvin to which the file's
+shift law moves its relaxation times; docs/howto/dma.md). ``model`` may then
+be left out (it is the file's).
+
 Every value is one number: a range or a choice (which a sweep's ``[random]``
 takes) is an error. Unknown keys, missing keys and bad values are
 ``ValueError`` naming the file and the key, on one line. The key rules and the
@@ -70,6 +77,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from vimpact.model.material_file import inline_material
 from vimpact.model.numerics import Numerics
 from vimpact.model.scene import ScaleError, Scene
 from vimpact.model.toml_input import (ARM_KEYS, PHYSICAL_DEFAULTS,
@@ -121,7 +129,7 @@ def load_scene(path) -> tuple[Scene, Numerics | None]:
     """
     path = Path(path)
     text, data = read_toml(path, "scene file")
-    return _scene(TomlSource(path), text, data)
+    return _scene(TomlSource(path), text, data, path.parent)
 
 
 def scene_from_toml(text: str, source="<string>") -> tuple[Scene, Numerics | None]:
@@ -130,9 +138,12 @@ def scene_from_toml(text: str, source="<string>") -> tuple[Scene, Numerics | Non
     return _scene(spec, text, parse_toml(spec, text))
 
 
-def _scene(spec: TomlSource, text: str, data: dict) -> tuple[Scene, Numerics | None]:
+def _scene(spec: TomlSource, text: str, data: dict,
+           base: Path | None = None) -> tuple[Scene, Numerics | None]:
     source = spec.path
     _top_keys(spec, data)
+    # [scene] material = "FILE.toml" (and temperature_K): the file's values, written out
+    data, _ = inline_material(str(source), data, "scene", base)
     header = parse_header(spec, data)
     allow_large = spec.flag(data, "allow_large_contact", False)
     numerics = parse_numerics(spec, data["numerics"]) if "numerics" in data else None

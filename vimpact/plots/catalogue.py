@@ -24,6 +24,9 @@ CATALOGUE: dict[str, tuple[str, str | None]] = {
     "fig_beta_psi": ("friction: beta_x over psi for several Q1", None),
     "fig_chung_ooi": ("friction: rebound angle and spin over the impact angle (Chung and Ooi "
                       "2011, test 4)", None),
+    "fig_temperature": ("e_z over the impact speed at several temperatures, the example "
+                        "polymer sweeps/materials/synthetic_rubber.toml (run from the "
+                        "repository root)", None),
 }
 
 #: Names accepted by :func:`vimpact.plots.figures.plot_figure` (also ``"5.2"``,

@@ -468,12 +468,17 @@ class Figure(NamedTuple):
     spec: str | None
 
 
-def _friction(name: str) -> Callable:
-    """A figure of :mod:`vimpact.plots.friction` (imported when drawn)."""
+def _lazy(module: str, name: str) -> Callable:
+    """The figure ``name`` of ``module`` (imported when drawn)."""
     def draw(out):
         import importlib
-        return getattr(importlib.import_module("vimpact.plots.friction"), name)(out)
+        return getattr(importlib.import_module(module), name)(out)
     return draw
+
+
+def _friction(name: str) -> Callable:
+    """A figure of :mod:`vimpact.plots.friction` (imported when drawn)."""
+    return _lazy("vimpact.plots.friction", name)
 
 
 #: drawing function of each figure of :data:`vimpact.plots.catalogue.CATALOGUE`
@@ -482,6 +487,7 @@ _DRAW: dict[str, Callable] = {
     "fig5_3": fig5_3, "fig5_4": fig5_4, "fig5_5": fig5_5,
     "fig_mbf": _friction("fig_mbf"), "fig_beta_psi": _friction("fig_beta_psi"),
     "fig_chung_ooi": _friction("fig_chung_ooi"),
+    "fig_temperature": _lazy("vimpact.plots.temperature", "fig_temperature"),
 }
 if set(_DRAW) != set(CATALOGUE):  # the catalogue (titles, specs) and the drawings agree
     raise ImportError(f"figures without a drawing or a catalogue entry: "

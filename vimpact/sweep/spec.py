@@ -72,6 +72,11 @@ column, with its unit as suffix:
   prony: ``G_Pa`` (relaxed modulus), ``eta_Pa_s`` (parallel dashpot,
   default 0) and one ``[[random.arms]]`` table per Maxwell arm with
   ``G_Pa`` and ``tau_s``
+- or, instead of the material keys and ``nu``, a material file
+  (:mod:`vimpact.model.material_file`, e.g. written by ``vimpact material
+  fit``): ``material = "rubber.toml"`` (relative to the spec's directory) and
+  optionally ``temperature_K`` (kelvin; the file's shift law moves its times
+  there). Its values are fixed for every row; ``model`` may be left out
 
 Each value is a number (fixed), a range ``[lo, hi]`` or
 ``{ range = [lo, hi], log = true|false }``, or ``{ choice = [a, b, ...] }``
@@ -125,6 +130,7 @@ from pathlib import Path
 import numpy as np
 
 from vimpact import __version__
+from vimpact.model.material_file import inline_material
 from vimpact.model.numerics import Numerics
 from vimpact.model.scene import Scene
 from vimpact.model.toml_input import (ANGLE_RANGE_DEG, ARM_KEYS, FRICTION_KEYS, MATERIAL_KEYS,
@@ -409,6 +415,8 @@ class SweepSpec:
         asked). Not an axis: a refinement of the grid reads it
     grid_mu : grid mode with a ``psi`` axis: the friction coefficient of the rows with
         ``psi > 0`` (``[grid] mu``, default 1); ``None`` without ``psi``
+    material_text : the text of the material file ``[random] material`` names ("" without
+        one); part of :attr:`sweep_hash`
     """
 
     path: Path
@@ -430,6 +438,7 @@ class SweepSpec:
     layout: str = "auto"
     grid_tolerance: float | None = None
     grid_mu: float | None = None
+    material_text: str = ""
 
     @property
     def n_chunks(self) -> int:
@@ -456,10 +465,14 @@ class SweepSpec:
     @property
     def sweep_hash(self) -> str:
         """SHA-256 of the spec text, the resolved numerics, the package and schema
-        version: parts of a run can be resumed only by a run with the same hash."""
+        version (and the material file's text): parts of a run can be resumed only by a
+        run with the same hash."""
         h = hashlib.sha256()
-        for piece in (self.text, json.dumps(dataclasses.asdict(self.numerics), sort_keys=True),
-                      __version__, str(SCHEMA_VERSION)):
+        pieces = [self.text, json.dumps(dataclasses.asdict(self.numerics), sort_keys=True),
+                  __version__, str(SCHEMA_VERSION)]
+        if self.material_text:  # a spec without a material file keeps its hash
+            pieces.append(self.material_text)
+        for piece in pieces:
             h.update(piece.encode())
             h.update(b"\0")
         return h.hexdigest()
@@ -592,6 +605,8 @@ def load_spec(path) -> SweepSpec:
     text, data = read_toml(path, "sweep specification")
     spec = TomlSource(path)
     spec.unknown(data, SWEEP_TOP_KEYS)
+    # [random] material = "FILE.toml" (and temperature_K): the file's values, fixed
+    data, material_text = inline_material(str(path), data, "random", path.parent)
     header = parse_header(spec, data)
     model = header.model
     chunk_size = spec.integer("chunk_size", data.get("chunk_size", DEFAULT_CHUNK_SIZE), 1)
@@ -627,7 +642,7 @@ def load_spec(path) -> SweepSpec:
                      description=header.description, rows=rows, draws=draws, arms=arms,
                      axes=axes, tangential=header.tangential, rotation=header.rotation,
                      layout=layout, grid_tolerance=grid_tolerance,
-                     grid_mu=grid_mu)
+                     grid_mu=grid_mu, material_text=material_text)
 
 
 def _random(spec: TomlSource, model: str, table) -> tuple[dict, tuple, int]:
