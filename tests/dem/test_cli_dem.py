@@ -64,7 +64,8 @@ def test_lammps_lines_name_every_pair_and_one_wall_fix_per_type(tmp_path):
 
 @pytest.mark.parametrize("edit, words", [
     (("G = 9e7", "G = -9e7"), "G"),
-    (('model = "elastic"', 'model = "kelvin_voigt"\neta = 100.0'), "not allowed"),
+    (('model = "elastic"\nnu = 0.45', 'model = "kelvin_voigt"\neta = 100.0\nnu = 0.3'),
+     "equal nu"),
     (("min = 0.1", "min = 2.0"), "speeds"),
     (("density = 1200.0", 'density = "heavy"'), "density"),
 ])
