@@ -31,7 +31,7 @@ material = "rigid"
 default = 0.5
 """
 
-FILES = {"lammps": ["lammps.in"], "liggghts": ["liggghts.in"],
+FILES = {"lammps": ["lammps.in"], "liggghts": ["liggghts_settings.in", "liggghts.in"],
          "mercurydpm": ["mercurydpm_species.cpp"], "yade": ["yade_materials.py"],
          "mfix": ["mfix.dat"], "rebound": ["vimpact_restitution.py"]}
 

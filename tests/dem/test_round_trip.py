@@ -6,6 +6,7 @@ import importlib.util
 import numpy as np
 import pytest
 
+from tests.dem.codes import need
 from vimpact.dem import lammps
 from vimpact.dem.export import export
 from vimpact.dem.laws import hertz_contact_time
@@ -47,9 +48,9 @@ def problem():
 _NO_LAMMPS = lammps.lammps_available()
 
 
-@pytest.mark.skipif(_NO_LAMMPS is not None, reason=f"LAMMPS round trip: {_NO_LAMMPS}")
 @pytest.mark.parametrize("key", ["a-floor", "a-b"])
 def test_lammps_restitutes_what_the_report_predicts(problem, key):
+    need(_NO_LAMMPS, "LAMMPS")
     fits = {f.contact.key: f for f in export(problem, "lammps").fits}
     f = fits[key]
     R, m = f.contact.nominal()
@@ -91,7 +92,6 @@ def test_rebound_round_trip_with_the_exported_callback(problem, tmp_path):
     assert fit.params["e_z"] == pytest.approx(list(ex.targets[fit.contact.key].e_z), rel=1e-12)
 
 
-@pytest.mark.skipif(_NO_LAMMPS is not None, reason=f"LAMMPS: {_NO_LAMMPS}")
 def test_lammps_hertz_material_wall_is_a_body_of_the_particles_material():
     """What docs/dem.md says about LAMMPS (why the export uses `hertz` with k_n per
     contact): with `hertz/material E eta nu` a `fix wall/gran` wall behaves as a body of
@@ -99,6 +99,7 @@ def test_lammps_hertz_material_wall_is_a_body_of_the_particles_material():
     Measured through the elastic contact time against the Hertz closed form."""
     import math
 
+    need(_NO_LAMMPS, "LAMMPS")
     R, rho, v, E, nu = 0.005, 1150.0, 0.5, 1e8, 0.3
     m = rho * 4.0 / 3.0 * math.pi * R**3
 
