@@ -31,7 +31,7 @@ material = "rigid"
 default = 0.5
 """
 
-FILES = {"lammps": ["lammps.in"], "liggghts": ["liggghts_settings.in", "liggghts.in"],
+FILES = {"lammps": ["lammps_settings.in", "lammps_pair.in", "lammps_walls.in"], "liggghts": ["liggghts_settings.in", "liggghts.in"],
          "mercurydpm": ["mercurydpm_species.cpp"], "yade": ["yade_materials.py"],
          "mfix": ["mfix.dat"], "rebound": ["vimpact_restitution.py"]}
 
@@ -56,10 +56,13 @@ def test_lammps_lines_name_every_pair_and_one_wall_fix_per_type(tmp_path):
     src = tmp_path / "setup.toml"
     src.write_text(TOML)
     main(["dem", str(src), "--for", "lammps", "--out", str(tmp_path)])
-    text = (tmp_path / "lammps.in").read_text()
+    text = (tmp_path / "lammps_pair.in").read_text()
     assert [ln.split()[1:3] for ln in text.splitlines() if ln.startswith("pair_coeff")] == \
         [["1", "1"], ["1", "2"], ["2", "2"]]
-    assert sum(ln.startswith("fix wall_floor_") for ln in text.splitlines()) == 2
+    walls = (tmp_path / "lammps_walls.in").read_text().splitlines()
+    assert sum(ln.startswith("fix wall_floor_") for ln in walls) == 2
+    settings = (tmp_path / "lammps_settings.in").read_text()
+    assert "units si" in settings and "timestep" in text
 
 
 @pytest.mark.parametrize("edit, words", [

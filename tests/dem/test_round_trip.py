@@ -121,3 +121,21 @@ def test_lammps_hertz_material_wall_is_a_body_of_the_particles_material():
     t_contact = frac * n * dt
     assert t_contact == pytest.approx(t_hertz(E / (2 * (1 - nu**2))), rel=1e-3)
     assert t_contact / t_hertz(E / (1 - nu**2)) == pytest.approx(2**0.4, rel=1e-3)
+
+
+def test_lammps_runs_the_exported_files_at_every_size_level():
+    """What users paste: the settings, the per-type pair_coeff lines and the wall groups and
+    fixes, included unchanged in the documented order, with particles of every type at every
+    size level (a size range, so LAMMPS' mass scaling of the damping enters)."""
+    need(_NO_LAMMPS, "LAMMPS")
+    problem = problem_from_toml(TOML.replace("radius = 0.004", "radius = [0.003, 0.005]"), "rt")
+    fits = export(problem, "lammps").fits
+    speeds = np.geomspace(problem.speeds.min(), problem.speeds.max(), 5)
+    diff = {}
+    for steps in (lammps.STEPS_PER_CONTACT, 4 * lammps.STEPS_PER_CONTACT):
+        rows = lammps.round_trip_files(problem, speeds, steps, fits=fits)
+        assert {(r["contact"], r["level"]) for r in rows} == {
+            (f.contact.key, k) for f in fits for k in range(len(f.contact.levels()))}
+        diff[steps] = max(abs(r["e"] - r["predicted"]) for r in rows)
+    assert diff[lammps.STEPS_PER_CONTACT] < 1e-3
+    assert diff[4 * lammps.STEPS_PER_CONTACT] < diff[lammps.STEPS_PER_CONTACT] / 2

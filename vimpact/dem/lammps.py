@@ -89,34 +89,71 @@ def _coeffs(p: dict) -> str:
             "limit_damping")
 
 
-def render(problem: DemProblem, fits: list[ContactFit]) -> dict[str, str]:
-    """``lammps.in``: type comments, ``pair_coeff`` lines, one ``fix wall/gran`` per type and wall."""
-    lines = ["# LAMMPS input lines written by `vimpact dem` (units si; GRANULAR package)",
-             f"# from {problem.source}; speeds {problem.speeds.min():g}..{problem.speeds.max():g} m/s",
-             "# normal: viscoelastic Hertz, eta_n0 = 2 E* A / m_eff (exact at the nominal sizes)",
-             "atom_style sphere", "comm_modify vel yes", ""]
+#: default time steps per (shortest) contact in the exported ``timestep``
+STEPS_PER_CONTACT = 100
+
+
+def shortest_contact(problem: DemProblem, fits: list[ContactFit]) -> float:
+    """The shortest elastic Hertz contact time over every contact and size level at the
+    fastest speed, s."""
+    from vimpact.dem.laws import hertz_contact_time
+
+    v = float(problem.speeds.max())
+    return min(float(hertz_contact_time(f.params["E_star_Pa"], *f.contact.effective(lvl), v))
+               for f in fits for lvl in f.contact.levels())
+
+
+def render(problem: DemProblem, fits: list[ContactFit],
+           steps_per_contact: int = STEPS_PER_CONTACT) -> dict[str, str]:
+    """Three files, included in this order: ``lammps_settings.in`` (before ``create_box``
+    / ``read_data``), ``lammps_pair.in`` (after ``create_box``) and ``lammps_walls.in``
+    (after the atoms exist: its groups are by type and static)."""
+    src = (f"# from {problem.source}; speeds {problem.speeds.min():g}.."
+           f"{problem.speeds.max():g} m/s")
+    settings = ["# LAMMPS settings written by `vimpact dem`: include BEFORE create_box / read_data",
+                src, "units si", "atom_style sphere", "atom_modify map array",
+                "comm_modify vel yes", "newton off", ""]
+    r_max = max(max(t.radii) for t in problem.types)
+    t_c = shortest_contact(problem, fits)
+    dt = t_c / steps_per_contact
+    pair = ["# LAMMPS pair lines written by `vimpact dem` (units si; GRANULAR package):",
+            f"# include AFTER create_box {len(problem.types)} ... (one atom type per particle type)",
+            src,
+            "# normal: viscoelastic Hertz, eta_n0 = 2 E* A / m_eff (exact at the nominal sizes)"]
     for t in problem.types:
         R = t.radius
-        lines.append(f"# type {t.index} = {t.name}: nominal diameter {2 * R:.6g} m, "
-                     f"density {t.density:g} kg/m^3")
-        lines.append(f"# set type {t.index} diameter {2 * R:.6g}")
-        lines.append(f"# set type {t.index} density {t.density:.6g}")
-    lines += ["", "pair_style granular"]
+        rng = (f", radius range {min(t.radii):.6g}..{max(t.radii):.6g} m" if len(t.radii) > 1
+               else "")
+        pair.append(f"# type {t.index} = {t.name}: nominal diameter {2 * R:.6g} m{rng}, "
+                    f"density {t.density:g} kg/m^3")
+    pair += ["pair_style granular"]
     for f in fits:
         if not f.contact.is_wall:
             i, j = sorted((f.contact.first.index, f.contact.second.index))
-            lines.append(f"pair_coeff {i} {j} {_coeffs(f.params)}"
-                         f"   # {f.contact.key}: A = {f.params['A_s']:.6g} s")
-    walls = [f for f in fits if f.contact.is_wall]
-    if walls:
-        lines += ["", "# walls: one fix per particle type (a fix has one parameter set);",
-                  "# replace 'zplane 0.0 NULL' by your wall's geometry"]
-    for f in walls:
+            pair.append(f"pair_coeff {i} {j} {_coeffs(f.params)}"
+                        f"   # {f.contact.key}: A = {f.params['A_s']:.6g} s")
+    pair += [f"neighbor {0.25 * r_max:.6g} bin   # skin: a quarter of the largest radius",
+             f"timestep {dt:.8g}   # s: shortest contact {t_c:.6g} s (fastest speed, smallest "
+             f"sizes) / {steps_per_contact} steps", ""]
+    walls = ["# LAMMPS wall lines written by `vimpact dem`: include AFTER the atoms exist",
+             "# (after create_atoms / read_data): the groups by type are static, so atoms",
+             "# added later (fix pour, fix deposit) must be added to vimpact_typeN themselves.",
+             "# One fix per particle type (a fix has one parameter set); replace",
+             "# 'zplane 0.0 NULL' by your wall's geometry.", src]
+    grouped = set()
+    for f in fits:
+        if not f.contact.is_wall:
+            continue
         t, w = f.contact.first, f.contact.second
-        lines.append(f"group vimpact_type{t.index} type {t.index}")
-        lines.append(f"fix wall_{w.name}_{t.name} vimpact_type{t.index} wall/gran granular "
+        if t.index not in grouped:
+            walls.append(f"group vimpact_type{t.index} type {t.index}")
+            grouped.add(t.index)
+        walls.append(f"fix wall_{w.name}_{t.name} vimpact_type{t.index} wall/gran granular "
                      f"{_coeffs(f.params)} zplane 0.0 NULL   # A = {f.params['A_s']:.6g} s")
-    return {"lammps.in": "\n".join(lines) + "\n"}
+    out = {"lammps_settings.in": "\n".join(settings), "lammps_pair.in": "\n".join(pair)}
+    if problem.walls:
+        out["lammps_walls.in"] = "\n".join(walls) + "\n"
+    return out
 
 
 # ---- running LAMMPS itself (round trip) -----------------------------------
@@ -253,13 +290,102 @@ def round_trip(problem: DemProblem, speeds=(0.1, 1.0), steps_per_contact: int = 
     return rows
 
 
+def level_prediction(fit: ContactFit, R: float, m: float, v) -> np.ndarray:
+    """What LAMMPS' law gives with ``fit``'s lines for a pair of effective radius ``R`` (m)
+    and mass ``m`` (kg): ``eta_n0`` is fixed, so the dissipation time is ``A m / m_nom``."""
+    from vimpact.dem.laws import viscoelastic_hertz_restitution
+
+    _, m_nom = fit.contact.nominal()
+    return viscoelastic_hertz_restitution(fit.params["A_s"] * m / m_nom, fit.params["E_star_Pa"],
+                                          R, m, v)
+
+
+def round_trip_files(problem: DemProblem, speeds, steps_per_contact: int = STEPS_PER_CONTACT,
+                     fits: list[ContactFit] | None = None) -> list[dict]:
+    """Run LAMMPS once on the exported files, included unchanged in the documented order,
+    with head-on collisions of every contact at every size level and speed (m/s): one dict
+    per collision with ``contact``, ``level``, ``v``, ``e`` (LAMMPS', from its velocities)
+    and ``predicted`` (the report's, with LAMMPS' mass scaling of the damping)."""
+    if fits is None:
+        from vimpact.dem.export import export
+
+        fits = export(problem, CODE).fits
+    files = render(problem, fits, steps_per_contact)
+    r_max = max(max(t.radii) for t in problem.types)
+    z_pairs = 20.0 * r_max
+    atoms, cases = [], []
+    x = 0.0
+    for f in fits:
+        c = f.contact
+        for lvl, (b1, b2) in enumerate(c.levels()):
+            R, m = c.effective((b1, b2))
+            for v in speeds:
+                R2 = None if c.is_wall else b2.R
+                x += 4.0 * (b1.R + (R2 or b1.R))
+                gap = 1e-3 * b1.R
+                case = {"contact": c.key, "level": lvl, "v": float(v),
+                        "predicted": float(level_prediction(f, R, m, v))}
+                if c.is_wall:
+                    atoms.append((c.first.index, (x, 0.0, b1.R + gap), b1.R, c.first.density,
+                                  (0.0, 0.0, -float(v))))
+                    case["ids"] = [len(atoms)]
+                else:
+                    atoms.append((c.first.index, (x - b1.R - gap / 2, 0.0, z_pairs), b1.R,
+                                  c.first.density, (v * b2.m / (b1.m + b2.m), 0.0, 0.0)))
+                    atoms.append((c.second.index, (x + b2.R + gap / 2, 0.0, z_pairs), b2.R,
+                                  c.second.density, (-v * b1.m / (b1.m + b2.m), 0.0, 0.0)))
+                    case["ids"] = [len(atoms) - 1, len(atoms)]
+                cases.append(case)
+    from vimpact.dem.laws import hertz_contact_time
+
+    dt = shortest_contact(problem, fits) / steps_per_contact
+    vmin = float(min(speeds))
+    t_end = 2e-3 * r_max / vmin + 3.0 * max(
+        float(hertz_contact_time(f.params["E_star_Pa"], *f.contact.effective(lvl), vmin))
+        for f in fits for lvl in f.contact.levels())
+    lines = ["include lammps_settings.in", "boundary f f f",
+             f"region box block {-4 * r_max:.6g} {x + 4 * r_max:.6g} {-4 * r_max:.6g} "
+             f"{4 * r_max:.6g} {-4 * r_max:.6g} {z_pairs + 4 * r_max:.6g}",
+             f"create_box {len(problem.types)} box", "include lammps_pair.in"]
+    for k, (typ, (ax, ay, az), R, rho, (vx, vy, vz)) in enumerate(atoms, start=1):
+        lines += [f"create_atoms {typ} single {ax:.12g} {ay:.12g} {az:.12g}",
+                  f"set atom {k} diameter {2 * R:.12g} density {rho:.12g}",
+                  f"set atom {k} vx {vx:.12g} vy {vy:.12g} vz {vz:.12g}"]
+    if "lammps_walls.in" in files:
+        lines.append("include lammps_walls.in")
+    lines += ["fix integrate all nve/sphere", "thermo 0", f"run {int(math.ceil(t_end / dt))}"]
+    names = []
+    for k in range(1, len(atoms) + 1):
+        lines += [f"variable vx{k} equal vx[{k}]", f"variable vz{k} equal vz[{k}]"]
+        names += [f"vx{k}", f"vz{k}"]
+    with tempfile.TemporaryDirectory() as tmp:
+        for name, text in files.items():
+            with open(os.path.join(tmp, name), "w") as fh:
+                fh.write(text)
+        script = "\n".join(f"include {os.path.join(tmp, ln.split()[1])}" if ln.startswith("include ")
+                           else ln for ln in lines) + "\n"
+        values = run_lammps(script, names, timeout=600.0)
+    vel = {k: (values[2 * k - 2], values[2 * k - 1]) for k in range(1, len(atoms) + 1)}
+    rows = []
+    for case in cases:
+        ids = case.pop("ids")
+        e = (vel[ids[0]][1] / case["v"] if len(ids) == 1
+             else (vel[ids[1]][0] - vel[ids[0]][0]) / case["v"])
+        rows.append(dict(case, e=e))
+    return rows
+
+
 if __name__ == "__main__":  # python -m vimpact.dem.lammps SETUP.toml [STEPS_PER_CONTACT]
     from vimpact.dem.problem import load_problem
 
     why = lammps_available()
     if why:
         sys.exit(f"cannot run LAMMPS: {why}")
-    steps = int(sys.argv[2]) if len(sys.argv) > 2 else 4000
-    print(f"{'contact':12s} {'v [m/s]':>8s} {'predicted e':>12s} {'LAMMPS e':>12s} {'diff':>10s}")
-    for key, v, e_pred, e_lmp in round_trip(load_problem(sys.argv[1]), (0.05, 0.2, 1.0), steps):
-        print(f"{key:12s} {v:8.3g} {e_pred:12.8f} {e_lmp:12.8f} {e_lmp - e_pred:10.2e}")
+    prob = load_problem(sys.argv[1])
+    steps = int(sys.argv[2]) if len(sys.argv) > 2 else STEPS_PER_CONTACT
+    sp = np.geomspace(prob.speeds.min(), prob.speeds.max(), 5)
+    print(f"{'contact':12s} {'level':>5s} {'v [m/s]':>8s} {'predicted e':>12s} {'LAMMPS e':>12s} "
+          f"{'diff':>10s}")
+    for r in round_trip_files(prob, sp, steps):
+        print(f"{r['contact']:12s} {r['level']:5d} {r['v']:8.3g} {r['predicted']:12.8f} "
+              f"{r['e']:12.8f} {r['e'] - r['predicted']:10.2e}")
