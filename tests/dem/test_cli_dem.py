@@ -83,3 +83,28 @@ def test_bad_input_is_one_line_and_exit_2(edit, words, tmp_path, capsys):
 def test_missing_file_is_exit_2(tmp_path, capsys):
     assert main(["dem", str(tmp_path / "nope.toml"), "--for", "mfix"]) == 2
     assert capsys.readouterr().err.count("\n") == 1
+
+
+def test_json_output_is_the_fits_and_progress_goes_to_stderr(tmp_path, capsys):
+    import json
+
+    src = tmp_path / "setup.toml"
+    src.write_text(TOML)
+    assert main(["dem", str(src), "--for", "liggghts", "--out", str(tmp_path), "--json",
+                 "--steps-per-contact", "40"]) == 0
+    cap = capsys.readouterr()
+    data = json.loads(cap.out)  # strict JSON: no NaN or Infinity
+    assert data["code"] == "liggghts"
+    assert {c["contact"] for c in data["contacts"]} == {"a-a", "a-b", "a-floor", "b-b", "b-floor"}
+    assert all(c["residual_e_z"]["rms"] <= c["residual_e_z"]["max_abs"] for c in data["contacts"])
+    assert "vimpact curves 5/5" in cap.err
+    assert "/ 40 steps" not in (tmp_path / "liggghts.in").read_text()
+    assert "40 steps per shortest contact" in (tmp_path / "liggghts.in").read_text()
+
+
+def test_steps_per_contact_only_for_codes_with_a_time_step(tmp_path, capsys):
+    src = tmp_path / "setup.toml"
+    src.write_text(TOML)
+    assert main(["dem", str(src), "--for", "rebound", "--steps-per-contact", "50"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "--steps-per-contact" in err

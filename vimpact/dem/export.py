@@ -29,30 +29,51 @@ def code_module(code: str):
 
 
 def export(problem: DemProblem, code: str, out_dir=None, numerics=None,
-           targets: dict[str, Targets] | None = None) -> Export:
+           targets: dict[str, Targets] | None = None, steps_per_contact: int | None = None,
+           progress=None) -> Export:
     """Fit ``code``'s constants for every contact of ``problem``; with ``out_dir``
     write its input file(s), ``report_<code>.md`` and ``report_<code>.png`` there.
 
     ``targets`` (from an earlier call) skips the vimpact runs; they must hold
-    ``beta_x`` if the code has a tangential restitution.
+    ``beta_x`` if the code has a tangential restitution. ``steps_per_contact``
+    sets the exported time step of the codes that get one (LAMMPS, LIGGGHTS,
+    Yade; default: the module's ``STEPS_PER_CONTACT``). ``progress(text)`` is
+    called before each contact's vimpact runs and before the fit.
     """
     mod = code_module(code)
+    say = progress or (lambda _text: None)
+    steps = getattr(mod, "STEPS_PER_CONTACT", None)
+    if steps_per_contact is not None:
+        if steps is None:
+            from vimpact.model.validation import InputError, message
+
+            raise InputError(message("--steps-per-contact", steps_per_contact,
+                                     "only with --for lammps, liggghts or yade "
+                                     f"({code} takes no time step)"))
+        steps = steps_per_contact
     if targets is None or (mod.TANGENTIAL and any(t.beta_x is None for t in targets.values())):
-        targets = {c.key: compute_targets(problem, c, tangential=mod.TANGENTIAL, numerics=numerics)
-                   for c in problem.contacts}
+        targets = {}
+        for k, c in enumerate(problem.contacts, start=1):
+            say(f"vimpact curves {k}/{len(problem.contacts)}: {c.key}"
+                + (" (normal and tangential)" if mod.TANGENTIAL else ""))
+            targets[c.key] = compute_targets(problem, c, tangential=mod.TANGENTIAL,
+                                             numerics=numerics)
+    say(f"fitting {code}'s constants")
     fits = mod.fit(problem, targets)
+    render_kw = {} if steps is None else {"steps_per_contact": steps}
     files: list[Path] = []
     if out_dir is not None:
         from vimpact.dem import report
 
         out = Path(out_dir)
         out.mkdir(parents=True, exist_ok=True)
-        for name, text in mod.render(problem, fits).items():
+        for name, text in mod.render(problem, fits, **render_kw).items():
             (out / name).write_text(text, encoding="utf-8")
             files.append(out / name)
         png = report.figure(code, problem, targets, fits, out / f"report_{code}.png")
         md = out / f"report_{code}.md"
         md.write_text(report.markdown(code, problem, targets, fits, [p.name for p in files],
-                                      png.name), encoding="utf-8")
+                                      png.name, steps, getattr(mod, "TIME_STEP_ERROR", None)),
+                      encoding="utf-8")
         files += [md, png]
     return Export(code, fits, targets, files)
