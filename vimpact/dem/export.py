@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import importlib
+import math
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -21,6 +22,7 @@ class Export:
     fits: list[ContactFit]
     targets: dict[str, Targets]
     files: list[Path]
+    problem: DemProblem | None = None
 
 
 def code_module(code: str):
@@ -34,8 +36,9 @@ def export(problem: DemProblem, code: str, out_dir=None, numerics=None,
     """Fit ``code``'s constants for every contact of ``problem``; with ``out_dir``
     write its input file(s), ``report_<code>.md`` and ``report_<code>.png`` there.
 
-    ``targets`` (from an earlier call) skips the vimpact runs; they must hold
-    ``beta_x`` if the code has a tangential restitution. ``steps_per_contact``
+    ``targets`` (from an earlier call, by contact key) skips the vimpact runs of
+    the contacts it holds (those without ``beta_x`` are run again when the code
+    has a tangential restitution). ``steps_per_contact``
     sets the exported time step of the codes that get one (LAMMPS, LIGGGHTS,
     Yade; default: the module's ``STEPS_PER_CONTACT``). ``progress(text)`` is
     called before each contact's vimpact runs and before the fit.
@@ -51,13 +54,14 @@ def export(problem: DemProblem, code: str, out_dir=None, numerics=None,
                                      "only with --for lammps, liggghts or yade "
                                      f"({code} takes no time step)"))
         steps = steps_per_contact
-    if targets is None or (mod.TANGENTIAL and any(t.beta_x is None for t in targets.values())):
-        targets = {}
-        for k, c in enumerate(problem.contacts, start=1):
-            say(f"vimpact curves {k}/{len(problem.contacts)}: {c.key}"
-                + (" (normal and tangential)" if mod.TANGENTIAL else ""))
-            targets[c.key] = compute_targets(problem, c, tangential=mod.TANGENTIAL,
-                                             numerics=numerics)
+    targets = {k: t for k, t in (targets or {}).items()
+               if not (mod.TANGENTIAL and t.beta_x is None)}
+    missing = [c for c in problem.contacts if c.key not in targets]
+    for k, c in enumerate(missing, start=1):
+        say(f"vimpact curves {k}/{len(missing)}: {c.key}"
+            + (" (normal and tangential)" if mod.TANGENTIAL else ""))
+        targets[c.key] = compute_targets(problem, c, tangential=mod.TANGENTIAL, numerics=numerics)
+    targets = {c.key: targets[c.key] for c in problem.contacts}
     say(f"fitting {code}'s constants")
     fits = mod.fit(problem, targets)
     render_kw = {} if steps is None else {"steps_per_contact": steps}
@@ -76,4 +80,63 @@ def export(problem: DemProblem, code: str, out_dir=None, numerics=None,
                                       png.name, steps, getattr(mod, "TIME_STEP_ERROR", None)),
                       encoding="utf-8")
         files += [md, png]
-    return Export(code, fits, targets, files)
+    return Export(code, fits, targets, files, problem)
+
+
+#: most size classes :func:`export_to_residual` tries per size-range type
+MAX_SIZE_CLASSES = 8
+
+
+def export_to_residual(problem: DemProblem, code: str, residual: float, out_dir=None,
+                       numerics=None, steps_per_contact: int | None = None,
+                       progress=None) -> tuple[Export, bool, int]:
+    """Split every size-range type into size classes
+    (:meth:`DemProblem.with_size_classes`) until the largest ``e_z`` residual of
+    every contact is at most ``residual``: 1 class, then (the size range's error
+    falling about as 1/k) the number that scaling says, checked again, up to
+    :data:`MAX_SIZE_CLASSES`; it stops early when a split no longer lowers the
+    residual (what is left is not the size range's, e.g. the speed dependence a
+    constant-``e`` code cannot follow). Writes the files of the best problem.
+
+    Returns
+    -------
+    (export, met, needed) : the export (``export.problem.size_classes`` is the
+    number of classes used, its types the split ones), whether the target was
+    met and the number of classes the 1/k scaling says it takes (0 when splitting
+    does not lower the residual).
+    """
+    from vimpact.model.validation import positive
+
+    positive("--residual", residual)
+    say = progress or (lambda _text: None)
+    cache: dict = {}
+
+    def ident(c):
+        return (c.key, c.first.radii, getattr(c.second, "radii", None))
+
+    last = None
+    stalled = not problem.has_size_range
+    k = 1
+    while True:
+        prob = problem.with_size_classes(k) if k > 1 else problem
+        say(f"size classes per size-range type: {k}")
+        known = {c.key: cache[ident(c)] for c in prob.contacts if ident(c) in cache}
+        ex = export(prob, code, None, numerics, known, steps_per_contact, progress)
+        for c in prob.contacts:
+            cache[ident(c)] = ex.targets[c.key]
+        worst = max(f.res_e_z.max_abs for f in ex.fits)
+        if last is not None and worst >= 0.95 * last[2]:
+            stalled = True
+            break  # splitting no longer helps: the residual left is not the size range's
+        last = (prob, ex, worst)
+        if worst <= residual or not problem.has_size_range or k >= MAX_SIZE_CLASSES:
+            break
+        # the size range's error falls about as 1/k: aim there, at least one class more
+        k = min(MAX_SIZE_CLASSES, max(k + 1, math.ceil(1.1 * k * worst / residual)))
+    prob, ex, worst = last
+    met = worst <= residual
+    k = prob.size_classes
+    needed = k if met else (0 if stalled else math.ceil(k * worst / residual))
+    if out_dir is not None:
+        ex = export(prob, code, out_dir, numerics, ex.targets, steps_per_contact)
+    return ex, met, needed

@@ -161,6 +161,18 @@ class DemProblem:
     speeds: np.ndarray = field(repr=False)
     angles_deg: tuple[float, ...] = ()
     source: str = "<string>"
+    toml: str = field(default="", repr=False)
+    size_classes: int = 1
+
+    @property
+    def has_size_range(self) -> bool:
+        """Some type has a radius range (it can be split into size classes)."""
+        return any(len(t.radii) > 1 for t in self.types)
+
+    def with_size_classes(self, k: int) -> "DemProblem":
+        """The same set-up with every size-range type split into ``k`` types of equal
+        radius ratio (``NAME_1`` .. ``NAME_k``, smallest first; friction as the type's)."""
+        return problem_from_toml(self.toml, self.source, size_classes=k)
 
     def contact(self, a: str, b: str) -> Contact:
         """The contact of the named type/wall pair (either order)."""
@@ -220,8 +232,15 @@ def material_from_table(table, where: str = "material", source: str = "<string>"
         raise InputError(f"{source}: {where}: {exc}") from None
 
 
-def problem_from_toml(text: str, source: str = "<string>") -> DemProblem:
-    """Parse a DEM set-up (module doc) from TOML text."""
+def problem_from_toml(text: str, source: str = "<string>", size_classes: int = 1) -> DemProblem:
+    """Parse a DEM set-up (module doc) from TOML text.
+
+    ``size_classes`` > 1 splits every type with a radius range ``[min, max]``
+    into that many types ``NAME_1`` .. ``NAME_k`` with the ranges
+    ``min q^(i-1) .. min q^i``, ``q = (max/min)^(1/k)``, numbered in order.
+    """
+    if isinstance(size_classes, bool) or not isinstance(size_classes, int) or size_classes < 1:
+        raise InputError(message("size_classes", size_classes, "an integer >= 1"))
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
@@ -251,7 +270,8 @@ def problem_from_toml(text: str, source: str = "<string>") -> DemProblem:
     if not isinstance(tables, dict) or not tables:
         raise _err(source, "[types]", tables, "at least one [types.NAME] table")
     types = []
-    for i, (name, t) in enumerate(tables.items(), start=1):
+    base: dict[str, str] = {}  # type name -> its TOML table (differ for size classes)
+    for name, t in tables.items():
         where = f"types.{name}"
         if not isinstance(t, dict):
             raise _err(source, where, t, "a table")
@@ -271,17 +291,23 @@ def problem_from_toml(text: str, source: str = "<string>") -> DemProblem:
             lo, hi = (_num(source, f"{where}.radius", x) for x in r)
             if not (0.0 < lo <= hi < math.inf):
                 raise _err(source, f"{where}.radius", r, "0 < min <= max (m)")
-            radii = (lo, math.sqrt(lo * hi), hi) if hi > lo else (lo,)
+            ranges = [(lo, hi)] if size_classes == 1 or hi == lo else [
+                (lo * (hi / lo) ** (k / size_classes), lo * (hi / lo) ** ((k + 1) / size_classes))
+                for k in range(size_classes)]
         else:
             R = _num(source, f"{where}.radius", r)
             if not (0.0 < R < math.inf):
                 raise _err(source, f"{where}.radius", R, "a finite number > 0 (m)")
-            radii = (R,)
+            ranges = [(R, R)]
         theta = _num(source, f"{where}.theta_ratio", t.get("theta_ratio", DEFAULT_THETA_RATIO))
         if not (0.0 < theta < math.inf):
             raise _err(source, f"{where}.theta_ratio", theta, "a finite number > 0")
         mat = material_from_table(t["material"], f"{where}.material", source)
-        types.append(ParticleType(name, i, mat, radii, rho, theta))
+        for k, (lo, hi) in enumerate(ranges, start=1):
+            radii = (lo, math.sqrt(lo * hi), hi) if hi > lo else (lo,)
+            sub = name if len(ranges) == 1 else f"{name}_{k}"
+            base[sub] = name
+            types.append(ParticleType(sub, len(types) + 1, mat, radii, rho, theta))
 
     walls = []
     for k, (name, w) in enumerate((data.get("walls") or {}).items(), start=len(types) + 1):
@@ -297,7 +323,7 @@ def problem_from_toml(text: str, source: str = "<string>") -> DemProblem:
     fr = data.get("friction", {})
     if not isinstance(fr, dict):
         raise _err(source, "[friction]", fr, "a table of coefficients")
-    names = [t.name for t in types] + [w.name for w in walls]
+    names = [base[t.name] for t in types] + [w.name for w in walls]
     for key in fr:
         if key != "default" and (key.count("-") < 1 or not any(
                 key == f"{a}-{b}" for a in names for b in names)):
@@ -308,6 +334,7 @@ def problem_from_toml(text: str, source: str = "<string>") -> DemProblem:
             raise _err(source, f"friction.{key}", mu, "a number >= 0")
 
     def mu_of(a: str, b: str) -> float:
+        a, b = base.get(a, a), base.get(b, b)
         for key in (f"{a}-{b}", f"{b}-{a}", "default"):
             if key in fr:
                 return float(fr[key])
@@ -325,7 +352,7 @@ def problem_from_toml(text: str, source: str = "<string>") -> DemProblem:
         except InputError as exc:
             raise InputError(f"{source}: contact {c.key}: {exc}") from None
     return DemProblem(tuple(types), tuple(walls), tuple(contacts), speeds,
-                      tuple(float(a) for a in angles), source)
+                      tuple(float(a) for a in angles), source, text, size_classes)
 
 
 def load_problem(path) -> DemProblem:
