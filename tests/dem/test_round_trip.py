@@ -139,3 +139,21 @@ def test_lammps_runs_the_exported_files_at_every_size_level():
         diff[steps] = max(abs(r["e"] - r["predicted"]) for r in rows)
     assert diff[lammps.STEPS_PER_CONTACT] < 1e-3
     assert diff[4 * lammps.STEPS_PER_CONTACT] < diff[lammps.STEPS_PER_CONTACT] / 2
+
+
+def test_lammps_tangential_constants_give_the_predicted_beta(problem):
+    """The fitted Mindlin stiffness and tangential damping, run by LAMMPS in an oblique
+    wall impact (friction large enough for stick), give the beta the report predicts."""
+    need(_NO_LAMMPS, "LAMMPS")
+    import dataclasses
+
+    ex = export(problem, "lammps")
+    f = next(x for x in ex.fits if x.contact.key == "a-floor")
+    stick = dataclasses.replace(f, params=dict(f.params, mu_s=1e6))
+    t = ex.targets["a-floor"]
+    for i in (0, t.v.size - 1):
+        e, beta = lammps.oblique_wall_restitution(stick, float(t.v[i]))
+        assert e == pytest.approx(f.e_z[i], abs=1e-4)
+        assert beta == pytest.approx(f.beta_x[i], abs=5e-3)
+        # and the fit itself is close to vimpact's full-stick beta_x
+        assert abs(f.beta_x[i] - t.beta_x[i]) < 1e-2

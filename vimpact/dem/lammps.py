@@ -21,9 +21,11 @@ nominal one); the report shows the error at the ends of a size range. ``m_eff = 
 
 Tangential: LAMMPS has no tangential restitution input. The export uses
 ``tangential mindlin`` with the relaxed Mindlin stiffness ``k_t = 8 G / (2 -
-nu)`` of the pair material (``F_t = k_t a xi``) and ``x_gamma_t = (c_t/c_n) =
-2 (1 - nu)/(2 - nu)`` (the tangential dashpot of a Kelvin-Voigt body relative
-to the normal one); its ``beta_x`` is not fitted and not reported.
+nu)`` of the pair material (``F_t = k_t a xi``) as the start and fits
+``k_t`` and the tangential damping ``x_gamma_t`` (``eta_t = x_gamma_t eta_n``)
+to vimpact's full-stick ``beta_x`` by running the law in stick
+(:func:`vimpact.dem.laws.viscoelastic_hertz_mindlin`, checked against LAMMPS
+to 2e-3 in ``beta``); the friction ``mu_s`` caps it in LAMMPS, not in the fit.
 """
 
 from __future__ import annotations
@@ -41,7 +43,9 @@ from vimpact.dem.fit import (ContactFit, Residual, Targets, fit_viscoelastic_her
 from vimpact.dem.problem import Contact, DemProblem
 
 CODE = "lammps"
-TANGENTIAL = False
+TANGENTIAL = True
+#: speeds (of the nominal level) the tangential damping is fitted at
+TANGENTIAL_FIT_POINTS = 3
 #: friction written for a contact without one (LAMMPS needs a finite mu_s)
 STICK_MU = 1.0e6
 
@@ -70,17 +74,65 @@ def fit(problem: DemProblem, targets: dict[str, Targets]) -> list[ContactFit]:
         _, m_nom = c.nominal()
         A, _ = fit_viscoelastic_hertz(t.subset(t.nominal), c.E_star)
         e = viscoelastic_hertz_prediction(t, c.E_star, A, mass_factor=t.m / m_nom)
-        notes = ["beta_x: not represented (LAMMPS has no tangential restitution input; "
-                 "tangential mindlin with the relaxed stiffness is exported, not fitted)"]
+        notes = []
+        params = contact_constants(c, A)
+        b = res_b = None
+        if t.beta_x is not None:
+            k_relaxed = params["k_t"]
+            params["k_t"], params["x_gamma_t"], b = _fit_tangential(c, t, A, params)
+            res_b = Residual.of(b, t.beta_x)
+            notes.append(f"beta_x: Mindlin stiffness k_t = {params['k_t']:.4g} Pa "
+                         f"({params['k_t'] / k_relaxed:.3g} x the relaxed 8 G/(2 - nu)) and "
+                         f"tangential damping x_gamma_t = {params['x_gamma_t']:.4g} fitted in "
+                         "full stick; friction (mu_s) caps the force in LAMMPS, not in the fit")
         if len(set(t.level.tolist())) > 1:
             notes.append("size range: A is fitted at the nominal size; LAMMPS multiplies "
                          "eta_n0 by m_eff, so at the other sizes the damping is off by "
                          "m_eff / m_eff,nominal (included in the residual)")
         if not math.isfinite(c.mu):
             notes.append(f"no friction given: mu_s = {STICK_MU:g} (stick)")
-        fits.append(ContactFit(c, contact_constants(c, A), e, None, Residual.of(e, t.e_z), None,
-                               notes))
+        fits.append(ContactFit(c, params, e, b, Residual.of(e, t.e_z), res_b, notes))
     return fits
+
+
+def _tangential_beta(c: Contact, t: Targets, A: float, params: dict, k_t: float,
+                     x_gamma: float, pick=None) -> np.ndarray:
+    """LAMMPS' ``beta`` at the points of ``t`` (``pick``: a subset) with Mindlin stiffness
+    ``k_t`` (Pa) and tangential damping ``x_gamma`` (full stick; the damping time carries
+    LAMMPS' mass scaling)."""
+    from vimpact.dem import laws, linear
+
+    F = linear.mass_factor(c)
+    _, m_nom = c.nominal()
+    kappa = k_t / (2.0 * params["E_star_Pa"])
+    idx = np.arange(t.v.size) if pick is None else pick
+    d = laws.hertz_overlap(c.E_star, t.R[idx], t.m[idx], t.v[idx])
+    alpha = A * (t.m[idx] / m_nom) * t.v[idx] / d
+    return np.array([laws.viscoelastic_hertz_mindlin(a, kappa, x_gamma, F)[1] for a in alpha])
+
+
+def _fit_tangential(c: Contact, t: Targets, A: float, params: dict
+                    ) -> tuple[float, float, np.ndarray]:
+    """``k_t`` (Pa) and ``x_gamma_t`` >= 0 closest to vimpact's ``beta_x`` (RMS over a few
+    nominal speeds, starting from 0.74 x the relaxed Mindlin stiffness and ``x_gamma_t = 0.4``,
+    near the fits of Kelvin-Voigt pairs) and
+    the law's ``beta`` at every point with them."""
+    from scipy.optimize import minimize
+
+    nominal = np.flatnonzero(t.nominal)
+    pick = nominal[np.unique(np.linspace(0, nominal.size - 1, TANGENTIAL_FIT_POINTS).round()
+                             .astype(int))]
+    k0 = params["k_t"]
+
+    def cost(z) -> float:
+        k, x = k0 * math.exp(float(np.clip(z[0], -5.0, 5.0))), abs(float(z[1]))
+        r = _tangential_beta(c, t, A, params, k, x, pick) - t.beta_x[pick]
+        return float(np.mean(r * r))
+
+    best = minimize(cost, [-0.3, 0.4], method="Nelder-Mead",
+                    options={"xatol": 2e-3, "fatol": 1e-9, "maxiter": 80})
+    k, x = k0 * math.exp(float(np.clip(best.x[0], -5.0, 5.0))), abs(float(best.x[1]))
+    return k, x, _tangential_beta(c, t, A, params, k, x)
 
 
 def _coeffs(p: dict) -> str:
@@ -292,6 +344,38 @@ def round_trip(problem: DemProblem, speeds=(0.1, 1.0), steps_per_contact: int = 
             rows.append((f.contact.key, v, float(predicted_restitution(f, v)),
                          lammps_restitution(f, v, t_c, steps_per_contact)))
     return rows
+
+
+def oblique_wall_restitution(fit: ContactFit, v: float, steps_per_contact: int = 2000
+                             ) -> tuple[float, float]:
+    """LAMMPS' ``(e, beta)`` for the wall contact of ``fit`` (nominal size): a sphere hits
+    the wall with normal speed ``v`` and tangential speed ``v`` (m/s), no spin. ``beta =
+    -v_c,end / v_c0`` with the contact point's velocity ``v_x - R omega_y``; the spin is
+    taken from the tangential impulse (``I = 0.4 m R^2``, LAMMPS' solid sphere)."""
+    from vimpact.dem.laws import hertz_contact_time
+
+    c = fit.contact
+    R, m = c.nominal()
+    rho = c.first.density
+    t_c = float(hertz_contact_time(fit.params["E_star_Pa"], R, m, v))
+    dt = t_c / steps_per_contact
+    gap = 1e-3 * R
+    coeffs = _coeffs(fit.params)
+    script = "\n".join([
+        "units si", "atom_style sphere", "atom_modify map array", "boundary f f f",
+        "comm_modify vel yes", "newton off",
+        f"region box block {-40 * R} {40 * R} {-40 * R} {40 * R} {-4 * R} {40 * R}",
+        "create_box 1 box", "pair_style granular", f"pair_coeff * * {coeffs}",
+        f"create_atoms 1 single 0 0 {R + gap:.12g}",
+        f"set atom 1 diameter {2 * R:.12g} density {rho:.12g}",
+        f"velocity all set {v:.12g} 0 {-v:.12g}",
+        f"fix w all wall/gran granular {coeffs} zplane 0.0 NULL",
+        "fix nve all nve/sphere", f"timestep {dt:.12g}",
+        f"run {int(math.ceil((gap / v + 2.0 * t_c) / dt))}",
+        "variable vx equal vx[1]", "variable vz equal vz[1]", ""])
+    vx, vz = run_lammps(script, ["vx", "vz"])
+    omega = R * m * (v - vx) / (0.4 * m * R * R)
+    return vz / v, -(vx - R * omega) / v
 
 
 def level_prediction(fit: ContactFit, R: float, m: float, v) -> np.ndarray:
