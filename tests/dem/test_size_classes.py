@@ -30,11 +30,11 @@ def test_classes_split_the_range_geometrically_and_keep_friction():
 
 def test_lammps_residual_target_is_met_by_splitting(tmp_path):
     problem = problem_from_toml(RANGE, "classes")
-    one, met1, _ = export_to_residual(problem, "lammps", 1.0)  # any target: one class
+    one, met1, _ = export_to_residual(problem, "lammps", 1.0, tangential=False)  # one class
     worst1 = max(f.res_e_z.max_abs for f in one.fits)
     assert met1 and one.problem.size_classes == 1 and worst1 > 0.05
     target = worst1 / 3.0
-    ex, met, needed = export_to_residual(problem, "lammps", target, tmp_path)
+    ex, met, needed = export_to_residual(problem, "lammps", target, tmp_path, tangential=False)
     worst = max(f.res_e_z.max_abs for f in ex.fits)
     assert met and worst <= target and needed == ex.problem.size_classes > 1
     assert "pair_coeff 2 3" in (tmp_path / "lammps_pair.in").read_text()
@@ -43,6 +43,6 @@ def test_lammps_residual_target_is_met_by_splitting(tmp_path):
 def test_cli_says_how_many_classes(tmp_path, capsys):
     src = tmp_path / "setup.toml"
     src.write_text(RANGE)
-    assert main(["dem", str(src), "--for", "lammps", "--out", str(tmp_path),
+    assert main(["dem", str(src), "--for", "liggghts", "--out", str(tmp_path),
                  "--residual", "1.0"]) == 0
     assert "size classes: 1 per size-range type (2 particle types)" in capsys.readouterr().out

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import importlib
 import math
 from dataclasses import dataclass
@@ -32,7 +33,7 @@ def code_module(code: str):
 
 def export(problem: DemProblem, code: str, out_dir=None, numerics=None,
            targets: dict[str, Targets] | None = None, steps_per_contact: int | None = None,
-           progress=None) -> Export:
+           progress=None, tangential: bool | None = None) -> Export:
     """Fit ``code``'s constants for every contact of ``problem``; with ``out_dir``
     write its input file(s), ``report_<code>.md`` and ``report_<code>.png`` there.
 
@@ -41,7 +42,8 @@ def export(problem: DemProblem, code: str, out_dir=None, numerics=None,
     has a tangential restitution). ``steps_per_contact``
     sets the exported time step of the codes that get one (LAMMPS, LIGGGHTS,
     Yade; default: the module's ``STEPS_PER_CONTACT``). ``progress(text)`` is
-    called before each contact's vimpact runs and before the fit.
+    called before each contact's vimpact runs and before the fit. ``tangential=False``
+    skips ``beta_x`` (and the tangential fits) for a code that has it.
     """
     mod = code_module(code)
     say = progress or (lambda _text: None)
@@ -54,13 +56,15 @@ def export(problem: DemProblem, code: str, out_dir=None, numerics=None,
                                      "only with --for lammps, liggghts or yade "
                                      f"({code} takes no time step)"))
         steps = steps_per_contact
-    targets = {k: t for k, t in (targets or {}).items()
-               if not (mod.TANGENTIAL and t.beta_x is None)}
+    tan = mod.TANGENTIAL if tangential is None else (mod.TANGENTIAL and tangential)
+    targets = {k: t for k, t in (targets or {}).items() if not (tan and t.beta_x is None)}
+    if not tan:
+        targets = {k: dataclasses.replace(t, beta_x=None) for k, t in targets.items()}
     missing = [c for c in problem.contacts if c.key not in targets]
     for k, c in enumerate(missing, start=1):
         say(f"vimpact curves {k}/{len(missing)}: {c.key}"
-            + (" (normal and tangential)" if mod.TANGENTIAL else ""))
-        targets[c.key] = compute_targets(problem, c, tangential=mod.TANGENTIAL, numerics=numerics)
+            + (" (normal and tangential)" if tan else ""))
+        targets[c.key] = compute_targets(problem, c, tangential=tan, numerics=numerics)
     targets = {c.key: targets[c.key] for c in problem.contacts}
     say(f"fitting {code}'s constants")
     fits = mod.fit(problem, targets)
@@ -89,14 +93,17 @@ MAX_SIZE_CLASSES = 8
 
 def export_to_residual(problem: DemProblem, code: str, residual: float, out_dir=None,
                        numerics=None, steps_per_contact: int | None = None,
-                       progress=None) -> tuple[Export, bool, int]:
+                       progress=None, tangential: bool | None = None
+                       ) -> tuple[Export, bool, int]:
     """Split every size-range type into size classes
     (:meth:`DemProblem.with_size_classes`) until the largest ``e_z`` residual of
     every contact is at most ``residual``: 1 class, then (the size range's error
     falling about as 1/k) the number that scaling says, checked again, up to
     :data:`MAX_SIZE_CLASSES`; it stops early when a split no longer lowers the
     residual (what is left is not the size range's, e.g. the speed dependence a
-    constant-``e`` code cannot follow). Writes the files of the best problem.
+    constant-``e`` code cannot follow). Writes the files of the best problem (with
+    ``beta_x`` and the tangential fits, unless ``tangential=False``; the search itself
+    uses ``e_z`` only).
 
     Returns
     -------
@@ -121,7 +128,8 @@ def export_to_residual(problem: DemProblem, code: str, residual: float, out_dir=
         prob = problem.with_size_classes(k) if k > 1 else problem
         say(f"size classes per size-range type: {k}")
         known = {c.key: cache[ident(c)] for c in prob.contacts if ident(c) in cache}
-        ex = export(prob, code, None, numerics, known, steps_per_contact, progress)
+        ex = export(prob, code, None, numerics, known, steps_per_contact, progress,
+                    tangential=False)  # the search needs e_z only
         for c in prob.contacts:
             cache[ident(c)] = ex.targets[c.key]
         worst = max(f.res_e_z.max_abs for f in ex.fits)
@@ -138,5 +146,6 @@ def export_to_residual(problem: DemProblem, code: str, residual: float, out_dir=
     k = prob.size_classes
     needed = k if met else (0 if stalled else math.ceil(k * worst / residual))
     if out_dir is not None:
-        ex = export(prob, code, out_dir, numerics, ex.targets, steps_per_contact)
+        ex = export(prob, code, out_dir, numerics, ex.targets, steps_per_contact, progress,
+                    tangential)
     return ex, met, needed

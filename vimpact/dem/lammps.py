@@ -96,7 +96,7 @@ def fit(problem: DemProblem, targets: dict[str, Targets]) -> list[ContactFit]:
 
 
 def _tangential_beta(c: Contact, t: Targets, A: float, params: dict, k_t: float,
-                     x_gamma: float, pick=None) -> np.ndarray:
+                     x_gamma: float, pick=None, rtol: float = 1e-8) -> np.ndarray:
     """LAMMPS' ``beta`` at the points of ``t`` (``pick``: a subset) with Mindlin stiffness
     ``k_t`` (Pa) and tangential damping ``x_gamma`` (full stick; the damping time carries
     LAMMPS' mass scaling)."""
@@ -108,7 +108,8 @@ def _tangential_beta(c: Contact, t: Targets, A: float, params: dict, k_t: float,
     idx = np.arange(t.v.size) if pick is None else pick
     d = laws.hertz_overlap(c.E_star, t.R[idx], t.m[idx], t.v[idx])
     alpha = A * (t.m[idx] / m_nom) * t.v[idx] / d
-    return np.array([laws.viscoelastic_hertz_mindlin(a, kappa, x_gamma, F)[1] for a in alpha])
+    return np.array([laws.viscoelastic_hertz_mindlin(a, kappa, x_gamma, F, rtol)[1]
+                     for a in alpha])
 
 
 def _fit_tangential(c: Contact, t: Targets, A: float, params: dict
@@ -126,7 +127,7 @@ def _fit_tangential(c: Contact, t: Targets, A: float, params: dict
 
     def cost(z) -> float:
         k, x = k0 * math.exp(float(np.clip(z[0], -5.0, 5.0))), abs(float(z[1]))
-        r = _tangential_beta(c, t, A, params, k, x, pick) - t.beta_x[pick]
+        r = _tangential_beta(c, t, A, params, k, x, pick, rtol=1e-6) - t.beta_x[pick]
         return float(np.mean(r * r))
 
     best = minimize(cost, [-0.3, 0.4], method="Nelder-Mead",

@@ -155,8 +155,8 @@ def viscoelastic_hertz_restitution(A: float, E_star: float, R, m, v0) -> np.ndar
     return viscoelastic_hertz_curve(A * v0 / hertz_overlap(E_star, R, m, v0))
 
 
-def viscoelastic_hertz_mindlin(alpha: float, kappa: float, x_gamma: float, F: float
-                               ) -> tuple[float, float]:
+def viscoelastic_hertz_mindlin(alpha: float, kappa: float, x_gamma: float, F: float,
+                               rtol: float = RTOL) -> tuple[float, float]:
     """Normal and tangential restitution of the clipped viscoelastic Hertz law with a
     Mindlin tangential spring and dashpot in stick (LAMMPS ``hertz ... damping
     viscoelastic tangential mindlin k_t x_gamma_t mu limit_damping``).
@@ -173,6 +173,7 @@ def viscoelastic_hertz_mindlin(alpha: float, kappa: float, x_gamma: float, F: fl
     alpha : ``A v0 / d_H``; kappa : ``k_t / (2 E*)`` (Mindlin over Hertz tangent
         stiffness, ``2 (1 - nu)/(2 - nu)`` for one material); x_gamma : tangential
         over normal damping; F : contact-point mass factor ``1 + m R^2/Theta``
+    rtol : integrator tolerance (relative; absolute ``rtol / 100``)
 
     Returns
     -------
@@ -198,8 +199,8 @@ def viscoelastic_hertz_mindlin(alpha: float, kappa: float, x_gamma: float, F: fl
 
     events = [_terminal(overlap)] + ([_terminal(force)] if a > 0.0 else [])
     s0 = 1e-9
-    sol = solve_ivp(rhs, (s0, 50.0 + 50.0 * a), [s0, 1.0, s0, 1.0], method="DOP853", rtol=RTOL,
-                    atol=ATOL, events=events)
+    sol = solve_ivp(rhs, (s0, 50.0 + 50.0 * a), [s0, 1.0, s0, 1.0], method="DOP853", rtol=rtol,
+                    atol=rtol / 100.0, events=events)
     for ev_t, ev_y in zip(sol.t_events, sol.y_events):
         if len(ev_t):
             return abs(float(ev_y[0][1])), -float(ev_y[0][3])
