@@ -31,7 +31,8 @@ material = "rigid"
 default = 0.5
 """
 
-FILES = {"lammps": ["lammps_settings.in", "lammps_pair.in", "lammps_walls.in"], "liggghts": ["liggghts_settings.in", "liggghts.in"],
+FILES = {"lammps": ["lammps_settings.in", "lammps_pair.in", "lammps_walls.in"],
+         "liggghts": ["liggghts_settings.in", "liggghts.in"],
          "mercurydpm": ["mercurydpm_species.cpp"], "yade": ["yade_materials.py"],
          "mfix": ["mfix.dat"], "rebound": ["vimpact_restitution.py"]}
 
