@@ -14,12 +14,12 @@ from vimpact.dem.problem import problem_from_toml
 
 @pytest.fixture(scope="module")
 def exported():
-    need(liggghts.liggghts_available(), "LIGGGHTS")
     problem = problem_from_toml(TOML, "round-trip")
     return problem, export(problem, "liggghts").fits
 
 
 def test_liggghts_runs_the_exported_files_and_restitutes_the_prediction(exported):
+    need(liggghts.liggghts_available(), "LIGGGHTS")
     problem, fits = exported
     speeds = np.geomspace(problem.speeds.min(), problem.speeds.max(), 5)
     diff = {}

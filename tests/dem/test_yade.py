@@ -14,12 +14,12 @@ from vimpact.dem.problem import problem_from_toml
 
 @pytest.fixture(scope="module")
 def exported():
-    need(yade.yade_available(), "Yade")
     problem = problem_from_toml(TOML, "round-trip")
     return problem, export(problem, "yade").fits
 
 
 def test_yade_runs_the_exported_file_and_restitutes_the_prediction(exported):
+    need(yade.yade_available(), "Yade")
     problem, fits = exported
     speeds = np.geomspace(problem.speeds.min(), problem.speeds.max(), 5)
     diff = {}
