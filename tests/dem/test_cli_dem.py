@@ -31,7 +31,8 @@ material = "rigid"
 default = 0.5
 """
 
-FILES = {"lammps": ["lammps.in"], "liggghts": ["liggghts.in"],
+FILES = {"lammps": ["lammps_settings.in", "lammps_pair.in", "lammps_walls.in"],
+         "liggghts": ["liggghts_settings.in", "liggghts.in"],
          "mercurydpm": ["mercurydpm_species.cpp"], "yade": ["yade_materials.py"],
          "mfix": ["mfix.dat"], "rebound": ["vimpact_restitution.py"]}
 
@@ -46,7 +47,7 @@ def test_writes_input_and_report_for_every_code(code, tmp_path, capsys):
         assert (out / name).stat().st_size > 0, name
     report = (out / f"report_{code}.md").read_text()
     assert "a-b" in report and "a-floor" in report and "b-floor" in report
-    if code not in ("yade", "mfix"):
+    if code not in ("yade", "mfix", "lammps"):
         assert "not represented" in report
     text = capsys.readouterr().out
     assert "e_z residual" in text
@@ -56,15 +57,19 @@ def test_lammps_lines_name_every_pair_and_one_wall_fix_per_type(tmp_path):
     src = tmp_path / "setup.toml"
     src.write_text(TOML)
     main(["dem", str(src), "--for", "lammps", "--out", str(tmp_path)])
-    text = (tmp_path / "lammps.in").read_text()
+    text = (tmp_path / "lammps_pair.in").read_text()
     assert [ln.split()[1:3] for ln in text.splitlines() if ln.startswith("pair_coeff")] == \
         [["1", "1"], ["1", "2"], ["2", "2"]]
-    assert sum(ln.startswith("fix wall_floor_") for ln in text.splitlines()) == 2
+    walls = (tmp_path / "lammps_walls.in").read_text().splitlines()
+    assert sum(ln.startswith("fix wall_floor_") for ln in walls) == 2
+    settings = (tmp_path / "lammps_settings.in").read_text()
+    assert "units si" in settings and "timestep" in text
 
 
 @pytest.mark.parametrize("edit, words", [
     (("G = 9e7", "G = -9e7"), "G"),
-    (('model = "elastic"', 'model = "kelvin_voigt"\neta = 100.0'), "not allowed"),
+    (('model = "elastic"\nnu = 0.45', 'model = "kelvin_voigt"\neta = 100.0\nnu = 0.3'),
+     "equal nu"),
     (("min = 0.1", "min = 2.0"), "speeds"),
     (("density = 1200.0", 'density = "heavy"'), "density"),
 ])
@@ -79,3 +84,28 @@ def test_bad_input_is_one_line_and_exit_2(edit, words, tmp_path, capsys):
 def test_missing_file_is_exit_2(tmp_path, capsys):
     assert main(["dem", str(tmp_path / "nope.toml"), "--for", "mfix"]) == 2
     assert capsys.readouterr().err.count("\n") == 1
+
+
+def test_json_output_is_the_fits_and_progress_goes_to_stderr(tmp_path, capsys):
+    import json
+
+    src = tmp_path / "setup.toml"
+    src.write_text(TOML)
+    assert main(["dem", str(src), "--for", "liggghts", "--out", str(tmp_path), "--json",
+                 "--steps-per-contact", "40"]) == 0
+    cap = capsys.readouterr()
+    data = json.loads(cap.out)  # strict JSON: no NaN or Infinity
+    assert data["code"] == "liggghts"
+    assert {c["contact"] for c in data["contacts"]} == {"a-a", "a-b", "a-floor", "b-b", "b-floor"}
+    assert all(c["residual_e_z"]["rms"] <= c["residual_e_z"]["max_abs"] for c in data["contacts"])
+    assert "vimpact curves 5/5" in cap.err
+    assert "/ 40 steps" not in (tmp_path / "liggghts.in").read_text()
+    assert "40 steps per shortest contact" in (tmp_path / "liggghts.in").read_text()
+
+
+def test_steps_per_contact_only_for_codes_with_a_time_step(tmp_path, capsys):
+    src = tmp_path / "setup.toml"
+    src.write_text(TOML)
+    assert main(["dem", str(src), "--for", "rebound", "--steps-per-contact", "50"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "--steps-per-contact" in err

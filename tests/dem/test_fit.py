@@ -7,7 +7,7 @@ import vimpact as v
 from vimpact.dem import laws
 from vimpact.dem.fit import Targets, fit_constant, fit_scalar, fit_viscoelastic_hertz
 from vimpact.dem.problem import problem_from_toml
-from vimpact.dem.yade import _beta as yade_beta
+from vimpact.dem.yade import yade_law
 
 TOML = """
 [speeds]
@@ -66,10 +66,32 @@ def test_constant_fit_is_the_mean_and_reports_the_spread():
     assert res.max_abs == pytest.approx(0.1) and res.rms == pytest.approx(np.sqrt(0.02 / 3))
 
 
+def yade_beta(en, et, F, q=1.0):
+    return yade_law(1e-4, en, et, q, F)[1]
+
+
 def test_yade_et_fit_recovers_et():
     target = np.full(5, yade_beta(0.8, 0.35, 2.9))
     et, pred = fit_scalar(lambda x: np.full(5, yade_beta(0.8, x, 2.9)), target, 1e-6, 1.0)
     assert et == pytest.approx(0.35, rel=1e-5)
+
+
+def test_yade_law_between_spheres_is_the_clipped_linear_law():
+    """Yade's kn, cn from (tc, en) are the textbook spring-dashpot of damping ratio
+    |ln en| / sqrt(pi^2 + ln^2 en) and period-based contact time; with the force clipped at
+    zero the restitution is above en, and a wall (massR = m/2) damps by 1/sqrt(2) less."""
+    from vimpact.dem import laws
+
+    en = 0.8
+    zeta = laws.zeta_of_restitution(en)
+    e_pair, _, t_pair = yade_law(1e-4, en, 1.0, 1.0, 3.5)
+    assert e_pair == pytest.approx(laws.linear_spring_dashpot(zeta, "force")[0], abs=1e-9)
+    assert e_pair > en
+    e_wall = yade_law(1e-4, en, 1.0, 0.5, 3.5)[0]
+    assert e_wall == pytest.approx(laws.linear_spring_dashpot(zeta / np.sqrt(2), "force")[0],
+                                   abs=1e-9)
+    # the unclipped contact lasts tc exactly (half a damped period), the clipped one less
+    assert t_pair < 1e-4
 
 
 def test_kelvin_voigt_fit_is_close_to_tau_and_residual_is_second_order():

@@ -7,7 +7,7 @@ import pytest
 
 from vimpact.dem import laws, linear
 from vimpact.dem.mfix import _beta as mfix_beta
-from vimpact.dem.yade import _beta as yade_beta
+from vimpact.dem.yade import yade_law
 from vimpact.reference.closed_forms import linear_model_zeta
 
 
@@ -56,11 +56,14 @@ def test_tabulated_master_curve_equals_direct_solves():
     np.testing.assert_allclose(laws.viscoelastic_hertz_curve(alphas), direct, atol=2e-7)
 
 
-@pytest.mark.parametrize("en, et", [(0.7, 0.4), (0.3, 0.9), (0.95, 0.05)])
-def test_yade_tangential_restitution_is_et_for_solid_spheres(en, et):
+@pytest.mark.parametrize("et", [0.4, 0.9, 0.05])
+def test_yade_tangential_restitution_is_et_for_solid_spheres(et):
     """Yade's ks, cs use the contact-point mass 2/7 m of solid spheres (mass factor 3.5):
-    the tangential oscillator then completes half a damped period in tc, so beta = et."""
-    assert yade_beta(en, et, 3.5) == pytest.approx(et, rel=1e-8)
+    the tangential oscillator then completes half a damped period in tc, so beta = et when
+    the normal contact lasts tc too (en = 1: no damping, the force ends with the overlap)."""
+    e, beta, t = yade_law(1e-4, 1.0, et, 1.0, 3.5)
+    assert e == pytest.approx(1.0, abs=1e-9) and t == pytest.approx(1e-4, rel=1e-8)
+    assert beta == pytest.approx(et, rel=1e-8)
 
 
 def test_linear_tangential_undamped_closed_form():

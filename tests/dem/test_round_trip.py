@@ -6,6 +6,7 @@ import importlib.util
 import numpy as np
 import pytest
 
+from tests.dem.codes import need
 from vimpact.dem import lammps
 from vimpact.dem.export import export
 from vimpact.dem.laws import hertz_contact_time
@@ -47,10 +48,15 @@ def problem():
 _NO_LAMMPS = lammps.lammps_available()
 
 
-@pytest.mark.skipif(_NO_LAMMPS is not None, reason=f"LAMMPS round trip: {_NO_LAMMPS}")
+@pytest.fixture(scope="module")
+def lammps_export(problem):
+    return export(problem, "lammps")
+
+
 @pytest.mark.parametrize("key", ["a-floor", "a-b"])
-def test_lammps_restitutes_what_the_report_predicts(problem, key):
-    fits = {f.contact.key: f for f in export(problem, "lammps").fits}
+def test_lammps_restitutes_what_the_report_predicts(lammps_export, key):
+    need(_NO_LAMMPS, "LAMMPS")
+    fits = {f.contact.key: f for f in lammps_export.fits}
     f = fits[key]
     R, m = f.contact.nominal()
     for v in (0.1, 1.0):
@@ -91,7 +97,6 @@ def test_rebound_round_trip_with_the_exported_callback(problem, tmp_path):
     assert fit.params["e_z"] == pytest.approx(list(ex.targets[fit.contact.key].e_z), rel=1e-12)
 
 
-@pytest.mark.skipif(_NO_LAMMPS is not None, reason=f"LAMMPS: {_NO_LAMMPS}")
 def test_lammps_hertz_material_wall_is_a_body_of_the_particles_material():
     """What docs/dem.md says about LAMMPS (why the export uses `hertz` with k_n per
     contact): with `hertz/material E eta nu` a `fix wall/gran` wall behaves as a body of
@@ -99,6 +104,7 @@ def test_lammps_hertz_material_wall_is_a_body_of_the_particles_material():
     Measured through the elastic contact time against the Hertz closed form."""
     import math
 
+    need(_NO_LAMMPS, "LAMMPS")
     R, rho, v, E, nu = 0.005, 1150.0, 0.5, 1e8, 0.3
     m = rho * 4.0 / 3.0 * math.pi * R**3
 
@@ -120,3 +126,39 @@ def test_lammps_hertz_material_wall_is_a_body_of_the_particles_material():
     t_contact = frac * n * dt
     assert t_contact == pytest.approx(t_hertz(E / (2 * (1 - nu**2))), rel=1e-3)
     assert t_contact / t_hertz(E / (1 - nu**2)) == pytest.approx(2**0.4, rel=1e-3)
+
+
+def test_lammps_runs_the_exported_files_at_every_size_level():
+    """What users paste: the settings, the per-type pair_coeff lines and the wall groups and
+    fixes, included unchanged in the documented order, with particles of every type at every
+    size level (a size range, so LAMMPS' mass scaling of the damping enters)."""
+    need(_NO_LAMMPS, "LAMMPS")
+    problem = problem_from_toml(TOML.replace("radius = 0.004", "radius = [0.003, 0.005]"), "rt")
+    fits = export(problem, "lammps", tangential=False).fits  # the normal law is checked here
+    speeds = np.geomspace(problem.speeds.min(), problem.speeds.max(), 5)
+    diff = {}
+    for steps in (lammps.STEPS_PER_CONTACT, 4 * lammps.STEPS_PER_CONTACT):
+        rows = lammps.round_trip_files(problem, speeds, steps, fits=fits)
+        assert {(r["contact"], r["level"]) for r in rows} == {
+            (f.contact.key, k) for f in fits for k in range(len(f.contact.levels()))}
+        diff[steps] = max(abs(r["e"] - r["predicted"]) for r in rows)
+    assert diff[lammps.STEPS_PER_CONTACT] < 1e-3
+    assert diff[4 * lammps.STEPS_PER_CONTACT] < diff[lammps.STEPS_PER_CONTACT] / 2
+
+
+def test_lammps_tangential_constants_give_the_predicted_beta(lammps_export):
+    """The fitted Mindlin stiffness and tangential damping, run by LAMMPS in an oblique
+    wall impact (friction large enough for stick), give the beta the report predicts."""
+    need(_NO_LAMMPS, "LAMMPS")
+    import dataclasses
+
+    ex = lammps_export
+    f = next(x for x in ex.fits if x.contact.key == "a-floor")
+    stick = dataclasses.replace(f, params=dict(f.params, mu_s=1e6))
+    t = ex.targets["a-floor"]
+    for i in (0, t.v.size - 1):
+        e, beta = lammps.oblique_wall_restitution(stick, float(t.v[i]))
+        assert e == pytest.approx(f.e_z[i], abs=1e-4)
+        assert beta == pytest.approx(f.beta_x[i], abs=5e-3)
+        # and the fit itself is close to vimpact's full-stick beta_x
+        assert abs(f.beta_x[i] - t.beta_x[i]) < 1e-2

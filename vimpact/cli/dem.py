@@ -26,6 +26,16 @@ def add_parser(sub) -> None:
                         "temperature_K)")
     p.add_argument("--preset", default="fast", choices=("fast", "default", "precise"),
                    help="vimpact numerics for the restitution curves (default: fast)")
+    p.add_argument("--steps-per-contact", type=int, default=None, metavar="N",
+                   help="time steps per shortest contact in the exported time step (lammps: "
+                        "100, liggghts: 100, yade: 400 by default); the report gives the "
+                        "code's time-step error measured at such steps")
+    p.add_argument("--residual", type=float, default=None, metavar="E",
+                   help="split every type with a radius range into 1, 2, ... size classes "
+                        "(types NAME_1..NAME_k) until the largest e_z residual of every contact "
+                        "is at most E (up to 8 classes); the summary says how many it took")
+    p.add_argument("--json", action="store_true",
+                   help="print the fits (constants, residuals, files written) as JSON")
     p.set_defaults(func=run)
 
 
@@ -34,12 +44,83 @@ def run(args: argparse.Namespace) -> int:
     from vimpact.dem.problem import load_problem
     from vimpact.model.numerics import Numerics
 
+    import json
+    import sys
+
+    from vimpact.model.validation import InputError, message
+
+    if args.steps_per_contact is not None and args.steps_per_contact < 4:
+        raise InputError(message("--steps-per-contact", args.steps_per_contact,
+                                  "an integer >= 4"))
     problem = load_problem(args.file, temperature=args.temperature)
     out = args.out or f"vimpact-dem-{args.code}"
-    result = export(problem, args.code, out, Numerics.preset(args.preset))
+
+    def progress(text: str) -> None:
+        print(f"vimpact dem: {text}", file=sys.stderr, flush=True)
+
+    classes = None
+    if args.residual is not None:
+        from vimpact.dem.export import export_to_residual
+
+        result, met, needed = export_to_residual(problem, args.code, args.residual, out,
+                                         Numerics.preset(args.preset),
+                                         steps_per_contact=args.steps_per_contact,
+                                         progress=progress)
+        worst = max(f.res_e_z.max_abs for f in result.fits)
+        classes = {"size_classes": result.problem.size_classes,
+                   "types": len(result.problem.types), "target": args.residual,
+                   "max_residual_e_z": worst, "met": met, "classes_needed": needed}
+    else:
+        result = export(problem, args.code, out, Numerics.preset(args.preset),
+                        steps_per_contact=args.steps_per_contact, progress=progress)
+    if args.json:
+        data = to_json(result)
+        if classes is not None:
+            data["size_classes"] = classes
+        print(json.dumps(data, indent=1))
+        return 0
+    if classes is not None:
+        head = (f"size classes: {classes['size_classes']} per size-range type "
+                f"({classes['types']} particle types), largest e_z residual "
+                f"{classes['max_residual_e_z']:.2e}")
+        if classes["met"]:
+            print(f"{head} <= target {args.residual:g}")
+        elif classes["classes_needed"]:
+            print(f"{head} > target {args.residual:g}: not met; about "
+                  f"{classes['classes_needed']} classes would be (the size range's error "
+                  "falls as 1/classes)")
+        else:
+            print(f"{head} > target {args.residual:g}: not met; splitting does not lower it "
+                  "(the residual left is not the size range's)")
     for f in result.fits:
         rb = f"; beta_x {f.res_beta_x}" if f.res_beta_x is not None else ""
         print(f"{f.contact.key}: e_z residual {f.res_e_z}{rb}")
     for path in result.files:
         print(f"wrote {path}")
     return 0
+
+
+def _number(x):
+    """JSON-safe: non-finite floats become ``None`` (never NaN or Infinity in the output)."""
+    import math
+
+    if isinstance(x, float) and not math.isfinite(x):
+        return None
+    return x
+
+
+def to_json(result) -> dict:
+    """The fits of an export as plain data: per contact the constants (SI), the residuals
+    (code minus vimpact, dimensionless) and the notes; the files written."""
+    def res(r):
+        return None if r is None else {"max_abs": r.max_abs, "rms": r.rms}
+
+    return {
+        "code": result.code,
+        "contacts": [{"contact": f.contact.key, "wall": f.contact.is_wall,
+                      "params": {k: _number(v) for k, v in f.params.items()
+                                 if isinstance(v, (int, float))},
+                      "residual_e_z": res(f.res_e_z), "residual_beta_x": res(f.res_beta_x),
+                      "notes": f.notes} for f in result.fits],
+        "files": [str(p) for p in result.files],
+    }

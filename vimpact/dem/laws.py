@@ -155,6 +155,58 @@ def viscoelastic_hertz_restitution(A: float, E_star: float, R, m, v0) -> np.ndar
     return viscoelastic_hertz_curve(A * v0 / hertz_overlap(E_star, R, m, v0))
 
 
+def viscoelastic_hertz_mindlin(alpha: float, kappa: float, x_gamma: float, F: float,
+                               rtol: float = RTOL) -> tuple[float, float]:
+    """Normal and tangential restitution of the clipped viscoelastic Hertz law with a
+    Mindlin tangential spring and dashpot in stick (LAMMPS ``hertz ... damping
+    viscoelastic tangential mindlin k_t x_gamma_t mu limit_damping``).
+
+    In the units of :func:`viscoelastic_hertz_e` (overlap ``x``, tangential
+    displacement ``s`` in ``d_H``, contact-point velocity ``w`` in ``v0``):
+    ``w' = -(5/4) F sqrt(x) (1.5 kappa s + 1.5 alpha x_gamma w)``, ``s' = w``, from
+    ``F_t = -(k_t a s + x_gamma eta_n v_t)`` with ``k_t = 8 G*`` = ``1.5 kappa`` times
+    ``k_n = 4/3 E*`` and ``eta_n = 2 E* A a``. The tangential force ends with the
+    normal one (its Coulomb limit is then zero).
+
+    Parameters
+    ----------
+    alpha : ``A v0 / d_H``; kappa : ``k_t / (2 E*)`` (Mindlin over Hertz tangent
+        stiffness, ``2 (1 - nu)/(2 - nu)`` for one material); x_gamma : tangential
+        over normal damping; F : contact-point mass factor ``1 + m R^2/Theta``
+    rtol : integrator tolerance (relative; absolute ``rtol / 100``)
+
+    Returns
+    -------
+    (e, beta) : ``beta = -w_end / w_0`` with ``w_0 = 1`` (the contact point slides
+        initially at the normal approach speed)
+    """
+    a, k, g = float(alpha), float(kappa), float(x_gamma)
+
+    def rhs(_, y):
+        x, v, s, w = y
+        r = math.sqrt(max(x, 0.0))
+        f = x * r + 1.5 * a * r * v
+        ft = 1.5 * k * s * r + 1.5 * a * g * r * w
+        if f < 0.0:
+            f, ft = 0.0, 0.0
+        return [v, -1.25 * f, w, -1.25 * F * ft]
+
+    def overlap(_, y):
+        return y[0]
+
+    def force(_, y):
+        return y[0] + 1.5 * a * y[1]
+
+    events = [_terminal(overlap)] + ([_terminal(force)] if a > 0.0 else [])
+    s0 = 1e-9
+    sol = solve_ivp(rhs, (s0, 50.0 + 50.0 * a), [s0, 1.0, s0, 1.0], method="DOP853", rtol=rtol,
+                    atol=rtol / 100.0, events=events)
+    for ev_t, ev_y in zip(sol.t_events, sol.y_events):
+        if len(ev_t):
+            return abs(float(ev_y[0][1])), -float(ev_y[0][3])
+    raise RuntimeError(f"viscoelastic Hertz-Mindlin law with alpha = {a} did not end its contact")
+
+
 # ---- Tsuji-type Hertz (LIGGGHTS) ----------------------------------------
 
 def liggghts_beta(e_in: float) -> float:

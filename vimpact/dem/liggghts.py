@@ -12,6 +12,12 @@ speed; integrated here without ``limitForce`` it equals the input ``e``
 (to 1e-10), so the export is the constant closest to vimpact's ``e_z(v)`` in
 RMS and the residual is the speed dependence LIGGGHTS cannot follow. There is
 no tangential restitution input.
+
+Files: ``liggghts_settings.in`` (before ``create_box``: units, atom style,
+communication) and ``liggghts.in`` (after it: ``hard_particles yes`` when a
+Young's modulus exceeds the 1e9 Pa LIGGGHTS accepts by default in SI units,
+the property matrices, the pair style, one ``fix wall/gran`` per wall and the
+time step). Checked by running LIGGGHTS-PUBLIC 3.8.0 (tests/dem/test_liggghts.py).
 """
 
 from __future__ import annotations
@@ -28,10 +34,19 @@ CODE = "liggghts"
 TANGENTIAL = False
 #: Young's modulus of a rigid wall relative to the stiffest particle type
 RIGID_WALL_FACTOR = 1000.0
+#: largest Young's modulus LIGGGHTS accepts in SI units without ``hard_particles yes``, Pa
+SOFT_LIMIT = 1.0e9
+#: default time steps per (shortest) contact in the exported ``timestep``
+STEPS_PER_CONTACT = 100
+#: the code's time-step error in e, about ``C / steps_per_contact``: ``(C, measurement)``,
+#: the largest |e - predicted| over the round trip of sweeps/dem/two_rubbers.toml
+TIME_STEP_ERROR = (0.05, "LIGGGHTS-PUBLIC 3.8.0 (Debian): "
+                   "4.1e-4 at 100, 7.1e-5 at 800 steps")
 
 
 def fit(problem: DemProblem, targets: dict[str, Targets]) -> list[ContactFit]:
     fits = []
+    Y = _youngs(problem)
     for c in problem.contacts:
         t = targets[c.key]
         e_in, _ = fit_constant(t.e_z, 1e-6, 1.0)
@@ -39,8 +54,13 @@ def fit(problem: DemProblem, targets: dict[str, Targets]) -> list[ContactFit]:
         e = np.full_like(t.e_z, e_code)
         notes = ["speed-independent restitution: the residual is vimpact's speed dependence",
                  "beta_x: not represented (no tangential restitution input)"]
-        fits.append(ContactFit(c, {"coefficientRestitution": e_in, "mu": c.mu}, e, None,
-                               Residual.of(e, t.e_z), None, notes))
+        (E1, nu1), (E2, nu2) = Y[c.first.index - 1], Y[c.second.index - 1]
+        E_code = 1.0 / ((1.0 - nu1**2) / E1 + (1.0 - nu2**2) / E2)
+        R, m = c.nominal()
+        t_c = float(laws.hertz_contact_time(E_code, R, m, problem.speeds.max()))
+        fits.append(ContactFit(c, {"coefficientRestitution": e_in, "mu": c.mu, "e_liggghts": e_code,
+                                   "E_star_Pa": E_code, "t_contact_min": t_c},
+                               e, None, Residual.of(e, t.e_z), None, notes))
     return fits
 
 
@@ -54,7 +74,14 @@ def _youngs(problem: DemProblem) -> list[tuple[float, float]]:
     return out
 
 
-def render(problem: DemProblem, fits: list[ContactFit]) -> dict[str, str]:
+def time_step(fits: list[ContactFit], steps_per_contact: int = STEPS_PER_CONTACT) -> float:
+    """``timestep`` (s): the shortest Hertz contact time (fastest impact) over
+    ``steps_per_contact``."""
+    return min(f.params["t_contact_min"] for f in fits) / steps_per_contact
+
+
+def render(problem: DemProblem, fits: list[ContactFit],
+           steps_per_contact: int = STEPS_PER_CONTACT) -> dict[str, str]:
     names = [t.name for t in problem.types] + [w.name for w in problem.walls]
     n = len(names)
     e = np.full((n, n), 0.5)  # wall-wall entries are never used
@@ -65,21 +92,150 @@ def render(problem: DemProblem, fits: list[ContactFit]) -> dict[str, str]:
         m = f.params["mu"]
         mu[i, j] = mu[j, i] = m if math.isfinite(m) else 1.0e6
     Y = _youngs(problem)
-    lines = ["# LIGGGHTS lines written by `vimpact dem` (units si)",
+    settings = ["# LIGGGHTS settings written by `vimpact dem`: include BEFORE create_box / read_data",
+                f"# from {problem.source}",
+                "units si", "atom_style granular", "atom_modify map array", "newton off",
+                "communicate single vel yes", ""]
+    lines = ["# LIGGGHTS lines written by `vimpact dem` (units si): include AFTER create_box",
+             f"# (create_box {n} ...: particle types and walls), before create_atoms / run",
              f"# from {problem.source}; speeds {problem.speeds.min():g}..{problem.speeds.max():g} m/s",
              "# atom types: " + ", ".join(f"{k + 1} = {nm}" for k, nm in enumerate(names)),
-             "# walls are atom types of their own (fix mesh/surface ... type N)",
              "# wall-wall matrix entries are placeholders (never used)"]
     if any(w.material is None for w in problem.walls):
         lines.append(f"# rigid wall: Young's modulus {RIGID_WALL_FACTOR:g} x the stiffest particle type")
+    if max(E for E, _ in Y) > SOFT_LIMIT:
+        lines.append("hard_particles yes   # a Young's modulus above 1e9 Pa (LIGGGHTS refuses it otherwise)")
     lines += [
         "fix m1 all property/global youngsModulus peratomtype " + " ".join(f"{E:.8g}" for E, _ in Y),
         "fix m2 all property/global poissonsRatio peratomtype " + " ".join(f"{nu:.6g}" for _, nu in Y),
         f"fix m3 all property/global coefficientRestitution peratomtypepair {n} "
-        + " ".join(f"{x:.6f}" for x in e.ravel()),
+        + " ".join(f"{x:.8f}" for x in e.ravel()),
         f"fix m4 all property/global coefficientFriction peratomtypepair {n} "
         + " ".join(f"{x:.6g}" for x in mu.ravel()),
         "pair_style gran model hertz tangential history",
-        "pair_coeff * *",
-    ]
-    return {"liggghts.in": "\n".join(lines) + "\n"}
+        "pair_coeff * *"]
+    for w in problem.walls:
+        lines.append(f"fix wall_{w.name} all wall/gran model hertz tangential history primitive "
+                     f"type {w.index} zplane 0.0   # replace 'zplane 0.0' by your wall's geometry")
+    lines += [f"timestep {time_step(fits, steps_per_contact):.8g}   # s: {steps_per_contact} steps "
+              f"per shortest contact (v = {problem.speeds.max():g} m/s)", ""]
+    return {"liggghts_settings.in": "\n".join(settings), "liggghts.in": "\n".join(lines)}
+
+
+# ---- running LIGGGHTS itself (round trip) ----------------------------------
+
+#: the LIGGGHTS executable (Debian package ``liggghts``)
+LIGGGHTS = "liggghts"
+
+
+def liggghts_available() -> str | None:
+    """``None`` if the ``liggghts`` executable can be run, else why not."""
+    import shutil
+
+    if shutil.which(LIGGGHTS) is None:
+        return "the 'liggghts' executable is not on PATH (Debian: apt-get install liggghts)"
+    return None
+
+
+def round_trip(problem: DemProblem, speeds, steps_per_contact: int = STEPS_PER_CONTACT,
+               fits: list[ContactFit] | None = None, timeout: float = 600.0) -> list[dict]:
+    """Run LIGGGHTS once with the exported files, included unchanged, on head-on
+    collisions of every contact (nominal sizes) at ``speeds`` (m/s): one dict per
+    collision with ``contact``, ``v``, ``e`` (LIGGGHTS', from its velocities) and
+    ``predicted`` (the report's)."""
+    import os
+    import subprocess
+    import tempfile
+
+    if fits is None:
+        from vimpact.dem.export import export
+
+        fits = export(problem, CODE).fits
+    files = render(problem, fits, steps_per_contact)
+    n_types = len(problem.types) + len(problem.walls)
+    cases, atoms = [], []
+    x, top = 0.0, 0.0
+    r_max = max(max(t.radii) for t in problem.types)
+    z_pairs = 20.0 * r_max  # far above any wall at z = 0; pairs collide along x
+    for f in fits:
+        c = f.contact
+        for v in speeds:
+            R1 = c.first.radius
+            R2 = None if c.is_wall else c.second.radius
+            x += 4.0 * (R1 + (R2 or R1))
+            gap = 1e-3 * R1
+            case = {"contact": c.key, "v": float(v), "predicted": float(f.params["e_liggghts"]),
+                    "ids": []}
+            if c.is_wall:
+                atoms.append((c.first.index, (x, 0.0, R1 + gap), R1, c.first.density,
+                              (0.0, 0.0, -float(v))))
+                case["ids"] = [len(atoms)]
+            else:
+                m1, m2 = c.first.mass(R1), c.second.mass(R2)
+                atoms.append((c.first.index, (x - R1 - gap / 2, 0.0, z_pairs), R1,
+                              c.first.density, (v * m2 / (m1 + m2), 0.0, 0.0)))
+                atoms.append((c.second.index, (x + R2 + gap / 2, 0.0, z_pairs), R2,
+                              c.second.density, (-v * m1 / (m1 + m2), 0.0, 0.0)))
+                case["ids"] = [len(atoms) - 1, len(atoms)]
+            cases.append(case)
+            top = x
+    dt = time_step(fits, steps_per_contact)
+    t_end = max(1e-3 * f.contact.first.radius / min(speeds) for f in fits) + 3.0 * max(
+        float(laws.hertz_contact_time(f.params["E_star_Pa"], *f.contact.nominal(), min(speeds)))
+        for f in fits)
+    lines = ["include liggghts_settings.in", "boundary f f f",
+             f"region box block {-r_max * 4:.6g} {top + 4 * r_max:.6g} {-4 * r_max:.6g} "
+             f"{4 * r_max:.6g} {-4 * r_max:.6g} {z_pairs + 4 * r_max:.6g} units box",
+             f"create_box {n_types} box", f"neighbor {0.5 * r_max:.6g} bin",
+             "include liggghts.in"]
+    for k, (typ, (ax, ay, az), R, rho, (vx, vy, vz)) in enumerate(atoms, start=1):
+        lines += [f"create_atoms {typ} single {ax:.12g} {ay:.12g} {az:.12g} units box",
+                  f"set atom {k} diameter {2 * R:.12g} density {rho:.12g}",
+                  f"group one id {k}", f"velocity one set {vx:.12g} {vy:.12g} {vz:.12g} units box",
+                  "group one delete"]
+    lines += ["fix integrate all nve/sphere", "thermo 0", f"run {int(math.ceil(t_end / dt))}"]
+    for k in range(1, len(atoms) + 1):
+        lines += [f"variable vx{k} equal vx[{k}]", f"variable vz{k} equal vz[{k}]",
+                  f'print "VIMPACT {k} ${{vx{k}}} ${{vz{k}}}"']
+    with tempfile.TemporaryDirectory() as tmp:
+        for name, text in files.items():
+            with open(os.path.join(tmp, name), "w") as fh:
+                fh.write(text)
+        with open(os.path.join(tmp, "in.drive"), "w") as fh:
+            fh.write("\n".join(lines) + "\n")
+        proc = subprocess.run([LIGGGHTS, "-in", "in.drive", "-log", "none"], cwd=tmp,
+                              capture_output=True, text=True, timeout=timeout,
+                              env=dict(os.environ, OMP_NUM_THREADS="1"))
+    vel = {}
+    for ln in proc.stdout.splitlines():
+        if ln.startswith("VIMPACT "):
+            _, k, vx, vz = ln.split()
+            vel[int(k)] = (float(vx), float(vz))
+    if proc.returncode != 0 or len(vel) != len(atoms):
+        raise RuntimeError(f"LIGGGHTS failed: {(proc.stdout + proc.stderr).strip()[-2000:]}")
+    rows = []
+    for case in cases:
+        ids = case.pop("ids")
+        if len(ids) == 1:
+            e = vel[ids[0]][1] / case["v"]
+        else:
+            e = (vel[ids[1]][0] - vel[ids[0]][0]) / case["v"]
+        rows.append(dict(case, e=e))
+    return rows
+
+
+if __name__ == "__main__":  # python -m vimpact.dem.liggghts SETUP.toml [STEPS_PER_CONTACT]
+    import sys
+
+    from vimpact.dem.problem import load_problem
+
+    why = liggghts_available()
+    if why:
+        sys.exit(f"cannot run LIGGGHTS: {why}")
+    prob = load_problem(sys.argv[1])
+    steps = int(sys.argv[2]) if len(sys.argv) > 2 else STEPS_PER_CONTACT
+    sp = np.geomspace(prob.speeds.min(), prob.speeds.max(), 5)
+    print(f"{'contact':12s} {'v [m/s]':>8s} {'predicted e':>12s} {'LIGGGHTS e':>12s} {'diff':>10s}")
+    for r in round_trip(prob, sp, steps):
+        print(f"{r['contact']:12s} {r['v']:8.3g} {r['predicted']:12.8f} {r['e']:12.8f} "
+              f"{r['e'] - r['predicted']:10.2e}")

@@ -7,10 +7,18 @@ and ``speciesHandler.getMixedObject(a, b)`` those of a type pair (walls are
 species too), so a full pair matrix is represented, and ``A`` does not carry
 the mass (exact over a size range, unlike LAMMPS' ``eta_n0``). The fit
 assumes the force is clipped at zero (no attraction); if your build lets it
-pull, the restitution is lower. No tangential restitution for this species
-(sliding friction only): ``beta_x`` is not represented. Setter names follow
-MercuryDPM's ``HertzianBSHPViscoelasticNormalSpecies`` and
-``SlidingFrictionSpecies``; check them against your version.
+pull, the restitution is lower (MercuryDPM's
+``HertzianBSHPViscoelasticInteraction::computeNormalForce`` clips it).
+
+Species: ``HertzianBSHPViscoelasticMindlinSpecies`` (header
+``Species/HertzianBSHPViscoelasticMindlinSpecies.h``; the normal species with
+``MindlinSpecies``): friction needs a tangential stiffness, so the Mindlin
+part gets ``setEffectiveShearModulus(G/(2 - nu))`` of the pair material (the
+Mindlin stiffness ``8 G* a`` of a rigid sphere on the pair's half-space) and
+``setSlidingFrictionCoefficient(mu)``; its tangential dissipation is left at
+MercuryDPM's default and ``beta_x`` is not fitted. Not run here (no Debian or
+PyPI build of MercuryDPM): the class, header and setter names were read from
+MercuryDPM's sources (``Kernel/Species``), not compiled.
 """
 
 from __future__ import annotations
@@ -22,7 +30,8 @@ from vimpact.dem.problem import DemProblem
 
 CODE = "mercurydpm"
 TANGENTIAL = False
-SPECIES = "HertzianBSHPViscoelasticSlidingFrictionSpecies"
+SPECIES = "HertzianBSHPViscoelasticMindlinSpecies"
+HEADER = "Species/HertzianBSHPViscoelasticMindlinSpecies.h"
 
 
 def fit(problem: DemProblem, targets: dict[str, Targets]) -> list[ContactFit]:
@@ -30,17 +39,23 @@ def fit(problem: DemProblem, targets: dict[str, Targets]) -> list[ContactFit]:
     for c in problem.contacts:
         t = targets[c.key]
         A, e = fit_viscoelastic_hertz(t, c.E_star)
+        mat = c.material
         fits.append(ContactFit(c, {"effectiveElasticModulus": c.E_star, "dissipation": A,
+                                   "effectiveShearModulus": mat.G_inf / (2.0 - mat.nu),
                                    "mu": c.mu}, e, None, Residual.of(e, t.e_z), None,
-                               ["beta_x: not represented (sliding friction species only)"]))
+                               ["beta_x: not fitted (Mindlin tangential stiffness of the relaxed "
+                                "pair material, MercuryDPM's default tangential dissipation)"]))
     return fits
 
 
 def render(problem: DemProblem, fits: list[ContactFit]) -> dict[str, str]:
     ident = {t.index: f"s_{t.name}" for t in problem.types}
     ident.update({w.index: f"s_{w.name}" for w in problem.walls})
-    lines = ["// MercuryDPM species written by `vimpact dem` (SI units); inside setupInitialConditions()",
-             f"// from {problem.source}; speeds {problem.speeds.min():g}..{problem.speeds.max():g} m/s"]
+    lines = ["// MercuryDPM species written by `vimpact dem` (SI units)",
+             f"// from {problem.source}; speeds {problem.speeds.min():g}..{problem.speeds.max():g} m/s",
+             f"// Put the #include at the top of your driver and the rest inside setupInitialConditions()",
+             "// (or your constructor), before particles and walls are created.",
+             f"#include \"{HEADER}\""]
     for t in problem.types:
         lines.append(f"auto {ident[t.index]} = speciesHandler.copyAndAddObject({SPECIES}());")
         lines.append(f"{ident[t.index]}->setDensity({t.density:.8g});  // kg/m^3")
@@ -56,5 +71,6 @@ def render(problem: DemProblem, fits: list[ContactFit]) -> dict[str, str]:
         lines.append(f"// {f.contact.key}")
         lines.append(f"{target}->setEffectiveElasticModulus({p['effectiveElasticModulus']:.10g});  // Pa")
         lines.append(f"{target}->setDissipation({p['dissipation']:.10g});  // A, s")
+        lines.append(f"{target}->setEffectiveShearModulus({p['effectiveShearModulus']:.10g});  // Pa, Mindlin")
         lines.append(f"{target}->setSlidingFrictionCoefficient({mu:.6g});")
     return {"mercurydpm_species.cpp": "\n".join(lines) + "\n"}

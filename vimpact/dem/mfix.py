@@ -11,13 +11,15 @@ they set the contact time only (chosen as the Hertz contact time at the
 geometric mean speed of the first contact of each kind), not ``e``.
 
 Tangential: with LSD, MFiX takes ``DES_ETAT_FAC`` (tangential over normal
-damping, one value for all particle pairs) and ``DES_ETAT_W_FAC`` (walls),
-with ``DES_KT_FAC = DES_KT_W_FAC = 2/7``; ``DES_ET_INPUT`` belongs to the
+damping, one value for all particle pairs, in [0, 1]: MFiX refuses others)
+and ``DES_ETAT_W_FAC`` (walls), with ``KT_FAC = KT_W_FAC = 2/7`` (tangential
+over normal stiffness); ``DES_ET_INPUT`` belongs to the
 Hertzian model and is not used here. Each contact's ``DES_ETAT_FAC`` is
 fitted to vimpact's full-stick ``beta_x(v)``; the exported single value is
 their mean, and the report's ``beta_x`` residual is that of the exported
 value. Friction is likewise one ``MEW`` and one ``MEW_W``: per-pair
-friction is not represented.
+friction is not represented. Not run here (no Debian or PyPI build of MFiX):
+the keywords and their ranges were read from MFiX's documentation, not run.
 """
 
 from __future__ import annotations
@@ -33,6 +35,8 @@ from vimpact.dem.problem import DemProblem
 CODE = "mfix"
 TANGENTIAL = True
 KT_FAC = 2.0 / 7.0
+#: MFiX's allowed range of DES_ETAT_FAC and DES_ETAT_W_FAC
+ETAT_FAC_RANGE = (0.0, 1.0)
 
 
 def _beta(en: float, etat_fac: float, F: float) -> float:
@@ -60,7 +64,7 @@ def fit(problem: DemProblem, targets: dict[str, Targets]) -> list[ContactFit]:
                                ["speed-independent en: the residual is vimpact's speed dependence"]))
         if t.beta_x is not None:
             etat, _ = fit_scalar(lambda x: np.full_like(t.beta_x, _beta(en, x, F)),
-                                 t.beta_x, 0.0, 20.0)
+                                 t.beta_x, *ETAT_FAC_RANGE)
             fits[-1].params["etat_fac"] = etat
     # one DES_ETAT_FAC for particle pairs, one DES_ETAT_W_FAC for walls: export the means
     for wall in (False, True):
@@ -98,7 +102,7 @@ def render(problem: DemProblem, fits: list[ContactFit]) -> dict[str, str]:
              "DES_EN_INPUT = " + " ".join(f"{x:.6f}" for x in upper)]
     if pp:
         lines.append(f"KN = {pp[0].params['kn']:.6g}   ! N/m, contact time of {pp[0].contact.key}")
-        lines.append(f"DES_KT_FAC = {KT_FAC:.8g}")
+        lines.append(f"KT_FAC = {KT_FAC:.8g}")
         if math.isfinite(pp[0].params["etat_fac"]):
             lines.append(f"DES_ETAT_FAC = {pp[0].params['etat_fac']:.6g}")
         mus = {f.params["mu"] for f in pp}
@@ -113,7 +117,7 @@ def render(problem: DemProblem, fits: list[ContactFit]) -> dict[str, str]:
         first.sort(key=lambda f: f.contact.first.index)
         lines.append("DES_EN_WALL_INPUT = " + " ".join(f"{f.params['en']:.6f}" for f in first))
         lines.append(f"KN_W = {first[0].params['kn']:.6g}   ! N/m, contact time of {first[0].contact.key}")
-        lines.append(f"DES_KT_W_FAC = {KT_FAC:.8g}")
+        lines.append(f"KT_W_FAC = {KT_FAC:.8g}")
         if math.isfinite(first[0].params["etat_fac"]):
             lines.append(f"DES_ETAT_W_FAC = {first[0].params['etat_fac']:.6g}")
         mu = first[0].params["mu"]

@@ -166,6 +166,21 @@ class DemProblem:
     speeds: np.ndarray = field(repr=False)
     angles_deg: tuple[float, ...] = ()
     source: str = "<string>"
+    toml: str = field(default="", repr=False)
+    size_classes: int = 1
+    base: Path | None = field(default=None, repr=False)
+    temperature: float | None = None
+
+    @property
+    def has_size_range(self) -> bool:
+        """Some type has a radius range (it can be split into size classes)."""
+        return any(len(t.radii) > 1 for t in self.types)
+
+    def with_size_classes(self, k: int) -> "DemProblem":
+        """The same set-up with every size-range type split into ``k`` types of equal
+        radius ratio (``NAME_1`` .. ``NAME_k``, smallest first; friction as the type's)."""
+        return problem_from_toml(self.toml, self.source, base=self.base,
+                                 temperature=self.temperature, size_classes=k)
 
     def contact(self, a: str, b: str) -> Contact:
         """The contact of the named type/wall pair (either order)."""
@@ -176,7 +191,7 @@ class DemProblem:
 
 
 def problem_from_toml(text: str, source: str = "<string>", *, base: Path | None = None,
-                      temperature: float | None = None) -> DemProblem:
+                      temperature: float | None = None, size_classes: int = 1) -> DemProblem:
     """Parse a DEM set-up (module doc) from TOML text.
 
     Parameters
@@ -186,7 +201,12 @@ def problem_from_toml(text: str, source: str = "<string>", *, base: Path | None 
         current directory)
     temperature : the temperature of the DEM run, K; overrides the file's
         ``temperature_K``; every viscoelastic material is shifted to it
+    size_classes : > 1 splits every type with a radius range ``[min, max]``
+        into that many types ``NAME_1`` .. ``NAME_k`` with the ranges
+        ``min q^(i-1) .. min q^i``, ``q = (max/min)^(1/k)``, numbered in order
     """
+    if isinstance(size_classes, bool) or not isinstance(size_classes, int) or size_classes < 1:
+        raise InputError(message("size_classes", size_classes, "an integer >= 1"))
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
@@ -228,7 +248,8 @@ def problem_from_toml(text: str, source: str = "<string>", *, base: Path | None 
     if not isinstance(tables, dict) or not tables:
         raise _err(source, "[types]", tables, "at least one [types.NAME] table")
     types = []
-    for i, (name, t) in enumerate(tables.items(), start=1):
+    base_of: dict[str, str] = {}  # type name -> its TOML table (differ for size classes)
+    for name, t in tables.items():
         where = f"types.{name}"
         if not isinstance(t, dict):
             raise _err(source, where, t, "a table")
@@ -248,17 +269,23 @@ def problem_from_toml(text: str, source: str = "<string>", *, base: Path | None 
             lo, hi = (_num(source, f"{where}.radius", x) for x in r)
             if not (0.0 < lo <= hi < math.inf):
                 raise _err(source, f"{where}.radius", r, "0 < min <= max (m)")
-            radii = (lo, math.sqrt(lo * hi), hi) if hi > lo else (lo,)
+            ranges = [(lo, hi)] if size_classes == 1 or hi == lo else [
+                (lo * (hi / lo) ** (k / size_classes), lo * (hi / lo) ** ((k + 1) / size_classes))
+                for k in range(size_classes)]
         else:
             R = _num(source, f"{where}.radius", r)
             if not (0.0 < R < math.inf):
                 raise _err(source, f"{where}.radius", R, "a finite number > 0 (m)")
-            radii = (R,)
+            ranges = [(R, R)]
         theta = _num(source, f"{where}.theta_ratio", t.get("theta_ratio", DEFAULT_THETA_RATIO))
         if not (0.0 < theta < math.inf):
             raise _err(source, f"{where}.theta_ratio", theta, "a finite number > 0")
         mat = material(t["material"], f"{where}.material")
-        types.append(ParticleType(name, i, mat, radii, rho, theta))
+        for k, (lo, hi) in enumerate(ranges, start=1):
+            radii = (lo, math.sqrt(lo * hi), hi) if hi > lo else (lo,)
+            sub = name if len(ranges) == 1 else f"{name}_{k}"
+            base_of[sub] = name
+            types.append(ParticleType(sub, len(types) + 1, mat, radii, rho, theta))
 
     walls = []
     for k, (name, w) in enumerate((data.get("walls") or {}).items(), start=len(types) + 1):
@@ -274,7 +301,7 @@ def problem_from_toml(text: str, source: str = "<string>", *, base: Path | None 
     fr = data.get("friction", {})
     if not isinstance(fr, dict):
         raise _err(source, "[friction]", fr, "a table of coefficients")
-    names = [t.name for t in types] + [w.name for w in walls]
+    names = [base_of[t.name] for t in types] + [w.name for w in walls]
     for key in fr:
         if key != "default" and (key.count("-") < 1 or not any(
                 key == f"{a}-{b}" for a in names for b in names)):
@@ -285,6 +312,7 @@ def problem_from_toml(text: str, source: str = "<string>", *, base: Path | None 
             raise _err(source, f"friction.{key}", mu, "a number >= 0")
 
     def mu_of(a: str, b: str) -> float:
+        a, b = base_of.get(a, a), base_of.get(b, b)
         for key in (f"{a}-{b}", f"{b}-{a}", "default"):
             if key in fr:
                 return float(fr[key])
@@ -302,7 +330,8 @@ def problem_from_toml(text: str, source: str = "<string>", *, base: Path | None 
         except InputError as exc:
             raise InputError(f"{source}: contact {c.key}: {exc}") from None
     return DemProblem(tuple(types), tuple(walls), tuple(contacts), speeds,
-                      tuple(float(a) for a in angles), source)
+                      tuple(float(a) for a in angles), source, text, size_classes, base,
+                      temperature)
 
 
 def load_problem(path, temperature: float | None = None) -> DemProblem:

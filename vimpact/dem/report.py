@@ -31,19 +31,23 @@ def figure(code: str, problem: DemProblem, targets: dict[str, Targets],
     for k, f in enumerate(fits):
         t = targets[f.contact.key]
         ax = axes[0, k]
-        for lvl in np.unique(t.level):
+        levels = np.unique(t.level)
+        sizes = {0: "R min", 1: "R nominal", 2: "R max"} if len(levels) == 3 else {0: ""}
+        for lvl in levels:
             sel = t.level == lvl
-            style = "-" if lvl == (int(t.level.max()) + 1) // 2 else "--"
+            size = sizes.get(int(lvl), "")
+            style = {"R min": ":", "R max": "--"}.get(size, "-")
             ax.plot(t.v[sel], t.e_z[sel], style, color="C0",
-                    label="vimpact" if lvl == 0 else None)
-            ax.plot(t.v[sel], f.e_z[sel], "o", ms=3, mfc="none", color="C3",
-                    label=code if lvl == 0 else None)
+                    label=f"vimpact {size}".strip())
+            ax.plot(t.v[sel], f.e_z[sel], "o" if style == "-" else ("v" if size == "R min" else "^"),
+                    ms=3, mfc="none", color="C3", label=f"{code} {size}".strip())
+        if len(levels) > 1 or k == 0:
+            ax.legend(fontsize=6)
         ax.set_xscale("log")
         ax.set_title(f"{f.contact.key}\nRMS {f.res_e_z.rms:.1e}", fontsize=8)
         ax.set_xlabel("v_z0 [m/s]")
         if k == 0:
             ax.set_ylabel("e_z")
-            ax.legend(fontsize=7)
         if rows == 2:
             ax = axes[1, k]
             if f.beta_x is not None and t.beta_x is not None:
@@ -57,8 +61,8 @@ def figure(code: str, problem: DemProblem, targets: dict[str, Targets],
             ax.set_xlabel("v_z0 [m/s]")
             if k == 0:
                 ax.set_ylabel("beta_x")
-    fig.suptitle(f"vimpact vs {code} with the exported constants "
-                 "(dashed: ends of a size range)", fontsize=9)
+    fig.suptitle(f"vimpact (lines) vs {code} with the exported constants (markers); "
+                 "size ranges: R min dotted, R max dashed", fontsize=9)
     fig.savefig(out, dpi=110)
     return out
 
@@ -72,8 +76,10 @@ def _fmt(x) -> str:
 
 
 def markdown(code: str, problem: DemProblem, targets: dict[str, Targets],
-             fits: list[ContactFit], files: list[str], png: str) -> str:
-    """The report text."""
+             fits: list[ContactFit], files: list[str], png: str,
+             steps_per_contact: int | None = None, step_error=None) -> str:
+    """The report text; ``steps_per_contact`` and ``step_error`` (the code module's
+    ``TIME_STEP_ERROR``) add the exported time step and the code's error at it."""
     lines = [f"# vimpact dem: {code}", "",
              f"Input: `{problem.source}`; normal impact speeds {problem.speeds.min():g} to "
              f"{problem.speeds.max():g} m/s ({problem.speeds.size} points, log-spaced)"
@@ -90,6 +96,15 @@ def markdown(code: str, problem: DemProblem, targets: dict[str, Targets],
         rb = str(f.res_beta_x) if f.res_beta_x is not None else "not represented"
         lines.append(f"| {c.key} | {mat.model}, G_inf {mat.G_inf:.4g} Pa, nu {mat.nu:.3g} | "
                      f"{params} | {f.res_e_z} | {rb} |")
+    if steps_per_contact is not None:
+        lines += ["", "## Time step", "",
+                  f"The exported time step is the shortest contact / {steps_per_contact}."]
+        if step_error is not None:
+            C, measured = step_error
+            lines.append(f"The code's own time-step error in e at that step is about "
+                         f"{C / steps_per_contact:.1e} (first order in the step, "
+                         f"{C:g} / steps; measured, largest over the round trip collisions: "
+                         f"{measured}). Change it with `--steps-per-contact`.")
     lines += ["", "## Notes", ""]
     for f in fits:
         for note in f.notes:

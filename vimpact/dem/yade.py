@@ -1,20 +1,26 @@
-"""Yade: ``ViscElMat(tc, en, et)`` with ``MatchMaker`` for type pairs.
+"""Yade: ``ViscElMat(tc, en, et)`` with a ``MatchMaker`` for every pair of materials.
 
-``ViscElMat`` is a linear spring-dashpot. From the contact time ``tc`` and
-the restitutions it sets, per contact of effective mass ``m``,
-``kn = m (pi^2 + ln^2 en) / tc^2``, ``cn = -2 m ln(en) / tc`` and
-``ks = 2/7 m (pi^2 + ln^2 et) / tc^2``, ``cs = -2 (2/7) m ln(et) / tc``
-(the 2/7 is the contact-point mass of solid spheres). The contact ends
-when the overlap does, so the normal restitution is ``en`` at every speed
-(integrated here: to 1e-12) and the export is the constant closest to
-vimpact's ``e_z(v)``. ``et`` is fitted by running the linear law in stick
-(normal and tangential together, with the pair's real contact-point mass
-factor) against vimpact's full-stick ``beta_x(v)``; a target ``beta_x <= 0``
-(no reversal) cannot be reached (``et`` gives ``beta`` in ``(0, 1]``). ``tc`` is
-the Hertz contact time at the geometric mean speed; it does not change
-``en`` or ``et``. Pair values go through ``MatchMaker(matches=((id1, id2,
-value), ...))`` on ``Ip2_ViscElMat_ViscElMat_ViscElPhys``; attribute names
-as in current Yade, check against your version.
+Yade's ``Ip2_ViscElMat_ViscElMat_ViscElPhys`` turns ``(tc, en, et)`` into a
+linear spring-dashpot, with ``massR = m1 m2 / (m1 + m2)`` from the bodies'
+masses (a body of mass 0, such as a ``wall`` or a fixed facet, takes the
+other body's mass, so at a wall ``massR = m / 2``, not the effective mass
+``m``):
+
+``kn = massR (pi^2 + ln^2 en) / tc^2``, ``cn = -2 massR ln(en) / tc``,
+``ks = 2/7 massR (pi^2 + ln^2 et) / tc^2``, ``cs = -4/7 massR ln(et) / tc``.
+
+``Law2_ScGeom_ViscElPhys_Basic`` clips the normal force at zero (the contact
+ends when the force does, while the spheres still overlap) and, in stick,
+adds the tangential spring (incremental) and dashpot; with the normal force
+at zero the Coulomb limit is zero, so the tangential force ends with it. So
+Yade does *not* restitute its input ``en``: between spheres it gives the
+clipped linear law's ``e(zeta)``, at a wall that of ``zeta / sqrt(2)``. The
+fit runs that law (:func:`yade_law`) and chooses ``en`` (and ``et``) so that
+what Yade produces is the constant closest to vimpact's curve; ``tc`` is set
+so that the contact lasts the Hertz contact time at the geometric mean speed
+(at a wall ``tc`` is ``1/sqrt(2)`` of it). ``et`` is fitted to vimpact's
+full-stick ``beta_x`` with the pair's contact-point mass factor. Checked by
+running Yade 2023.02 (tests/dem/test_yade.py).
 """
 
 from __future__ import annotations
@@ -23,81 +29,265 @@ import math
 
 import numpy as np
 
-from vimpact.dem import linear
+from vimpact.dem import laws, linear
 from vimpact.dem.fit import ContactFit, Residual, Targets, fit_constant, fit_scalar
-from vimpact.dem.problem import DemProblem
+from vimpact.dem.problem import Contact, DemProblem
 
 CODE = "yade"
 TANGENTIAL = True
+#: default time steps per (shortest) contact in the exported ``vimpact_dt``
+STEPS_PER_CONTACT = 400
+#: the code's time-step error in e, about ``C / steps_per_contact``: ``(C, measurement)``,
+#: the largest |e - predicted| over the round trip of sweeps/dem/two_rubbers.toml
+TIME_STEP_ERROR = (0.23, "Yade 2023.02 (Debian): "
+                   "2.2e-3 at 100, 5.8e-4 at 400, 1.1e-4 at 1600 steps")
+#: friction angle written for a contact without friction (stick)
+STICK_MU = 1.0e6
 
 
-def _beta(en: float, et: float, F: float) -> float:
-    """Yade's tangential restitution in stick with contact-point mass factor ``F``:
-    ``w_t^2 = ks F / m`` over ``omega0^2 = kn / m``, ``zeta_t = cs F / (2 m w_t)``."""
-    w_t = math.sqrt(2.0 / 7.0 * F * (math.pi**2 + linear.ln2(et)) / (math.pi**2 + linear.ln2(en)))
-    zeta_t = (math.sqrt(2.0 / 7.0 * F) * abs(math.log(et)) / math.sqrt(math.pi**2 + linear.ln2(et))
-              if et < 1.0 else 0.0)
-    return linear.tangential_beta(en, w_t, zeta_t)
+def mass_ratio(contact: Contact) -> float:
+    """Yade's ``massR`` over the true effective mass: 1/2 at a wall (mass 0), else 1."""
+    return 0.5 if contact.is_wall else 1.0
+
+
+def yade_law(tc: float, en: float, et: float, q: float, F: float, m: float = 1.0,
+             tangential: bool = True) -> tuple[float, float, float]:
+    """What Yade's linear law restitutes: ``(e, beta, contact time)``.
+
+    Parameters
+    ----------
+    tc : s; en, et : Yade's inputs, in (0, 1]
+    q : ``massR / m_eff`` (:func:`mass_ratio`); F : contact-point mass factor
+    m : effective mass, kg (cancels out)
+    """
+    mR = q * m
+    L2n, L2t = linear.ln2(en), linear.ln2(et)
+    kn = mR * (math.pi**2 + L2n) / tc**2
+    cn = -2.0 * mR * math.log(en) / tc
+    ks = 2.0 / 7.0 * mR * (math.pi**2 + L2t) / tc**2
+    cs = -4.0 / 7.0 * mR * math.log(et) / tc
+    w0 = math.sqrt(kn / m)
+    zeta = cn / (2.0 * math.sqrt(kn * m))
+    tan = None
+    if tangential:
+        w_t = math.sqrt(ks * F / m)
+        tan = (w_t / w0, cs * F / (2.0 * m * w_t))
+    e, beta, t = laws.linear_spring_dashpot(zeta, "force", tan)
+    return e, beta, t / w0
+
+
+def _en_for(target: float, q: float) -> float:
+    """Yade's ``en`` input for which it restitutes ``target`` (normal law only)."""
+    def e_of(en: float) -> float:
+        return yade_law(1.0, en, 1.0, q, 3.5, tangential=False)[0]
+
+    lo, hi = 1e-6, 1.0
+    if target >= 1.0:
+        return 1.0
+    if target <= e_of(lo):
+        return lo
+    for _ in range(80):  # e_of increases with en
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if e_of(mid) < target else (lo, mid)
+    return 0.5 * (lo + hi)
 
 
 def fit(problem: DemProblem, targets: dict[str, Targets]) -> list[ContactFit]:
     fits = []
     for c in problem.contacts:
         t = targets[c.key]
-        en, _ = fit_constant(t.e_z, 1e-6, 1.0)
-        e = np.full_like(t.e_z, linear.laws.linear_spring_dashpot(
-            linear.laws.zeta_of_restitution(en), "overlap")[0])
-        F = linear.mass_factor(c)
-        notes = ["speed-independent en: the residual is vimpact's speed dependence",
-                 "tc = Hertz contact time at the geometric mean speed (does not change en, et)"]
+        q, F = mass_ratio(c), linear.mass_factor(c)
+        e_const, _ = fit_constant(t.e_z, 1e-6, 1.0)
+        en = _en_for(e_const, q)
+        t_h = linear.hertz_time(c, problem.speeds)
+        # tc such that Yade's contact lasts t_h: the contact time scales with tc
+        tc = t_h / yade_law(1.0, en, 1.0, q, F, tangential=False)[2]
+        e_code = yade_law(tc, en, 1.0, q, F, tangential=False)[0]
+        e = np.full_like(t.e_z, e_code)
+        notes = ["speed-independent restitution: the residual is vimpact's speed dependence",
+                 f"Yade clips the normal force at zero{' and gives a wall mass 0' if c.is_wall else ''}:"
+                 f" its input en = {en:.6g} restitutes {e_code:.6g}",
+                 "tc: Yade's contact lasts the Hertz contact time at the geometric mean speed"]
         if abs(F - 3.5) > 1e-9:
             notes.append(f"contact-point mass factor {F:.4g} (not 3.5: not solid spheres); "
                          "et is fitted with it")
-        b = None
-        res_b = None
-        et = math.nan
+        b = res_b = None
+        et = 1.0
         if t.beta_x is not None:
-            target = float(np.mean(t.beta_x))
-            if target <= 0.0:
-                notes.append(f"beta_x: vimpact's mean {target:.3g} <= 0 (no reversal) cannot be "
-                             "represented by et; et = 1e-6 written")
-                et = 1e-6
-                b = np.full_like(t.beta_x, _beta(en, et, F))
-            else:
-                et, b = fit_scalar(lambda x: np.full_like(t.beta_x, _beta(en, x, F)),
-                                   t.beta_x, 1e-6, 1.0)
+            def beta(x: float) -> np.ndarray:
+                return np.full_like(t.beta_x, yade_law(tc, en, x, q, F)[1])
+
+            et, b = fit_scalar(beta, t.beta_x, 1e-6, 1.0)
             res_b = Residual.of(b, t.beta_x)
-        fits.append(ContactFit(c, {"tc": linear.hertz_time(c, problem.speeds), "en": en, "et": et,
-                                   "mu": c.mu}, e, b, Residual.of(e, t.e_z), res_b, notes))
+            if float(np.mean(t.beta_x)) <= 0.0:
+                notes.append("beta_x: vimpact's mean <= 0 (no reversal): et cannot reach it")
+        mu = c.mu if math.isfinite(c.mu) else STICK_MU
+        fits.append(ContactFit(c, {"tc": tc, "en": en, "et": et, "frictAngle": math.atan(mu),
+                                   "mu": c.mu, "e_yade": e_code, "t_contact": t_h},
+                               e, b, Residual.of(e, t.e_z), res_b, notes))
     return fits
 
 
-def render(problem: DemProblem, fits: list[ContactFit]) -> dict[str, str]:
+def time_step(fits: list[ContactFit], steps_per_contact: int = STEPS_PER_CONTACT) -> float:
+    """``O.dt`` (s): the shortest contact time over ``steps_per_contact``."""
+    return min(f.params["t_contact"] for f in fits) / steps_per_contact
+
+
+def render(problem: DemProblem, fits: list[ContactFit],
+           steps_per_contact: int = STEPS_PER_CONTACT) -> dict[str, str]:
+    """``yade_materials.py``: run it with ``exec`` in your Yade script before creating bodies."""
     names = [t.name for t in problem.types] + [w.name for w in problem.walls]
-    own = {f.contact.first.name: f for f in fits
-           if not f.contact.is_wall and f.contact.first is f.contact.second}
-    lines = ["# Yade snippet written by `vimpact dem` (SI units)",
-             f"# from {problem.source}; speeds {problem.speeds.min():g}..{problem.speeds.max():g} m/s",
-             "from yade import *", "ids = {}"]
+    density = {t.name: t.density for t in problem.types}
+    first = {}  # each material's own values: those of its first contact (Yade checks that all
+    for f in fits:  # materials define the same variables; the MatchMakers decide the values)
+        for nm in (f.contact.first.name, f.contact.second.name):
+            first.setdefault(nm, f.params)
+    dt = time_step(fits, steps_per_contact)
+    lines = [
+        "# Yade input written by `vimpact dem` (SI units: m, kg, s)",
+        f"# from {problem.source}; speeds {problem.speeds.min():g}..{problem.speeds.max():g} m/s",
+        "# Use: exec(open('yade_materials.py').read()) in your script BEFORE creating bodies; then",
+        "#   spheres: sphere(..., material=vimpact_mat['TYPE']); walls: wall(..., material=vimpact_mat['WALL'])",
+        "#   O.engines = [ForceResetter(), InsertionSortCollider([...]),",
+        "#                InteractionLoop([...geometry functors...], [vimpact_ip2], [vimpact_law]),",
+        "#                NewtonIntegrator(damping=0.0)]   # Yade's default damping 0.2 changes e",
+        f"#   O.dt = vimpact_dt   # {steps_per_contact} steps per shortest contact",
+        "# Walls must have mass 0 (Yade's wall() default): en at walls is fitted for that.",
+        "from yade import *",
+        "vimpact_mat = {}",
+    ]
     for nm in names:
-        f = own.get(nm)
-        if f is not None:
-            p = f.params
-            mu = p["mu"] if math.isfinite(p["mu"]) else 1.0e6
-            rho = f.contact.first.density
-            lines.append(f"ids[{nm!r}] = O.materials.append(ViscElMat(label={nm!r}, density={rho:.8g}, "
-                         f"tc={p['tc']:.8g}, en={p['en']:.8g}, et={p['et']:.8g}, "
-                         f"frictionAngle={math.atan(mu):.8g}))")
-        else:  # a wall: its own values come only through the matches below
-            lines.append(f"ids[{nm!r}] = O.materials.append(ViscElMat(label={nm!r}, density=1000.0))"
-                         "  # wall")
-    pairs = [f for f in fits if f.contact.first is not f.contact.second]
-    for attr in ("tc", "en", "et"):
-        m = ", ".join(f"(ids[{f.contact.first.name!r}], ids[{f.contact.second.name!r}], "
-                      f"{f.params[attr]:.8g})" for f in pairs)
-        lines.append(f"mm_{attr} = MatchMaker(matches=({m},))" if pairs else f"mm_{attr} = None")
-    lines += ["ip2 = Ip2_ViscElMat_ViscElMat_ViscElPhys()",
-              "if mm_tc is not None:",
-              "    ip2.tc, ip2.en, ip2.et = mm_tc, mm_en, mm_et",
-              "# use ip2 in InteractionLoop([...], [ip2], [Law2_ScGeom_ViscElPhys_Basic()])"]
-    return {"yade_materials.py": "\n".join(lines) + "\n"}
+        p = first[nm]
+        rho = density.get(nm, 1000.0)
+        kind = "" if nm in density else "  # wall (density unused)"
+        lines.append(f"vimpact_mat[{nm!r}] = O.materials.append(ViscElMat(label={nm!r}, "
+                     f"density={rho:.8g}, tc={p['tc']:.10g}, en={p['en']:.10g}, "
+                     f"et={p['et']:.10g}, frictionAngle={p['frictAngle']:.10g})){kind}")
+    lines.append("_m = vimpact_mat")
+    lines.append("vimpact_ip2 = Ip2_ViscElMat_ViscElMat_ViscElPhys(")
+    for attr in ("tc", "en", "et", "frictAngle"):
+        rows = ", ".join(f"(_m[{f.contact.first.name!r}], _m[{f.contact.second.name!r}], "
+                         f"{f.params[attr]:.10g})" for f in fits)
+        lines.append(f"    {attr}=MatchMaker(matches=({rows},)),")
+    lines += [")", "vimpact_law = Law2_ScGeom_ViscElPhys_Basic()",
+              f"vimpact_dt = {dt:.10g}  # s", ""]
+    return {"yade_materials.py": "\n".join(lines)}
+
+
+# ---- running Yade itself (round trip) -------------------------------------
+
+#: the Yade executable (Debian package ``yade``)
+YADE = "yade"
+
+_DRIVER = r"""
+import json
+exec(open({materials!r}).read())
+cases = {cases!r}
+walls_needed = sorted({{c["wall"] for c in cases if c["wall"]}})
+for w in walls_needed:
+    O.bodies.append(wall(0.0, axis=2, material=vimpact_mat[w]))
+runs = []
+x = 0.0
+for c in cases:
+    R1, R2, v = c["R1"], c["R2"], c["v"]
+    x += 4.0 * (R1 + (R2 or R1)) + 0.01
+    gap = 1e-3 * R1
+    if c["wall"]:
+        b1 = O.bodies.append(sphere((x, 0.0, R1 + gap), R1, material=vimpact_mat[c["first"]]))
+        O.bodies[b1].state.vel = Vector3(0.0, 0.0, -v)
+        runs.append((b1, None))
+    else:
+        z = 1.0  # far above any wall; the pair collides along x
+        b1 = O.bodies.append(sphere((x - R1 - gap / 2, 0.0, z), R1, material=vimpact_mat[c["first"]]))
+        b2 = O.bodies.append(sphere((x + R2 + gap / 2, 0.0, z), R2, material=vimpact_mat[c["second"]]))
+        m1, m2 = O.bodies[b1].state.mass, O.bodies[b2].state.mass
+        O.bodies[b1].state.vel = Vector3(v * m2 / (m1 + m2), 0.0, 0.0)
+        O.bodies[b2].state.vel = Vector3(-v * m1 / (m1 + m2), 0.0, 0.0)
+        runs.append((b1, b2))
+O.engines = [ForceResetter(),
+             InsertionSortCollider([Bo1_Sphere_Aabb(), Bo1_Wall_Aabb()]),
+             InteractionLoop([Ig2_Sphere_Sphere_ScGeom(), Ig2_Wall_Sphere_ScGeom()],
+                             [vimpact_ip2], [vimpact_law]),
+             NewtonIntegrator(damping=0.0)]
+O.dt = {dt!r}
+O.run({steps}, True)
+out = []
+for c, (b1, b2) in zip(cases, runs):
+    if b2 is None:
+        e = O.bodies[b1].state.vel[2] / c["v"]
+    else:
+        e = (O.bodies[b2].state.vel[0] - O.bodies[b1].state.vel[0]) / c["v"]
+    out.append(dict(c, e=float(e)))
+json.dump({{"rows": out, "open": O.interactions.countReal()}}, open({result!r}, "w"))
+"""
+
+
+def yade_available() -> str | None:
+    """``None`` if the ``yade`` executable can be run, else why not."""
+    import shutil
+
+    if shutil.which(YADE) is None:
+        return "the 'yade' executable is not on PATH (Debian: apt-get install yade)"
+    return None
+
+
+def round_trip(problem: DemProblem, speeds, steps_per_contact: int = STEPS_PER_CONTACT,
+               fits: list[ContactFit] | None = None, timeout: float = 600.0) -> list[dict]:
+    """Run Yade once with the exported ``yade_materials.py``, unchanged, on head-on
+    collisions of every contact (nominal sizes) at ``speeds`` (m/s); one dict per
+    collision with ``contact``, ``v``, ``e`` (Yade's, from its velocities) and
+    ``predicted`` (the report's)."""
+    import json
+    import os
+    import subprocess
+    import tempfile
+
+    if fits is None:
+        from vimpact.dem.export import export
+
+        fits = export(problem, CODE).fits
+    text = render(problem, fits, steps_per_contact)["yade_materials.py"]
+    dt = time_step(fits, steps_per_contact)
+    cases = []
+    for f in fits:
+        c = f.contact
+        for v in speeds:
+            cases.append({"contact": c.key, "first": c.first.name, "second": c.second.name,
+                          "wall": c.second.name if c.is_wall else None, "v": float(v),
+                          "R1": c.first.radius, "R2": None if c.is_wall else c.second.radius,
+                          "predicted": float(f.params["e_yade"])})
+    t_end = max(1e-3 * cs["R1"] / cs["v"] for cs in cases) + 3.0 * max(
+        f.params["t_contact"] for f in fits)
+    with tempfile.TemporaryDirectory() as tmp:
+        mats, drv, res = (os.path.join(tmp, n) for n in ("yade_materials.py", "drive.py", "out.json"))
+        with open(mats, "w") as fh:
+            fh.write(text)
+        with open(drv, "w") as fh:
+            fh.write(_DRIVER.format(materials=mats, cases=cases, dt=dt,
+                                    steps=int(math.ceil(t_end / dt)), result=res))
+        proc = subprocess.run([YADE, "-n", "-x", drv], cwd=tmp, capture_output=True, text=True,
+                              timeout=timeout, env=dict(os.environ, OMP_NUM_THREADS="1"))
+        if not os.path.exists(res):
+            raise RuntimeError(f"Yade failed: {(proc.stdout + proc.stderr).strip()[-2000:]}")
+        with open(res) as fh:
+            data = json.load(fh)
+    if data["open"]:
+        raise RuntimeError(f"Yade round trip: {data['open']} contacts still open at the end")
+    return data["rows"]
+
+
+if __name__ == "__main__":  # python -m vimpact.dem.yade SETUP.toml [STEPS_PER_CONTACT]
+    import sys
+
+    from vimpact.dem.problem import load_problem
+
+    why = yade_available()
+    if why:
+        sys.exit(f"cannot run Yade: {why}")
+    prob = load_problem(sys.argv[1])
+    steps = int(sys.argv[2]) if len(sys.argv) > 2 else STEPS_PER_CONTACT
+    sp = np.geomspace(prob.speeds.min(), prob.speeds.max(), 5)
+    print(f"{'contact':12s} {'v [m/s]':>8s} {'predicted e':>12s} {'Yade e':>12s} {'diff':>10s}")
+    for r in round_trip(prob, sp, steps):
+        print(f"{r['contact']:12s} {r['v']:8.3g} {r['predicted']:12.8f} {r['e']:12.8f} "
+              f"{r['e'] - r['predicted']:10.2e}")

@@ -34,15 +34,18 @@ tangential):
   material (``G``, ``nu``) with both; the tangential MDR mapping stays the
   approximation it is for ``nu != 0.5`` (and ignores the Dundurs coupling of
   dissimilar bodies);
-- equal ``nu``, one elastic side ``G_e`` and one Kelvin-Voigt side ``(G, eta)``:
-  ``G_e (G + eta s) / (G_e + G + eta s)`` is a standard solid with
-  ``G_inf = G_e G/(G_e + G)``, arm ``G_e^2/(G_e + G)`` and time
-  ``eta/(G_e + G)``;
-- equal ``nu``, one elastic side and one standard-solid side ``(G1, G2, tau)``:
-  a standard solid with ``G_inf = G_e G1/(G_e + G1)``, glassy modulus
-  ``G_e (G1 + G2)/(G_e + G1 + G2)`` and time ``tau (G_e + G1 + G2)/(G_e + G1)``.
+- equal ``nu``, any two generalized Maxwell materials: the series combination
+  ``M_1 M_2 / (M_1 + M_2)`` of their operator moduli, which is again one
+  (:func:`vimpact.model.series.series_material`: relaxed modulus
+  ``G_inf1 G_inf2/(G_inf1 + G_inf2)``, a dashpot only if both have one, at most
+  ``n_1 + n_2 + 1`` arms). Two Kelvin-Voigt bodies with different relaxation
+  times, for example, are a spring, a dashpot and one Maxwell arm.
 
-Everything else raises :class:`vimpact.InputError` saying why.
+Unequal ``nu`` with a viscoelastic side is refused: a body's normal compliance
+is ``(1 - nu)/(2 M(s))`` and its tangential one ``(2 - nu)/(4 M(s))``, so the
+normal and tangential series combinations weight the two spectra differently
+and have different relaxation times.
+Two rigid bodies raise :class:`vimpact.InputError` too.
 """
 
 from __future__ import annotations
@@ -56,6 +59,7 @@ import numpy as np
 
 from vimpact.model.material import Material
 from vimpact.model.scene import DEFAULT_THETA_RATIO, Scene
+from vimpact.model.series import series_material
 from vimpact.model.validation import InputError, finite, flag, positive, require
 
 #: relative tolerance for "same nu", "same relaxation times", "proportional"
@@ -152,21 +156,6 @@ def _is_elastic(mat: Material) -> bool:
     return not mat.arms and mat.eta0 == 0.0
 
 
-def _elastic_with_viscoelastic(G_e: float, mat: Material) -> Material:
-    """Series of an elastic ``G_e`` with a Kelvin-Voigt or one-arm body (same ``nu``)."""
-    nu = mat.nu
-    if not mat.arms:  # Kelvin-Voigt: G + eta s
-        G, eta = mat.G_inf, mat.eta0
-        return Material.standard_solid(nu=nu, G1=G_e * G / (G_e + G), G2=G_e**2 / (G_e + G),
-                                       eta=G_e**2 / (G_e + G) * eta / (G_e + G))
-    (G2, tau), G1 = mat.arms[0], mat.G_inf
-    G_inf = G_e * G1 / (G_e + G1)
-    G_glassy = G_e * (G1 + G2) / (G_e + G1 + G2)
-    tau_p = tau * (G_e + G1 + G2) / (G_e + G1)
-    arm = G_glassy - G_inf
-    return Material.standard_solid(nu=nu, G1=G_inf, G2=arm, eta=arm * tau_p)
-
-
 def pair_material(mat1: Material | None, mat2: Material | None) -> Material:
     """The one half-space material equivalent to two bodies' materials in contact.
 
@@ -206,23 +195,11 @@ def pair_material(mat1: Material | None, mat2: Material | None) -> Material:
     if not _same(mat1.nu, mat2.nu):
         raise InputError(
             f"materials with nu = {mat1.nu!r} and nu = {mat2.nu!r} are not allowed for a viscoelastic "
-            "pair: must have equal nu (with unequal nu the series combination has different "
-            "relaxation spectra in the normal and the tangential direction, which no single "
-            "half-space material reproduces)")
-    for elastic, other in ((mat1, mat2), (mat2, mat1)):
-        if _is_elastic(elastic):
-            if len(other.arms) + (other.eta0 > 0) == 1 and not (other.arms and other.eta0 > 0):
-                return _elastic_with_viscoelastic(elastic.G_inf, other)
-            raise InputError(
-                f"material pair (elastic, {other.model} with {len(other.arms)} arms and "
-                f"eta0 = {other.eta0!r}) is not allowed: must be an elastic body against a "
-                "Kelvin-Voigt or a one-arm standard solid (the series combination is only derived "
-                "for those; a general Prony series is not mapped)")
-    raise InputError(
-        f"material pair ({mat1.model}, {mat2.model}) is not allowed: two different viscoelastic "
-        "materials map onto one half-space only when one is a multiple of the other (same nu and "
-        "relaxation times); their series combination is not one generalized Maxwell material "
-        "of the supported form")
+            "pair: must have equal nu (a body's normal compliance is (1 - nu)/(2 M(s)) and its "
+            "tangential one (2 - nu)/(4 M(s)), so with unequal nu the normal and tangential series "
+            "combinations weight the two relaxation spectra differently and have different poles: "
+            "no one material of the generalized Maxwell form with one nu has both)")
+    return series_material(mat1, mat2)
 
 
 # ---- scenes -------------------------------------------------------------

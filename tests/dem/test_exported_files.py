@@ -1,0 +1,47 @@
+"""The files of the codes that are not run here (MercuryDPM, MFiX) hold only names and
+values their sources and documentation accept (a read check, see docs/dem.md)."""
+
+import re
+
+import pytest
+
+from tests.dem.test_cli_dem import TOML
+from vimpact.dem.export import export
+from vimpact.dem.problem import problem_from_toml
+
+#: MercuryDPM: the species class (Kernel/Species/HertzianBSHPViscoelasticMindlinSpecies.h) and
+#: the setters of its parts (HertzianViscoelasticNormalSpecies, MindlinSpecies, ParticleSpecies)
+MERCURY_SETTERS = {"setDensity", "setEffectiveElasticModulus", "setDissipation",
+                   "setEffectiveShearModulus", "setSlidingFrictionCoefficient"}
+#: MFiX LSD keywords (DES_ETAT_FAC, DES_ETAT_W_FAC in [0, 1]; KT_FAC, KT_W_FAC, not DES_KT_*)
+MFIX_KEYS = {"DES_COLL_MODEL", "DES_EN_INPUT", "DES_EN_WALL_INPUT", "KN", "KN_W", "KT_FAC",
+             "KT_W_FAC", "DES_ETAT_FAC", "DES_ETAT_W_FAC", "MEW", "MEW_W"}
+
+
+@pytest.fixture(scope="module")
+def problem():
+    return problem_from_toml(TOML, "files")
+
+
+def test_mercurydpm_species_compiles_by_name(problem, tmp_path):
+    export(problem, "mercurydpm", tmp_path)
+    text = (tmp_path / "mercurydpm_species.cpp").read_text()
+    assert '#include "Species/HertzianBSHPViscoelasticMindlinSpecies.h"' in text
+    assert "HertzianBSHPViscoelasticSlidingFrictionSpecies" not in text
+    code = "\n".join(ln.split("//")[0] for ln in text.splitlines())
+    assert set(re.findall(r"->(set\w+)\(", code)) == MERCURY_SETTERS
+    # friction comes with a tangential stiffness wherever it is set
+    assert text.count("setSlidingFrictionCoefficient") == text.count("setEffectiveShearModulus")
+
+
+def test_mfix_keywords_and_ranges(problem, tmp_path):
+    ex = export(problem, "mfix", tmp_path)
+    lines = [ln.split("!")[0] for ln in (tmp_path / "mfix.dat").read_text().splitlines()]
+    values = dict(ln.split("=", 1) for ln in lines if "=" in ln)
+    values = {k.strip(): v.strip() for k, v in values.items()}
+    assert set(values) <= MFIX_KEYS
+    for key in ("DES_ETAT_FAC", "DES_ETAT_W_FAC"):
+        assert 0.0 <= float(values[key]) <= 1.0
+    # the reported beta_x residual is that of the value written
+    for f in ex.fits:
+        assert 0.0 <= f.params["etat_fac"] <= 1.0 and f.res_beta_x is not None
