@@ -10,7 +10,7 @@ import pytest
 import vimpact as v
 from vimpact.bench import scaling, throughput
 from vimpact.bench.pure_python import pure_python_impact
-from vimpact.reference.numpy_elements import naive_impact
+from tests.oracles.naive import naive_impact
 
 SCENES = {
     "kelvin_voigt": v.Scene.from_dimensionless(0.1, 0.5),

@@ -194,7 +194,7 @@ def test_reference_with_friction_agrees_with_kernel(mu):
     """The engine (element kernel with friction) against the SI reference,
     which also checks |f_t| <= mu f_n per element at every step."""
     from vimpact import Numerics, simulate
-    from vimpact.reference.numpy_elements import naive_impact
+    from tests.oracles.naive import naive_impact
 
     scene = _scene(mu)
     num = Numerics(steps=150, elements=30, continuum=False)
@@ -206,7 +206,7 @@ def test_reference_with_friction_agrees_with_kernel(mu):
 
 def test_reference_gross_slip_and_cone():
     """The SI reference alone: gross slip closed form and the cone check."""
-    from vimpact.reference.numpy_elements import naive_impact
+    from tests.oracles.naive import naive_impact
 
     scene = _scene(0.02, v_x0=2.0)
     ref = naive_impact(scene, 120, 20)
@@ -279,7 +279,7 @@ def test_flat_punch_is_a_stick_slip_oscillator(mu):
     element enters at once and leaves together) with friction against the
     independent 1-DOF stick-slip oscillator."""
     from vimpact import Material, Scene
-    from vimpact.reference.numpy_elements import naive_impact
+    from tests.oracles.naive import naive_impact
 
     G, nu, R, m = 1e9, 0.3, 0.01, 0.004
     scene = Scene(Material.elastic(nu=nu, G=G), R=R, m=m, v_z0=1.0, v_x0=0.8, omega0=0.0,

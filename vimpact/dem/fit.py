@@ -18,7 +18,7 @@ from scipy.optimize import minimize_scalar
 
 from vimpact.dem import laws
 from vimpact.dem.problem import Contact, DemProblem
-from vimpact.model.pair import pair_restitution
+from vimpact.engine.pairs import pair_restitution
 
 
 @dataclass

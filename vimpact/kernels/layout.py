@@ -4,7 +4,8 @@ of the per-impact output row and of a trajectory record.
 Kernel units are described in :mod:`vimpact.kernels.elements`. Everything here
 is plain numbers (no numba: the command line's parser and the value objects
 read these codes without loading numba); the record writer is
-:func:`vimpact.kernels.record._record`. Nothing imports the API side.
+:func:`vimpact.kernels.record._record`, which imports this module (not the
+other way round). Nothing imports the API side.
 """
 
 from __future__ import annotations
@@ -49,13 +50,3 @@ N_REC = 8
 #: Element stiffness per unit length in kernel units (both halves of the row counted by the caller).
 ELEMENT_STIFFNESS = 15.0 / 16.0
 
-
-def __getattr__(name: str):
-    """``_record`` moved to :mod:`vimpact.kernels.record`; kernels of earlier commits
-    (the before/after benchmarks compile them from ``git show``) still import it
-    from here, which loads numba only then."""
-    if name == "_record":
-        from vimpact.kernels.record import _record
-
-        return _record
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

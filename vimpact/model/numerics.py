@@ -5,11 +5,13 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, replace
 
-from vimpact.kernels.layout import EULER, SYMPLECTIC_EULER, VERLET
 from vimpact.model.validation import one_of, positive, require
 
 #: Integrators by name (see :mod:`vimpact.kernels.elements`) and their nominal order.
-INTEGRATORS = {"euler": EULER, "symplectic_euler": SYMPLECTIC_EULER, "verlet": VERLET}
+#: The numbers are the kernels' integrator codes (``EULER``, ``SYMPLECTIC_EULER``,
+#: ``VERLET`` of :mod:`vimpact.kernels.layout`), written out because the model
+#: imports no other folder; ``tests/model/test_numerics_codes.py`` checks they agree.
+INTEGRATORS = {"euler": 0, "symplectic_euler": 1, "verlet": 2}
 ORDER = {"euler": 1, "symplectic_euler": 1, "verlet": 2}
 
 
