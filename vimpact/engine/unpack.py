@@ -7,15 +7,13 @@ import numpy as np
 from vimpact.engine.columns import SceneColumns
 from vimpact.engine.result import FINISHED, RESULT_FIELDS, STATUSES
 from vimpact.kernels import layout
+from vimpact.kernels import status as status_table
 from vimpact.model.numerics import MIN_CONTACT_STEPS
 from vimpact.model.scene import HALF_SPACE_LIMIT, TANGENTIAL_EFFECTS, TANGENTIAL_MEMORY
 
-#: kernel status code -> status name
+#: kernel status code -> status name (the status table's codes)
 KERNEL_STATUSES = {
-    layout.STATUS_OK: "ok",
-    layout.STATUS_TIME_LIMIT: "time_limit",
-    layout.STATUS_ROW_EXCEEDED: "row_exceeded",
-    layout.STATUS_NON_FINITE: "non_finite",
+    **status_table.BY_CODE,
     layout.STATUS_ASSUMPTION: "non_finite",  # only reached if a hand-over failed
 }
 
@@ -50,7 +48,7 @@ def unpack(cols: SceneColumns, out: np.ndarray, path_names: np.ndarray, explicit
     n = len(cols)
     valid = cols.valid
     kstatus = out[:, layout.OUT_STATUS].astype(np.int64)
-    status = np.full(n, "invalid", dtype=object)
+    status = np.full(n, status_table.INVALID, dtype=object)
     ran = valid & np.equal(refused, None)
     for code, name in KERNEL_STATUSES.items():
         status[ran & (kstatus == code)] = name

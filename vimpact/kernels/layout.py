@@ -10,17 +10,20 @@ other way round). Nothing imports the API side.
 
 from __future__ import annotations
 
+from vimpact.kernels.status import BY_CODE, code
+
 EULER = 0
 SYMPLECTIC_EULER = 1
 VERLET = 2
 
-# status codes written to OUT_STATUS
-STATUS_OK = 0
-STATUS_TIME_LIMIT = 1
-STATUS_ROW_EXCEEDED = 2
-STATUS_NON_FINITE = 3
-# a continuum kernel met a scene outside its assumptions (the element path takes it over)
-STATUS_ASSUMPTION = 4
+# status codes written to OUT_STATUS: those of the status table
+STATUS_OK = code("ok")
+STATUS_TIME_LIMIT = code("time_limit")
+STATUS_ROW_EXCEEDED = code("row_exceeded")
+STATUS_NON_FINITE = code("non_finite")
+# not a status of a result: a continuum kernel met a scene outside its assumptions (the
+# engine hands the row to the element path); a code of its own, after the table's
+STATUS_ASSUMPTION = max(BY_CODE) + 1
 
 # columns of the per-impact output row
 OUT_VZ_END = 0  # normal velocity at the end / v_z0 (negative: rebound)

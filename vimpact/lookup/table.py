@@ -45,6 +45,8 @@ import numpy as np
 import pandas as pd
 
 from vimpact.engine.result import STATUSES
+from vimpact.kernels.status import INVALID
+from vimpact.kernels.status import TABLE as STATUS_TABLE
 from vimpact.lookup.interpolate import cluster_nodes, same_node
 from vimpact.model.scene import HALF_SPACE_LIMIT, Scene
 from vimpact.model.validation import InputError, positive, require
@@ -57,7 +59,7 @@ __all__ = ["AXES", "DATA_STATUSES", "LOG_AXES", "LOOKUP_METHODS", "LOOKUP_MODELS
 LOOKUP_METHODS = ("cubic", "linear")
 
 #: Statuses whose rows are data (all others are failures and are skipped).
-DATA_STATUSES = ("ok",)
+DATA_STATUSES = tuple(s.name for s in STATUS_TABLE if s.has_data)
 
 #: Models whose tables :meth:`RestitutionTable.lookup` can interpolate.
 LOOKUP_MODELS = ("kelvin_voigt", "standard_solid")
@@ -287,7 +289,7 @@ def validate_table(data: pd.DataFrame, metadata: dict, path=None) -> None:
                          f"{_rows_text(i)} is not a vimpact status (known: "
                          + ", ".join(STATUSES) + ")")
     ok = np.isin(status, DATA_STATUSES)
-    ran = status != "invalid"  # every other row is an impact at its inputs
+    ran = status != INVALID  # every other row is an impact at its inputs
     bounds = {"e_z": (0.0, 1.0 + BOUND_SLACK, "in [0, 1 + 1e-6]"),
               "e_x": (0.0, 1.0 + BOUND_SLACK, "in [0, 1 + 1e-6]"),
               "beta_x": (-1.0 - BOUND_SLACK, 1.0 + BOUND_SLACK, "|beta_x| <= 1 + 1e-6")}

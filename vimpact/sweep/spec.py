@@ -125,6 +125,7 @@ from pathlib import Path
 import numpy as np
 
 from vimpact import __version__
+from vimpact.kernels.status import TABLE as STATUS_TABLE
 from vimpact.model.numerics import Numerics
 from vimpact.model.scene import Scene
 from vimpact.model.toml_input import (ANGLE_RANGE_DEG, ARM_KEYS, FRICTION_KEYS, MATERIAL_KEYS,
@@ -141,18 +142,9 @@ from vimpact.model.toml_input import (ANGLE_RANGE_DEG, ARM_KEYS, FRICTION_KEYS, 
 #: The random draws of version 3 are unchanged.
 SCHEMA_VERSION = 4
 
-#: Row statuses of a sweep table: those of :data:`vimpact.STATUSES` and two more.
-def _statuses() -> dict:
-    from vimpact.engine.result import STATUSES
-    return {
-        **STATUSES,
-        "invalid": "the parameters are not a valid scene (reason in the error column); "
-                   "outputs NaN",
-        "failed": "the simulation raised an error (message in the error column); outputs NaN",
-    }
-
-
-SWEEP_STATUSES = _statuses()
+#: Row statuses of a sweep table: those of :data:`vimpact.STATUSES` and ``failed``
+#: (the status table, :mod:`vimpact.kernels.status`).
+SWEEP_STATUSES = {s.name: s.message for s in STATUS_TABLE}
 
 DEFAULT_CHUNK_SIZE = 64
 #: Rows of one sweep at most (a grid axis has at most as many points).
