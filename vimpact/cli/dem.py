@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import argparse
 
+from vimpact.model.numerics import CONVERGED_PRESETS
+
 
 def add_parser(sub) -> None:
     from vimpact.dem import CODES  # the light list: the exports load scipy
@@ -20,7 +22,7 @@ def add_parser(sub) -> None:
     p.add_argument("--for", dest="code", required=True, choices=CODES, help="the DEM code")
     p.add_argument("--out", default=None,
                    help="output directory (default: vimpact-dem-<code> in the current directory)")
-    p.add_argument("--preset", default="fast", choices=("fast", "default", "precise"),
+    p.add_argument("--preset", default="fast", choices=CONVERGED_PRESETS,
                    help="vimpact numerics for the restitution curves (default: fast)")
     p.set_defaults(func=run)
 

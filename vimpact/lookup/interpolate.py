@@ -41,8 +41,14 @@ from vimpact.model.validation import InputError
 __all__ = ["BACKENDS", "HermiteGrid", "LOG_AXES", "NODE_ATOL", "NODE_RTOL", "cluster_nodes",
            "derivative_matrix", "hermite_slopes", "same_node"]
 
-#: Axes interpolated in the logarithm of the value by default (> 0 required).
-LOG_AXES = ("Q1", "Q2")
+#: Axes interpolated in the logarithm of the value (> 0 required; the one list for
+#: tables, their verification and refinement: held-out mid-points and inserted nodes
+#: are geometric means there): the damping parameters, which span decades, and
+#: ``theta_ratio = Theta / (m R^2)``, which enters the tangential dynamics through the
+#: effective mass factor ``1 + m R^2 / Theta``, smoother in ``log theta_ratio`` than in
+#: ``theta_ratio`` on nodes spaced by ratios. ``nu`` and ``psi`` (which is 0 at normal
+#: incidence) are interpolated as they are.
+LOG_AXES = ("Q1", "Q2", "theta_ratio")
 #: Evaluations of :meth:`HermiteGrid.__call__`: the numba kernel, the NumPy reference.
 BACKENDS = ("numba", "numpy")
 #: Points evaluated per block (bounds the temporary memory).

@@ -47,8 +47,8 @@ import pandas as pd
 from vimpact.engine.result import STATUSES
 from vimpact.kernels.status import INVALID
 from vimpact.kernels.status import TABLE as STATUS_TABLE
-from vimpact.lookup.interpolate import cluster_nodes, same_node
-from vimpact.model.scene import HALF_SPACE_LIMIT, Scene
+from vimpact.lookup.interpolate import LOG_AXES, cluster_nodes, same_node
+from vimpact.model.scene import DEFAULT_THETA_RATIO, HALF_SPACE_LIMIT, Scene
 from vimpact.model.validation import InputError, positive, require
 
 __all__ = ["AXES", "DATA_STATUSES", "LOG_AXES", "LOOKUP_METHODS", "LOOKUP_MODELS",
@@ -77,12 +77,6 @@ OUTPUTS = ("e_z", "e_x", "beta_x")
 #: several values, ``psi`` when it has a ``psi`` column (friction incidence).
 AXES = ("Q1", "Q2", "nu", "theta_ratio", "psi")
 
-#: Axes interpolated in the logarithm of the value: the damping parameters, which span
-#: decades, and ``theta_ratio = Theta / (m R^2)``, which enters the tangential dynamics
-#: through the effective mass factor ``1 + m R^2 / Theta``, smoother in ``log theta_ratio``
-#: than in ``theta_ratio`` on nodes spaced by ratios. ``nu`` and ``psi`` (which is 0
-#: at normal incidence) are interpolated as they are.
-LOG_AXES = ("Q1", "Q2", "theta_ratio")
 
 #: The most points of an e(v) curve (:meth:`RestitutionTable.restitution_curve`,
 #: ``vimpact table export --n``).
@@ -94,9 +88,6 @@ BOUND_SLACK = 1e-6
 
 _REQUIRED = ("Q1", "nu", "e_z", "e_x", "beta_x", "status")
 _META_PREFIX = "vimpact."  # the sweep's vimpact.sweep.store.META_PREFIX
-#: Theta / (m R^2) of a table without a ``theta_ratio`` column (the solid sphere,
-#: ``Scene``'s default).
-DEFAULT_THETA_RATIO = 0.4
 
 
 def _axis_is_log(name: str) -> bool:

@@ -238,3 +238,17 @@ PRESETS = {
     "precise": Numerics(steps=16000, elements=3200, rtol=1e-12),
     "thesis": Numerics(integrator="euler", steps=5000, elements=500),
 }
+
+
+#: The presets that converge (not the thesis's explicit Euler): for fits and exports.
+CONVERGED_PRESETS = tuple(n for n, p in PRESETS.items() if p.integrator != "euler")
+
+
+def preset_summary(name: str) -> str:
+    """One line on preset ``name`` for help texts: its error bound on the element
+    path (:func:`element_error_bound`, dimensionless), or what the thesis preset is."""
+    p = PRESETS[name]
+    if p.integrator == "euler":
+        return f"{name} (explicit Euler as in the thesis)"
+    bound = f"{element_error_bound(p.steps, p.elements):.0e}".replace("e-0", "e-")
+    return f"{name} (about {bound} on the element path)"

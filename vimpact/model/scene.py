@@ -22,6 +22,9 @@ TANGENTIAL_EFFECTS = ("auto", "stick", "none")
 
 #: ``Theta / (m R^2)`` of a solid sphere, the default moment of inertia.
 DEFAULT_THETA_RATIO = 0.4
+#: Hertz indentation (m) of the reference scene of :meth:`Scene.from_dimensionless`
+#: (R = 1 m, m = 1 kg, v_z0 = 1 m/s): a_H = sqrt(R d) = 0.01 R.
+REFERENCE_INDENTATION = 1e-4
 
 #: The thesis's half-space limit: contact half-width at most this times R.
 HALF_SPACE_LIMIT = 0.2
@@ -98,7 +101,7 @@ class Scene:
         if self.Theta is None:
             theta = DEFAULT_THETA_RATIO * self.m * self.R**2 if self.R < 1e150 else math.inf
             require("R", self.R, 0.0 < theta < math.inf,
-                    f"large enough for the default Theta = 0.4 m R^2 to be a finite number > 0 "
+                    f"large enough for the default Theta = {DEFAULT_THETA_RATIO} m R^2 to be a finite number > 0 "
                     f"(with m = {self.m:g} kg; give Theta)")
             object.__setattr__(self, "Theta", theta)
         object.__setattr__(self, "Theta", positive("Theta", self.Theta))
@@ -161,7 +164,7 @@ class Scene:
                     "e_z < 1e-160)")
         nu = poisson_ratio("nu", nu)  # a type check too: float("0.5") would take a string
         R, m, v_z0 = 1.0, 1.0, 1.0
-        d = 1e-4  # a_H = sqrt(R d) = 0.01 R
+        d = REFERENCE_INDENTATION  # a_H = sqrt(R d) = 0.01 R
         E_star = 15.0 * m * v_z0**2 / (16.0 * math.sqrt(R) * d**2.5)
         G = E_star * (1.0 - nu) / 2.0
         tau = Q1 / Q1_PER_TAU * d / v_z0  # eta / G_inf, s

@@ -34,7 +34,7 @@ import numpy as np
 
 from vimpact.model.material import MODELS, Material
 from vimpact.model.numerics import PRESETS, Numerics
-from vimpact.model.scene import TANGENTIAL_EFFECTS, TANGENTIAL_MEMORY, Scene
+from vimpact.model.scene import DEFAULT_THETA_RATIO, TANGENTIAL_EFFECTS, TANGENTIAL_MEMORY, Scene
 from vimpact.model.validation import InputError
 
 #: Material keys per model (Pa, Pa s).
@@ -47,7 +47,7 @@ MATERIAL_KEYS = {
 #: Sphere and initial-velocity keys (m, kg, m/s, m/s, rad/s).
 SPHERE_KEYS = ("R_m", "m_kg", "v_z0_m_s", "v_x0_m_s", "omega0_rad_s")
 #: Defaults of the optional physical keys (``eta_Pa_s``: optional for Prony only).
-PHYSICAL_DEFAULTS = {"v_x0_m_s": 0.0, "omega0_rad_s": 0.0, "theta_ratio": 0.4}
+PHYSICAL_DEFAULTS = {"v_x0_m_s": 0.0, "omega0_rad_s": 0.0, "theta_ratio": DEFAULT_THETA_RATIO}
 #: Optional friction keys (after the physical keys, in this order): Coulomb friction
 #: coefficient (1; default inf, full stick) and impact angle from the normal (degrees;
 #: an alternative to ``v_x0_m_s``).

@@ -21,6 +21,7 @@ import numpy as np
 
 from vimpact.engine.simulate import simulate_batch
 from vimpact.model.numerics import Numerics
+from vimpact.model.scene import REFERENCE_INDENTATION
 from vimpact.plots.style import drawing
 
 #: Numerics of these figures: about 1e-3 on beta_x, so that a figure takes seconds.
@@ -48,8 +49,8 @@ def _columns(nu, G, eta, R, m, v_z0, v_x0, theta_ratio, mu) -> dict:
 def _exit_incidence(nu, theta_ratio, Q1, psi1, mu=0.3) -> np.ndarray:
     """``psi2`` for incidences ``psi1`` (a dimensionless scene: v_z0 = 1 m/s, R = 1 m,
     m = 1 kg, a_H = 0.01 R)."""
-    d = 1e-4
-    G = 15.0 / (16.0 * d**2.5) * (1.0 - nu) / 2.0  # E* from d = 1e-4 m at 1 m/s
+    d = REFERENCE_INDENTATION  # m
+    G = 15.0 / (16.0 * d**2.5) * (1.0 - nu) / 2.0  # E* from d at 1 m/s
     T = d / 1.0
     eta = Q1 / np.sqrt(15.0 / 32.0) * T * G
     v_c = psi1 * mu * (2.0 - nu) / (2.0 * (1.0 - nu))

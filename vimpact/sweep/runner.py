@@ -53,6 +53,7 @@ from pathlib import Path
 
 import numpy as np
 
+from vimpact.model.scene import DEFAULT_THETA_RATIO
 from vimpact.model.validation import InputError
 from vimpact.sweep import store
 from vimpact.sweep.progress import Progress
@@ -309,7 +310,7 @@ def refined_spec(spec: SweepSpec, parts: Path, log: Callable[[str], None] | None
     if spec.model not in REFINABLE:
         raise InputError(f"grid.tolerance = {tol!r} is not allowed for a {spec.model} grid: "
                          f"only {' and '.join(REFINABLE)} grids are refined (remove it)")
-    theta = np.asarray(spec.axes.get("theta_ratio", [0.4]), dtype=float)
+    theta = np.asarray(spec.axes.get("theta_ratio", [DEFAULT_THETA_RATIO]), dtype=float)
     if theta.size != 1:
         raise InputError(f"grid.tolerance = {tol!r} is not allowed with {theta.size} "
                          "theta_ratio values: a refined grid has one theta_ratio (one "

@@ -127,7 +127,7 @@ import numpy as np
 from vimpact import __version__
 from vimpact.kernels.status import TABLE as STATUS_TABLE
 from vimpact.model.numerics import Numerics
-from vimpact.model.scene import Scene
+from vimpact.model.scene import DEFAULT_THETA_RATIO, Scene
 from vimpact.model.toml_input import (ANGLE_RANGE_DEG, ARM_KEYS, FRICTION_KEYS, MATERIAL_KEYS,
                                       PHYSICAL_DEFAULTS, SPHERE_KEYS, SWEEP_TOP_KEYS, TomlSource,
                                       friction_coefficient, input_keys, is_number, parse_header,
@@ -706,7 +706,7 @@ def _grid(spec: TomlSource, model: str, table) -> tuple[dict[str, np.ndarray], f
             continue
         if key not in table:
             if key == "theta_ratio":
-                axes[key] = np.array([0.4])
+                axes[key] = np.array([DEFAULT_THETA_RATIO])
                 continue
             raise spec.error(f"grid.{key}", "missing")
         values = _axis(spec, f"grid.{key}", table[key])
