@@ -1,4 +1,4 @@
-"""Issue 5, part 1: the cases that break naive solvers give a finite, converged,
+"""The cases that break naive solvers give a finite, converged,
 physically admissible answer with the default numerics.
 
 A matrix of impacts, one batch per axis (each axis swept with the others at
@@ -35,7 +35,7 @@ the dashpot at a fraction of ``d`` (``a_max`` about 0.18 ``a_H``), it does not
 sink in. So the allowed statuses are ``ok`` and, for ``v_c0 = 0`` only,
 ``vc0_zero``.
 
-``e_z <= 1`` is checked with the tolerance 1e-6 that the issue gives for the
+``e_z <= 1`` is checked with the tolerance 1e-6 required of the
 elastic limit (``e_z = 1`` within 1e-6): the time discretization of an
 (almost) elastic impact may return the normal speed to about 1e-10 above 1,
 which is neither a failure nor avoidable by a second-order integrator; a

@@ -1,4 +1,4 @@
-"""Issue 15, part 2: extreme but admissible inputs end in a converged answer or a status.
+"""Extreme but admissible inputs end in a converged answer or a status.
 
 Hypothesis draws batches of scenes whose physical inputs span about 30 decades
 (``G_inf``, ``R``, ``v_z0`` each log-uniform over [1e-15, 1e15] in its SI

@@ -45,7 +45,7 @@ Integrators (the value of ``integrator``):
     stress over its ramp; the force that decides whether an element still
     pushes at the step end takes the arms' damping part at the end velocity.
 
-Compile-time specialization (issue 5): the impact body :func:`_impact` takes
+Compile-time specialization: the impact body :func:`_impact` takes
 the scene's effects as its first arguments (``tangential``, ``memory``,
 ``integrator``, ``arms``, ``dashpot``) and is inlined into a batch kernel
 built by :func:`element_kernel` for one :class:`KernelSpec`, where these are
