@@ -40,8 +40,17 @@ import time
 import numpy as np
 
 from benchmarks.machine import bench_main, machine_info, module_at_commit, save_figure
-from vimpact.kernels.elements import (N_OUT, N_REC, OUT_STATUS, OUT_VC_END, OUT_VZ_END,
-                                      STATUS_OK, VERLET, KernelSpec, element_kernel)
+from vimpact.kernels.elements import (
+    N_OUT,
+    N_REC,
+    OUT_STATUS,
+    OUT_VC_END,
+    OUT_VZ_END,
+    STATUS_OK,
+    VERLET,
+    KernelSpec,
+    element_kernel,
+)
 
 TITLE = "element kernel: observed orders in steps and elements against the continuum kernel"
 

@@ -20,8 +20,16 @@ from pathlib import Path
 from types import ModuleType
 
 from vimpact.bench.machine import (  # noqa: F401  (re-exported for the scripts)
-    figure, load_average, machine_info, machine_line, median_time, progress, save_figure,
-    time_samples, use_agg)
+    figure,
+    load_average,
+    machine_info,
+    machine_line,
+    median_time,
+    progress,
+    save_figure,
+    time_samples,
+    use_agg,
+)
 
 RESULTS = Path(__file__).parent / "results"
 

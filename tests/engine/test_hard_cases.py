@@ -51,8 +51,16 @@ from typing import NamedTuple
 import pytest
 
 import vimpact as v
-from tests.oracles.hard_cases import (ELASTIC_EZ_TOL, EZ_MAX, fmt, hertz_unit, invariant_violations, material,
-                        scene, tighter)
+from tests.oracles.hard_cases import (
+    ELASTIC_EZ_TOL,
+    EZ_MAX,
+    fmt,
+    hertz_unit,
+    invariant_violations,
+    material,
+    scene,
+    tighter,
+)
 
 #: ``|e_z(default) - e_z(tighter)|`` and the same for ``beta_x`` (hence ``e_x``).
 #: The default numerics aim at about 1e-4 (README, Numerics); for a second-order

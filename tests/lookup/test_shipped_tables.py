@@ -15,9 +15,8 @@ Live since the tables were regenerated with the final sweep driver and verified
 remade.
 """
 
-from pathlib import Path
-
 import dataclasses
+from pathlib import Path
 
 import numpy as np
 import pytest

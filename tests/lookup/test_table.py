@@ -19,8 +19,7 @@ import pyarrow.parquet as pq
 import pytest
 
 import vimpact
-from vimpact import Material, Numerics, Scene, simulate, simulate_batch
-from vimpact import cli
+from vimpact import Material, Numerics, Scene, cli, simulate, simulate_batch
 from vimpact.lookup.table import RestitutionTable
 from vimpact.model.validation import InputError
 

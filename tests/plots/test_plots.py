@@ -8,8 +8,8 @@ import pytest
 
 from tests.lookup.test_table import make_table, results_frame, run, vimpact_main, write_table  # noqa: F401
 from vimpact import Material, Scene
-from vimpact.plots.figures import FIGURE_NAMES, FIGURES, figure_name, plot_figure
 from vimpact.lookup.table import RestitutionTable
+from vimpact.plots.figures import FIGURE_NAMES, FIGURES, figure_name, plot_figure
 
 
 def random_draws_table(path, n=40, seed=3):

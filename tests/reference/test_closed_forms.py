@@ -15,6 +15,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.integrate import quad, solve_ivp
 
+from vimpact.model.hertz import HERTZ_TIME_FACTOR, Q1_PER_TAU
 from vimpact.reference import closed_forms as analytic
 from vimpact.reference.closed_forms import (
     hertz_time_factor_quadrature,
@@ -24,7 +25,6 @@ from vimpact.reference.closed_forms import (
     linear_model_zeta,
     linear_tangential_frequency,
 )
-from vimpact.model.hertz import HERTZ_TIME_FACTOR, Q1_PER_TAU
 
 PHYSICS_HERTZ_TIME = 2.9432751843   # docs/physics.md#hertz-scales
 PHYSICS_KV_SLOPE = 1.8917            # docs/physics.md#kelvin-voigt-continuum, per tau/T

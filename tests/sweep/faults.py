@@ -151,7 +151,7 @@ class FullDisk:
         self.failures = 0
 
     def __call__(self, file, mode="r", *args, **kwargs):
-        real = io.open(file, mode, *args, **kwargs)
+        real = open(file, mode, *args, **kwargs)
         if "w" not in mode and "a" not in mode and "+" not in mode:
             return real
         self.opened += 1

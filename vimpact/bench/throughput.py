@@ -40,10 +40,17 @@ import numpy as np
 import pandas as pd
 
 import vimpact as v
-
 from vimpact.reference.numpy_elements import naive_impact
 
-from .machine import figure, load_average, machine_info, progress, ratio_spread, save_figure, use_agg
+from .machine import (
+    figure,
+    load_average,
+    machine_info,
+    progress,
+    ratio_spread,
+    save_figure,
+    use_agg,
+)
 from .pure_python import kernel_refinement, pure_python_impact, refined_row
 
 TITLE = "element-updates per second: batch kernel (1 and 2 threads) vs NumPy and pure Python"

@@ -15,8 +15,13 @@ from vimpact.cli.material_args import add_material_arguments, material_from_args
 from vimpact.engine.result import STATUSES, UNITS
 from vimpact.model.material import MODELS
 from vimpact.model.numerics import INTEGRATORS, PRESETS, Numerics, preset_summary
-from vimpact.model.scene import (DEFAULT_THETA_RATIO, TANGENTIAL_EFFECTS, TANGENTIAL_MEMORY,
-                                 ScaleError, Scene)
+from vimpact.model.scene import (
+    DEFAULT_THETA_RATIO,
+    TANGENTIAL_EFFECTS,
+    TANGENTIAL_MEMORY,
+    ScaleError,
+    Scene,
+)
 from vimpact.model.validation import InputError, positive
 
 

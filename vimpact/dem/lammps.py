@@ -36,8 +36,13 @@ import tempfile
 
 import numpy as np
 
-from vimpact.dem.fit import (ContactFit, Residual, Targets, fit_viscoelastic_hertz,
-                             viscoelastic_hertz_prediction)
+from vimpact.dem.fit import (
+    ContactFit,
+    Residual,
+    Targets,
+    fit_viscoelastic_hertz,
+    viscoelastic_hertz_prediction,
+)
 from vimpact.dem.problem import Contact, DemProblem
 
 CODE = "lammps"
@@ -199,7 +204,7 @@ def collision_script(coeffs: str, R1: float, rho1: float, v: float, t_contact: f
                   f"pair_coeff * * {coeffs}",
                   "variable m1 equal mass[1]", "variable m2 equal mass[2]",
                   # equal and opposite momenta: approach speed v, centre of mass at rest
-                  f"velocity all set 0 0 0",
+                  "velocity all set 0 0 0",
                   "variable u1 equal ${m2}/(${m1}+${m2})*" + f"{v:.12g}",
                   "variable u2 equal -${m1}/(${m1}+${m2})*" + f"{v:.12g}",
                   "group g1 id 1", "group g2 id 2",

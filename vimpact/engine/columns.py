@@ -47,8 +47,13 @@ import numpy as np
 
 from vimpact.model.hertz import Q1_PER_TAU, hertz_scales
 from vimpact.model.material import MODELS
-from vimpact.model.scene import (DEFAULT_THETA_RATIO, MAX_DASHPOT_TIME, TANGENTIAL_EFFECTS,
-                                 TANGENTIAL_MEMORY, Scene)
+from vimpact.model.scene import (
+    DEFAULT_THETA_RATIO,
+    MAX_DASHPOT_TIME,
+    TANGENTIAL_EFFECTS,
+    TANGENTIAL_MEMORY,
+    Scene,
+)
 from vimpact.model.validation import InputError, check_column, message
 
 #: numeric input columns: name -> (validation rule, default or None if required)
@@ -174,14 +179,14 @@ class SceneColumns:
             q2 = np.where(G2 > 0.0, self.G_inf / np.where(G2 > 0.0, G2, 1.0), np.inf)
         return np.where(self.model == MODEL_STANDARD_SOLID, q2, np.nan)
 
-    def take(self, index) -> "SceneColumns":
+    def take(self, index) -> SceneColumns:
         """The rows ``index`` (an integer array or a mask) as a new batch."""
         fields = {k: getattr(self, k)[index] for k in _FIELDS}
         return SceneColumns(**fields)
 
     # ---- constructors ---------------------------------------------------------
     @classmethod
-    def from_scenes(cls, scenes: Sequence[Scene]) -> "SceneColumns":
+    def from_scenes(cls, scenes: Sequence[Scene]) -> SceneColumns:
         """Columns of validated :class:`Scene` objects (one Python pass over them)."""
         n = len(scenes)
         k = max((len(s.material.arms) for s in scenes if isinstance(s, Scene)), default=0)
@@ -215,7 +220,7 @@ class SceneColumns:
         return out
 
     @classmethod
-    def from_columns(cls, data) -> "SceneColumns":
+    def from_columns(cls, data) -> SceneColumns:
         """Validate scene columns (module docstring); bad rows get a reason, never an exception.
 
         Raises :class:`InputError` only for a malformed batch: not a mapping, columns of

@@ -101,7 +101,7 @@ class ImpactResult:
     gross_slip_fraction: float = math.nan
     friction_energy: float = math.nan
     error: str | None = None
-    trajectory: "pd.DataFrame | None" = field(default=None, repr=False, compare=False)
+    trajectory: pd.DataFrame | None = field(default=None, repr=False, compare=False)
 
     def to_dict(self) -> dict:
         """Outputs as a plain dict (NaN kept as float NaN; no trajectory)."""

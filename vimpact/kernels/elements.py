@@ -62,18 +62,52 @@ from typing import NamedTuple
 import numpy as np
 from numba import prange
 
-from vimpact.kernels.arms import (_arm_coefficient, _arm_start, _arm_stress, _follow,
-                                  _follow_over, _follow_over_impulse, _follow_value, _free_rate,
-                                  _relax, _to_stress,
-                                  arm_coefficients, arm_implicit_coefficients)
+from vimpact.kernels.arms import (
+    _arm_coefficient,
+    _arm_start,
+    _arm_stress,
+    _follow,
+    _follow_over,
+    _follow_over_impulse,
+    _follow_value,
+    _free_rate,
+    _relax,
+    _to_stress,
+    arm_coefficients,
+    arm_implicit_coefficients,
+)
 from vimpact.kernels.jit import jit
 from vimpact.kernels.layout import (  # noqa: F401 - re-exported: the kernels' common layout
-    ELEMENT_STIFFNESS, EULER, N_OUT, N_REC, OUT_B_MAX, OUT_N_REC, OUT_STATUS, OUT_STEPS,
-    OUT_T_CONTACT, OUT_T_GROSS_SLIP, OUT_U_MAX, OUT_VC_END, OUT_VZ_END, OUT_W_FRICTION, REC_B,
-    REC_FX, REC_FZ, REC_SLIP, REC_T, REC_U, REC_V, REC_VC, STATUS_NON_FINITE, STATUS_OK, STATUS_ROW_EXCEEDED, STATUS_TIME_LIMIT, SYMPLECTIC_EULER,
-    VERLET)
+    ELEMENT_STIFFNESS,
+    EULER,
+    N_OUT,
+    N_REC,
+    OUT_B_MAX,
+    OUT_N_REC,
+    OUT_STATUS,
+    OUT_STEPS,
+    OUT_T_CONTACT,
+    OUT_T_GROSS_SLIP,
+    OUT_U_MAX,
+    OUT_VC_END,
+    OUT_VZ_END,
+    OUT_W_FRICTION,
+    REC_B,
+    REC_FX,
+    REC_FZ,
+    REC_SLIP,
+    REC_T,
+    REC_U,
+    REC_V,
+    REC_VC,
+    STATUS_NON_FINITE,
+    STATUS_OK,
+    STATUS_ROW_EXCEEDED,
+    STATUS_TIME_LIMIT,
+    SYMPLECTIC_EULER,
+    VERLET,
+)
 from vimpact.kernels.record import _record
-
 
 
 @jit(inline="always")
@@ -612,7 +646,7 @@ class KernelSpec(NamedTuple):
     friction: bool = False
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def element_kernel(spec: KernelSpec):
     """The batch kernel specialized for ``spec`` (compiled on first use, cached on disk).
 

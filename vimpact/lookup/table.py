@@ -386,7 +386,7 @@ class RestitutionTable:
 
     # ---- reading and writing -------------------------------------------
     @classmethod
-    def open(cls, path, validate: bool = True) -> "RestitutionTable":
+    def open(cls, path, validate: bool = True) -> RestitutionTable:
         """Read a restitution table and its ``vimpact.*`` metadata: one Parquet file, or a
         partitioned dataset written by a large sweep (a directory of part files plus
         ``_common_metadata``, which holds the metadata).
@@ -438,7 +438,7 @@ class RestitutionTable:
             table.validate()
         return table
 
-    def validate(self) -> "RestitutionTable":
+    def validate(self) -> RestitutionTable:
         """Check the rows and metadata (:func:`validate_table`); return the table.
 
         Raises

@@ -68,20 +68,20 @@ class Material:
 
     # ---- constructors -------------------------------------------------
     @classmethod
-    def elastic(cls, nu: float, G: float | None = None, E: float | None = None) -> "Material":
+    def elastic(cls, nu: float, G: float | None = None, E: float | None = None) -> Material:
         """Elastic half-space with shear modulus ``G`` or Young's modulus ``E`` (Pa)."""
         nu = poisson_ratio("nu", nu)
         return cls("elastic", nu, _modulus(G, E, nu))
 
     @classmethod
     def kelvin_voigt(cls, nu: float, eta: float, G: float | None = None,
-                     E: float | None = None) -> "Material":
+                     E: float | None = None) -> Material:
         """Kelvin-Voigt body: spring ``G`` (or ``E``, Pa) parallel to a dashpot ``eta`` (Pa s)."""
         nu = poisson_ratio("nu", nu)
         return cls("kelvin_voigt", nu, _modulus(G, E, nu), (), non_negative("eta", eta))
 
     @classmethod
-    def standard_solid(cls, nu: float, G1: float, G2: float, eta: float) -> "Material":
+    def standard_solid(cls, nu: float, G1: float, G2: float, eta: float) -> Material:
         """Standard linear solid: spring ``G1`` parallel to a Maxwell arm (spring ``G2``,
         dashpot ``eta``). Moduli in Pa, ``eta`` in Pa s; arm time ``tau = eta / G2``."""
         nu = poisson_ratio("nu", nu)
@@ -92,7 +92,7 @@ class Material:
         return cls("standard_solid", nu, G1, ((G2, eta / G2),))
 
     @classmethod
-    def prony(cls, nu: float, G_inf: float, arms, eta0: float = 0.0) -> "Material":
+    def prony(cls, nu: float, G_inf: float, arms, eta0: float = 0.0) -> Material:
         """Prony series: relaxed modulus ``G_inf`` (Pa), arms ``[(G_i [Pa], tau_i [s]), ...]``,
         optional parallel dashpot ``eta0`` (Pa s)."""
         nu = poisson_ratio("nu", nu)

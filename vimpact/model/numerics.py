@@ -72,7 +72,7 @@ class Numerics:
                     "between 1e-9 and 1e-2")
 
     @classmethod
-    def for_tolerance(cls, tolerance: float, integrator: str = "verlet") -> "Numerics":
+    def for_tolerance(cls, tolerance: float, integrator: str = "verlet") -> Numerics:
         """Numerics that reach ``tolerance`` on e_z and beta_x on the path that runs.
 
         The continuum paths (every full-stick scene with incremental memory;
@@ -136,7 +136,7 @@ class Numerics:
         return None
 
     @classmethod
-    def preset(cls, name: str) -> "Numerics":
+    def preset(cls, name: str) -> Numerics:
         """Named settings (:data:`PRESETS`): ``fast`` (2.3e-4 on e_z, e_x on the
         element path), ``default`` (3.1e-5 there), ``precise`` (1e-9 and better
         on the continuum paths; 4.9e-7 on the element path at its caps, the best
@@ -152,7 +152,7 @@ class Numerics:
         one_of("numerics preset", name, tuple(PRESETS))
         return PRESETS[name]
 
-    def with_(self, **changes) -> "Numerics":
+    def with_(self, **changes) -> Numerics:
         """A copy with some fields changed (validated)."""
         return replace(self, **changes)
 

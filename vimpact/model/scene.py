@@ -3,14 +3,22 @@
 from __future__ import annotations
 
 import math
-
-import numpy as np
 from dataclasses import dataclass, field
 
-from vimpact.model.hertz import HertzScales, Q1_PER_TAU, effective_modulus, hertz_scales
+import numpy as np
+
+from vimpact.model.hertz import Q1_PER_TAU, HertzScales, effective_modulus, hertz_scales
 from vimpact.model.material import Material
-from vimpact.model.validation import (InputError, finite, flag, friction_coefficient, one_of,
-                                     poisson_ratio, positive, require)
+from vimpact.model.validation import (
+    InputError,
+    finite,
+    flag,
+    friction_coefficient,
+    one_of,
+    poisson_ratio,
+    positive,
+    require,
+)
 
 TANGENTIAL_MEMORY = ("incremental", "seed")
 
@@ -145,7 +153,7 @@ class Scene:
     def from_dimensionless(cls, Q1: float, nu: float, Q2: float | None = None, *,
                            theta_ratio: float = DEFAULT_THETA_RATIO,
                            tangential_memory: str = "incremental", tangential: str = "auto",
-                           rotation: bool = True, mu: float = math.inf) -> "Scene":
+                           rotation: bool = True, mu: float = math.inf) -> Scene:
         """A physical scene with the given dimensionless parameters.
 
         Kelvin-Voigt for ``Q2 = None``, standard solid otherwise. Restitution

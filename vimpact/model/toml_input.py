@@ -98,7 +98,7 @@ def tangential_speed(v_z0, angle_deg):
     return float(out) if out.ndim == 0 else out
 
 
-def friction_coefficient(source: "TomlSource", key: str, value) -> float:
+def friction_coefficient(source: TomlSource, key: str, value) -> float:
     """A Coulomb friction coefficient: a number >= 0, or ``inf`` (TOML ``inf`` or the
     string ``"inf"``) for full stick."""
     if isinstance(value, str) and value.strip().lower() in ("inf", "+inf", "infinity"):
@@ -108,7 +108,7 @@ def friction_coefficient(source: "TomlSource", key: str, value) -> float:
     return float(value)
 
 
-def impact_angle(source: "TomlSource", key: str, value) -> float:
+def impact_angle(source: TomlSource, key: str, value) -> float:
     """An impact angle from the normal, degrees, in [0, 90)."""
     lo, hi = ANGLE_RANGE_DEG
     return source.number(key, value, lambda x: lo <= x < hi,

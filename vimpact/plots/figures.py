@@ -17,20 +17,23 @@ scipy are imported only when a figure is drawn.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from pathlib import Path
-from typing import Callable, NamedTuple
+from typing import NamedTuple
 
 import numpy as np
 import pandas as pd
 
-from vimpact.model.material import Material
-from vimpact.plots.catalogue import CATALOGUE, FIGURE_NAMES, figure_name  # noqa: F401 - re-exported
-from vimpact.model.numerics import Numerics
-from vimpact.model.scene import Scene
 from vimpact.engine.simulate import simulate, simulate_batch
 from vimpact.lookup.interpolate import cluster_nodes, same_node
 from vimpact.lookup.table import DATA_STATUSES, RestitutionTable
-from vimpact.plots.style import FORMATS, STYLE, check_out as _check_out, drawing as _drawing  # noqa: F401
+from vimpact.model.material import Material
+from vimpact.model.numerics import Numerics
+from vimpact.model.scene import Scene
+from vimpact.plots.catalogue import CATALOGUE, FIGURE_NAMES, figure_name  # noqa: F401 - re-exported
+from vimpact.plots.style import FORMATS, STYLE  # noqa: F401
+from vimpact.plots.style import check_out as _check_out
+from vimpact.plots.style import drawing as _drawing
 
 __all__ = ["FIGURES", "FIGURE_NAMES", "FORMATS", "plot_figure", "figure_name",
            "fig3_2", "fig4_2", "fig4_4", "fig5_1", "fig5_2", "fig5_3", "fig5_4", "fig5_5"]
@@ -104,7 +107,9 @@ def _default_nu(df: pd.DataFrame, nu) -> float:
 
 def _kv_curve(q1_min: float, q1_max: float, n: int = 48):
     """Kelvin-Voigt continuum ``e_z`` over ``[q1_min, q1_max]`` (log spaced)."""
-    from vimpact.reference.closed_forms import kelvin_voigt_continuum  # scipy: imported when drawing
+    from vimpact.reference.closed_forms import (
+        kelvin_voigt_continuum,  # scipy: imported when drawing
+    )
 
     q1 = np.geomspace(q1_min, q1_max, n)
     return q1, np.asarray(kelvin_voigt_continuum(q1, rtol=1e-10).e_z)

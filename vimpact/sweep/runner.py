@@ -57,8 +57,15 @@ from vimpact.model.scene import DEFAULT_THETA_RATIO
 from vimpact.model.validation import InputError
 from vimpact.sweep import store
 from vimpact.sweep.progress import Progress
-from vimpact.sweep.spec import (LABELS, OUTPUTS, RELATIVE, RESULTS, TANGENTIAL_OUTPUTS, SweepSpec,
-                                 load_spec)
+from vimpact.sweep.spec import (
+    LABELS,
+    OUTPUTS,
+    RELATIVE,
+    RESULTS,
+    TANGENTIAL_OUTPUTS,
+    SweepSpec,
+    load_spec,
+)
 
 
 class SweepInterrupted(KeyboardInterrupt):
@@ -348,7 +355,7 @@ def refined_spec(spec: SweepSpec, parts: Path, log: Callable[[str], None] | None
                                    "axes": {a: [float(x) for x in v] for a, v in axes.items()},
                                    "report": report})
         if log is not None:
-            log(f"refined grid: " + " x ".join(f"{a} {len(v)}" for a, v in axes.items())
+            log("refined grid: " + " x ".join(f"{a} {len(v)}" for a, v in axes.items())
                 + f" nodes, held-out error {_reached(report)}")
     new_axes = {k: (np.asarray(axes[k], dtype=float) if k in axes else v)
                 for k, v in spec.axes.items()}

@@ -128,11 +128,24 @@ from vimpact import __version__
 from vimpact.kernels.status import TABLE as STATUS_TABLE
 from vimpact.model.numerics import Numerics
 from vimpact.model.scene import DEFAULT_THETA_RATIO, Scene
-from vimpact.model.toml_input import (ANGLE_RANGE_DEG, ARM_KEYS, FRICTION_KEYS, MATERIAL_KEYS,
-                                      PHYSICAL_DEFAULTS, SPHERE_KEYS, SWEEP_TOP_KEYS, TomlSource,
-                                      friction_coefficient, input_keys, is_number, parse_header,
-                                      parse_numerics, read_toml, required_keys,
-                                      scene_from_values)
+from vimpact.model.toml_input import (
+    ANGLE_RANGE_DEG,
+    ARM_KEYS,
+    FRICTION_KEYS,
+    MATERIAL_KEYS,
+    PHYSICAL_DEFAULTS,
+    SPHERE_KEYS,
+    SWEEP_TOP_KEYS,
+    TomlSource,
+    friction_coefficient,
+    input_keys,
+    is_number,
+    parse_header,
+    parse_numerics,
+    read_toml,
+    required_keys,
+    scene_from_values,
+)
 
 #: Version of the table layout (columns, metadata keys and random draws): 3 since
 #: the draws are made per chunk from ``SeedSequence(seed, spawn_key=(chunk,))``; 4 since
