@@ -81,7 +81,8 @@ def test_elastic_is_hertz():
 
 
 def test_small_damping_slope():
-    """(1 - e_z) / tau0 -> 1.5 B(3/5, 3/2) = 1.8917 (docs/physics.md#kelvin-voigt-continuum), linearly in tau0."""
+    """(1 - e_z) / tau0 -> 1.5 B(3/5, 3/2) = 1.8917 (docs/physics.md#kelvin-voigt-continuum),
+    linearly in tau0."""
     slope = kelvin_voigt_small_damping_slope()
     assert abs(slope - 1.8917) < 1e-4
     s = {tau: (1.0 + run(tau, 1e-13)[OUT_VZ_END]) / tau for tau in (1e-4, 2e-4)}

@@ -164,7 +164,7 @@ def test_friction_converges_second_order_at_every_edge_position(rheology):
 
 @pytest.mark.slow
 def test_hypothesis_sweep_finite_and_passive():
-    hypothesis = pytest.importorskip("hypothesis")
+    pytest.importorskip("hypothesis")
     from hypothesis import given, settings
     from hypothesis import strategies as st
 

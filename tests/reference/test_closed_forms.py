@@ -172,7 +172,8 @@ def test_linear_tangential_frequency():
     m, R, k = 2.0, 0.1, 800.0
     Theta = 0.4 * m * R**2
     # solid sphere: effective mass 1/(1/m + R^2/Theta) = 2/7 m
-    assert linear_tangential_frequency(k, m, R, Theta) == pytest.approx(math.sqrt(k / (2.0 / 7.0 * m)), rel=1e-14)
+    assert linear_tangential_frequency(k, m, R, Theta) == pytest.approx(
+        math.sqrt(k / (2.0 / 7.0 * m)), rel=1e-14)
     assert linear_tangential_frequency(k, m, R, 1e30) == pytest.approx(math.sqrt(k / m), rel=1e-14)
 
 

@@ -742,7 +742,7 @@ def run(quick: bool = False) -> dict:
     out["table_4_1"] = table_4_1(cfg["table_steps"])
 
     timer.passes()
-    for name, g in out["integrators"].items():
+    for g in out["integrators"].values():
         rows = g["settings"]
         front = pareto([r["seconds_per_impact"] for r in rows], [_num(r["error"]) for r in rows])
         for i, r in enumerate(rows):

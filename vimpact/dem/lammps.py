@@ -14,7 +14,8 @@ LAMMPS 2025.7.22: the elastic contact time against a wall is the Hertz time of
 i.e. ``eta_n0 = 2 E* A / m_eff``: the dissipation time ``A`` is a material
 constant, but LAMMPS' coefficient carries the effective mass, so one
 ``eta_n0`` per type pair is exact only at one size (``A`` is fitted at the
-nominal one); the report shows the error at the ends of a size range. ``m_eff = m1 m2 / (m1 + m2)``, ``R_eff = R1 R2 / (R1 + R2)``; a wall
+nominal one); the report shows the error at the ends of a size range.
+``m_eff = m1 m2 / (m1 + m2)``, ``R_eff = R1 R2 / (R1 + R2)``; a wall
 (``fix wall/gran``) is a particle of infinite radius and mass, so there
 ``m_eff = m``, ``R_eff = R``, and the wall's parameters are the contact's own
 (one fix per particle type, since a fix has one parameter set).

@@ -321,7 +321,7 @@ def problem_from_toml(text: str, source: str = "<string>") -> DemProblem:
             contacts.append(Contact(a, w, mu_of(a.name, w.name)))
     for c in contacts:  # refuse unmappable material pairs now, naming the contact
         try:
-            c.material
+            _ = c.material  # the property maps the pair (or raises)
         except InputError as exc:
             raise InputError(f"{source}: contact {c.key}: {exc}") from None
     return DemProblem(tuple(types), tuple(walls), tuple(contacts), speeds,

@@ -126,9 +126,11 @@ class SceneColumns:
     def __len__(self) -> int:
         return self.nu.shape[0]
 
-    # ---- derived, vectorized (docs/physics.md#method-of-dimensionality-reduction, docs/physics.md#energy-and-passivity, docs/physics.md#dimensionless-parameters) ------------------
+    # ---- derived, vectorized (docs/physics.md#method-of-dimensionality-reduction,
+    # docs/physics.md#energy-and-passivity, docs/physics.md#dimensionless-parameters) ------
     @property
     def valid(self) -> np.ndarray:
+        """Rows without a reason to refuse them (valid scenes), bool."""
         return np.equal(self.reasons, None)
 
     @property
@@ -138,6 +140,7 @@ class SceneColumns:
 
     @property
     def theta_ratio(self) -> np.ndarray:
+        """``Theta / (m R^2)``, dimensionless."""
         return self.Theta / (self.m * self.R**2)
 
     @property
@@ -157,6 +160,7 @@ class SceneColumns:
 
     @property
     def has_arms(self) -> np.ndarray:
+        """Rows with at least one Maxwell arm, bool."""
         return (self.G_arm > 0.0).any(axis=1)
 
     @property

@@ -63,7 +63,8 @@ function of the edge state (``t_e(b)``), the error estimate of a long first
 step misses most of its error, and the small restart (3-4 extra steps) cut
 the ``beta_x``/``t_contact`` errors from 10-100 ``rtol`` to 1-3 ``rtol``.
 Measured against the scipy reference at ``rtol = 1e-12``: within 3e-11 on
-``e_z``, ``beta_x``, ``t_contact`` (3.4e-10 with a dashpot *and* arms). Events (``v = 0`` turning point, ``s = 0`` end of contact)
+``e_z``, ``beta_x``, ``t_contact`` (3.4e-10 with a dashpot *and* arms). Events
+(``v = 0`` turning point, ``s = 0`` end of contact)
 are located by re-taking the step with Newton on its length (derivative
 from the FSAL stage), safeguarded by bisection, so the event state is an
 ordinary Runge-Kutta step. Arms with ``tau_i = 0`` follow ``u`` at once and

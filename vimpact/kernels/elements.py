@@ -2,7 +2,8 @@
 
 Unit-free numba kernels; nothing here imports the user-facing layer.
 
-Kernel units (docs/physics.md#hertz-scales, docs/physics.md#method-of-dimensionality-reduction, docs/physics.md#energy-and-passivity): indentation ``u`` and normal
+Kernel units (docs/physics.md#hertz-scales, docs/physics.md#method-of-dimensionality-reduction,
+docs/physics.md#energy-and-passivity): indentation ``u`` and normal
 surface displacements ``w`` in units of the Hertz indentation ``d``; element
 positions ``xi`` in units of the Hertz radius ``a_H`` (so the MDR profile is
 ``g = xi^2``); time in units of ``T = d / v_z0``; normal velocity in units of
@@ -654,7 +655,8 @@ def element_kernel(spec: KernelSpec):
     max_steps, rec, rec_every, out)`` with per-set arrays of length ``n``
     (``g``, ``tau`` padded to ``(n, max_arms)``; ``h``, ``n_elem``, ``dxi``
     per set; ``mu`` the friction coefficient in tangential kernel units,
-    ``mu v_z0 / |v_c0|``, read only by kernels with ``spec.friction``), shared ``rec_every``, a trajectory buffer ``rec`` of shape
+    ``mu v_z0 / |v_c0|``, read only by kernels with ``spec.friction``), shared ``rec_every``,
+    a trajectory buffer ``rec`` of shape
     ``(n, n_rec, N_REC)`` (``n_rec`` may be 0) and ``out`` of shape
     ``(n, N_OUT)``. ``prange`` runs over the parameter sets; each writes its
     own row.

@@ -286,7 +286,8 @@ def interpolation_error(table, numerics=None, n: int = 200, seed: int = 0, theta
     dict (JSON-serializable): ``method``, ``points`` (held-out points simulated),
     ``failed`` (points whose simulation or lookup failed, left out), ``kinds``,
     ``seed``, ``numerics``, ``outputs`` (name -> ``max``, ``rms``, ``bound`` =
-    :data:`BOUND_FACTOR` x ``max``, dimensionless, and ``at``: the point of the max), ``per_axis`` (axis -> name -> max over
+    :data:`BOUND_FACTOR` x ``max``, dimensionless, and ``at``: the point of the max),
+    ``per_axis`` (axis -> name -> max over
     that axis's mid-points), ``node_error`` (name -> max over the node sample),
     ``vimpact_version``.
     """

@@ -158,6 +158,7 @@ class Numerics:
 
     @property
     def integrator_code(self) -> int:
+        """The kernels' code of :attr:`integrator` (:data:`INTEGRATORS`)."""
         return INTEGRATORS[self.integrator]
 
 

@@ -109,7 +109,8 @@ class Scene:
         if self.Theta is None:
             theta = DEFAULT_THETA_RATIO * self.m * self.R**2 if self.R < 1e150 else math.inf
             require("R", self.R, 0.0 < theta < math.inf,
-                    f"large enough for the default Theta = {DEFAULT_THETA_RATIO} m R^2 to be a finite number > 0 "
+                    f"large enough for the default Theta = {DEFAULT_THETA_RATIO} m R^2 to be a "
+                    "finite number > 0 "
                     f"(with m = {self.m:g} kg; give Theta)")
             object.__setattr__(self, "Theta", theta)
         object.__setattr__(self, "Theta", positive("Theta", self.Theta))

@@ -127,12 +127,15 @@ class TomlSource:
         self.path = path
 
     def error(self, key: str, message: str) -> ValueError:
+        """The error for ``key`` of this file, with ``message``."""
         return ValueError(f"{self.path}: {key}: {message}")
 
     def bad(self, key: str, value, allowed: str) -> ValueError:
+        """The error for ``key = value``: not allowed, must be ``allowed``."""
         return ValueError(f"{self.path}: {key} = {value!r} is not allowed: must be {allowed}")
 
     def unknown(self, table: dict, allowed, where: str = "") -> None:
+        """Raise for the first key of ``table`` (under ``where``) not in ``allowed``."""
         for key in table:
             if key not in allowed:
                 name = f"{where}.{key}" if where else key
@@ -140,22 +143,26 @@ class TomlSource:
                                  f"{', '.join(allowed)})")
 
     def number(self, key: str, value, check=None, allowed="a finite number") -> float:
+        """``value`` as a finite float that passes ``check``, else the error naming ``key``."""
         if not is_number(value) or not math.isfinite(value) or (check and not check(value)):
             raise self.bad(key, value, allowed)
         return float(value)
 
     def integer(self, key: str, value, minimum: int) -> int:
+        """``value`` as an integer >= ``minimum`` (not a bool), else the error naming ``key``."""
         if not isinstance(value, int) or isinstance(value, bool) or value < minimum:
             raise self.bad(key, value, f"an integer >= {minimum}")
         return value
 
     def choice(self, data: dict, key: str, choices, default: str) -> str:
+        """``data[key]`` (``default`` if absent), one of ``choices``."""
         value = data.get(key, default)
         if value not in choices:
             raise self.bad(key, value, "one of " + ", ".join(map(repr, choices)))
         return value
 
     def flag(self, data: dict, key: str, default: bool) -> bool:
+        """``data[key]`` (``default`` if absent), a bool."""
         value = data.get(key, default)
         if not isinstance(value, bool):
             raise self.bad(key, value, "true or false")

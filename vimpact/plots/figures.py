@@ -398,7 +398,8 @@ def _family_plot(table, out, name: str, column: str, nu, kv_table=None) -> Path:
 def fig5_4(table, out, nu=None, kv_table=None) -> Path:
     """Thesis fig. 5.4: ``e_z`` over ``Q1`` for a family of ``Q2`` (standard
     solid) with the Kelvin-Voigt curve (``Q2 -> 0``, continuum limit) in black.
-    Table: ``sweeps/fig5_4_5_standard_solid_q2.toml (+ sweeps/fig5_4_5_kelvin_voigt.toml)``; ``nu`` default 0.5 if present
+    Table: ``sweeps/fig5_4_5_standard_solid_q2.toml (+ sweeps/fig5_4_5_kelvin_voigt.toml)``;
+    ``nu`` default 0.5 if present
     (``kv_table`` is accepted for symmetry with :func:`fig5_5`)."""
     return _family_plot(table, out, "fig5_4", "e_z", nu, kv_table)
 
@@ -408,7 +409,8 @@ def fig5_5(table, out, nu=None, kv_table=None) -> Path:
     solid) with the Kelvin-Voigt curve in black: from ``kv_table`` (a
     Kelvin-Voigt table) if given, else from the table's own Kelvin-Voigt rows
     (``Q2`` 0 or NaN), else computed at the table's ``Q1`` values with its
-    numerics. Table: ``sweeps/fig5_4_5_standard_solid_q2.toml (+ sweeps/fig5_4_5_kelvin_voigt.toml)``; ``nu`` default 0.5 if present."""
+    numerics. Table: ``sweeps/fig5_4_5_standard_solid_q2.toml
+    (+ sweeps/fig5_4_5_kelvin_voigt.toml)``; ``nu`` default 0.5 if present."""
     return _family_plot(table, out, "fig5_5", "e_x", nu, kv_table)
 
 

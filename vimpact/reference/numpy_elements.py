@@ -1,7 +1,8 @@
 """Slow, independent reference of the MDR impact in physical (SI) units.
 
 This is the documentation-grade restatement of the element model of
-docs/physics.md (method of dimensionality reduction to energy and passivity), written directly in metres, seconds, kilograms and
+docs/physics.md (method of dimensionality reduction to energy and passivity), written
+directly in metres, seconds, kilograms and
 pascals. It shares no code with :mod:`vimpact.kernels.elements` and does not
 nondimensionalize anything: it only takes the discretization (``t_H`` and
 ``a_H`` for the step and the element spacing) from
@@ -39,7 +40,8 @@ displacement (and arms) solved so that the force sits on the cone (the
 force is affine in the end displacement: two evaluations give the line).
 A slipping element pushes with ``mu`` times its normal force, whose dashpot
 part moves with the normal velocity of each half-kick. ``check_cone``
-asserts ``|f_t| <= mu f_n (1 + 1e-12)`` for every element at every step. It is vectorized over elements with NumPy and loops
+asserts ``|f_t| <= mu f_n (1 + 1e-12)`` for every element at every step. It is vectorized
+over elements with NumPy and loops
 over time steps in Python: slow on purpose, keep the sizes small.
 
 Sign convention: ``v_z > 0`` into the half-space, indentation ``u > 0``
