@@ -49,6 +49,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import cast
 
 from vimpact.model.material import Material
 from vimpact.model.scene import DEFAULT_THETA_RATIO, Scene
@@ -98,7 +99,7 @@ class Body:
     @property
     def spin_compliance(self) -> float:
         """``R^2 / Theta`` (0 without rotation), 1/kg."""
-        return self.R**2 / self.Theta if self.rotation else 0.0
+        return self.R**2 / cast(float, self.Theta) if self.rotation else 0.0
 
 
 @dataclass(frozen=True)
@@ -187,7 +188,7 @@ def pair_material(mat1: Material | None, mat2: Material | None) -> Material:
         raise InputError("materials = (rigid, rigid) is not allowed: must be at least one "
                          "deformable body (two rigid bodies have no contact law)")
     if mat1 is None or mat2 is None:
-        return mat2 if mat1 is None else mat1
+        return cast(Material, mat2 if mat1 is None else mat1)  # not both: refused above
     lam = _proportion(mat1, mat2)
     if lam is not None:
         return _scaled(mat1, lam / (1.0 + lam))
@@ -306,16 +307,16 @@ def end_states(body1: Body, other: Body | Wall, scene: Scene, e_z: float, beta_x
     J_z = scene.m * (v_z_end - scene.v_z0)  # on body 1, along z
     if scene.computes_tangential and math.isfinite(beta_x):
         v_c_end = -beta_x * scene.v_c0
-        spin_total = scene.R**2 / scene.Theta if scene.rotation else 0.0
+        spin_total = scene.R**2 / cast(float, scene.Theta) if scene.rotation else 0.0
         P = (scene.v_c0 - v_c_end) / (1.0 / scene.m + spin_total)  # tangential impulse magnitude
     else:
         P = 0.0
     J_x = -P  # on body 1
     b1 = (body1.v_z + J_z / body1.m, body1.v_x + J_x / body1.m,
-          body1.omega + (body1.R * J_x / body1.Theta if body1.rotation else 0.0))
+          body1.omega + (body1.R * J_x / cast(float, body1.Theta) if body1.rotation else 0.0))
     if isinstance(other, Wall):
         return b1, None, J_z, J_x
     # body 2 gets -J at its contact point (-R2 along z): torque_y = -R2 * (-J_x)
     b2 = (other.v_z - J_z / other.m, other.v_x - J_x / other.m,
-          other.omega + (other.R * J_x / other.Theta if other.rotation else 0.0))
+          other.omega + (other.R * J_x / cast(float, other.Theta) if other.rotation else 0.0))
     return b1, b2, J_z, J_x

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import cast
 
 import numpy as np
 
@@ -199,7 +200,7 @@ class Scene:
     @property
     def theta_ratio(self) -> float:
         """``Theta / (m R^2)``, dimensionless."""
-        return self.Theta / (self.m * self.R**2)
+        return cast(float, self.Theta) / (self.m * self.R**2)
 
     @property
     def computes_tangential(self) -> bool:
@@ -229,7 +230,7 @@ class Scene:
     @property
     def Q1(self) -> float:
         """``Q1 = sqrt(15/32) (eta / G_inf) / T``, dimensionless (NaN for a general Prony series)."""
-        return Q1_PER_TAU * self.material.viscous_time() / self.hertz.T
+        return float(Q1_PER_TAU * self.material.viscous_time() / self.hertz.T)
 
     @property
     def Q2(self) -> float:
@@ -239,4 +240,5 @@ class Scene:
     @property
     def kinetic_energy(self) -> float:
         """Kinetic energy before the impact, J."""
-        return 0.5 * (self.m * (self.v_z0**2 + self.v_x0**2) + self.Theta * self.omega0**2)
+        return 0.5 * (self.m * (self.v_z0**2 + self.v_x0**2)
+                      + cast(float, self.Theta) * self.omega0**2)
