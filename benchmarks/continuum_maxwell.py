@@ -39,8 +39,16 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from benchmarks.machine import (bench_main, figure, load_average, module_at_commit,  # noqa: E402
-                                machine_info, repository_main, save_figure, use_agg)
+from benchmarks.machine import (  # noqa: E402
+    bench_main,
+    figure,
+    load_average,
+    machine_info,
+    module_at_commit,
+    repository_main,
+    save_figure,
+    use_agg,
+)
 
 TITLE = "Continuum full-stick kernel: time per impact to 1e-6/1e-8/1e-10, before vs after"
 
@@ -91,8 +99,14 @@ def run(quick: bool) -> dict:
 
     from tests.oracles.maxwell_continuum_scipy import maxwell_continuum_reference
     from vimpact.kernels.continuum_maxwell import maxwell_stick_batch
-    from vimpact.kernels.layout import (N_OUT, OUT_STATUS, OUT_STEPS, OUT_T_CONTACT,
-                                        OUT_VC_END, OUT_VZ_END)
+    from vimpact.kernels.layout import (
+        N_OUT,
+        OUT_STATUS,
+        OUT_STEPS,
+        OUT_T_CONTACT,
+        OUT_VC_END,
+        OUT_VZ_END,
+    )
 
     threads = numba.get_num_threads()
     numba.set_num_threads(1)

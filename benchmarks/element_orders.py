@@ -40,8 +40,17 @@ import time
 import numpy as np
 
 from benchmarks.machine import bench_main, machine_info, module_at_commit, save_figure
-from vimpact.kernels.elements import (N_OUT, N_REC, OUT_STATUS, OUT_VC_END, OUT_VZ_END,
-                                      STATUS_OK, VERLET, KernelSpec, element_kernel)
+from vimpact.kernels.elements import (
+    N_OUT,
+    N_REC,
+    OUT_STATUS,
+    OUT_VC_END,
+    OUT_VZ_END,
+    STATUS_OK,
+    VERLET,
+    KernelSpec,
+    element_kernel,
+)
 
 TITLE = "element kernel: observed orders in steps and elements against the continuum kernel"
 
@@ -211,7 +220,8 @@ def run(quick: bool) -> dict:
             "steps": steps.tolist(), "fine_steps": fine_steps, "elements": elems.tolist(),
             "fine_elements": fine_elems, "joint_steps": joint.tolist(),
             "joint_elements": (joint / 6.0).tolist(), "sweep_elements": sweep.tolist(),
-            "sweep_steps": sweep_steps, "envelope_shifts": ENVELOPE_SHIFTS, "cases": {}, "element_path_cases": {}}
+            "sweep_steps": sweep_steps, "envelope_shifts": ENVELOPE_SHIFTS, "cases": {},
+            "element_path_cases": {}}
     for name, (tau0, g, tau) in CASES.items():
         spec = KernelSpec(VERLET, True, 0, len(g) > 0, tau0 > 0.0)
         ez_ref, ex_ref = continuum(tau0, g, tau)

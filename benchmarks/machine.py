@@ -20,8 +20,16 @@ from pathlib import Path
 from types import ModuleType
 
 from vimpact.bench.machine import (  # noqa: F401  (re-exported for the scripts)
-    figure, load_average, machine_info, machine_line, median_time, progress, save_figure,
-    time_samples, use_agg)
+    figure,
+    load_average,
+    machine_info,
+    machine_line,
+    median_time,
+    progress,
+    save_figure,
+    time_samples,
+    use_agg,
+)
 
 RESULTS = Path(__file__).parent / "results"
 
@@ -86,5 +94,28 @@ def module_at_commit(commit: str, path: str) -> ModuleType | None:
     spec = importlib.util.spec_from_file_location(name, file)
     module = importlib.util.module_from_spec(spec)
     sys.modules[name] = module  # numba's cache finds the module again by name
-    spec.loader.exec_module(module)
+    lent = _lend_moved_names()
+    try:
+        spec.loader.exec_module(module)
+    finally:
+        for home, attr in lent:
+            delattr(home, attr)
     return module
+
+
+#: Names an earlier commit's kernel imports from a module they have since left:
+#: ``{old module: {name: module that defines it now}}``.
+MOVED_NAMES = {"vimpact.kernels.layout": {"_record": "vimpact.kernels.record"}}
+
+
+def _lend_moved_names() -> list[tuple[ModuleType, str]]:
+    """Put each moved name back on its old module while an old kernel is imported
+    (the modules themselves keep no alias); return what was lent."""
+    lent = []
+    for old, names in MOVED_NAMES.items():
+        home = importlib.import_module(old)
+        for attr, new in names.items():
+            if not hasattr(home, attr):
+                setattr(home, attr, getattr(importlib.import_module(new), attr))
+                lent.append((home, attr))
+    return lent

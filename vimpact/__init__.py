@@ -40,7 +40,7 @@ _EXPORTS = {
     "STATUSES": "vimpact.engine.result",
     "UNITS": "vimpact.engine.result",
     "ImpactResult": "vimpact.engine.result",
-    "Path": "vimpact.engine.routing",
+    "KernelPath": "vimpact.engine.routing",
     "choose_path": "vimpact.engine.routing",
     "HalfSpaceError": "vimpact.engine.simulate",
     "explain": "vimpact.engine.simulate",
@@ -50,8 +50,8 @@ _EXPORTS = {
     "Body": "vimpact.model.pair",
     "Wall": "vimpact.model.pair",
     "pair_material": "vimpact.model.pair",
-    "simulate_pair": "vimpact.model.pair",
-    "simulate_pair_batch": "vimpact.model.pair",
+    "simulate_pair": "vimpact.engine.pairs",
+    "simulate_pair_batch": "vimpact.engine.pairs",
 }
 
 __all__ = sorted(_EXPORTS) + ["__version__"]

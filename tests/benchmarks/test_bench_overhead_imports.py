@@ -3,8 +3,8 @@ command run end to end on a small configuration: files written, JSON keys
 (no time is asserted)."""
 
 import json
-import re
 import math
+import re
 
 import pytest
 

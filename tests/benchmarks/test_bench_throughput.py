@@ -8,9 +8,9 @@ import math
 import pytest
 
 import vimpact as v
-from vimpact.bench import scaling, throughput
+from tests.oracles.naive import naive_impact
+from vimpact.bench import scaling
 from vimpact.bench.pure_python import pure_python_impact
-from vimpact.reference.numpy_elements import naive_impact
 
 SCENES = {
     "kelvin_voigt": v.Scene.from_dimensionless(0.1, 0.5),

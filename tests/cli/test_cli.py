@@ -7,8 +7,8 @@ import sys
 import pandas as pd
 import pytest
 
-from vimpact.reference.closed_forms import kelvin_voigt_continuum
 from vimpact.cli.main import main
+from vimpact.reference.closed_forms import kelvin_voigt_continuum
 
 KEYS = {"e_z", "e_x", "beta_x", "t_contact", "u_max", "a_max", "t_hertz", "d_hertz", "a_hertz",
         "energy_ratio", "Q1", "Q2", "nu", "status"}

@@ -1,4 +1,5 @@
-"""Pairs and walls mapped onto the rigid-sphere problem (vimpact.model.pair)."""
+"""Pairs and walls mapped onto the rigid-sphere problem (vimpact.model.pair, run by
+vimpact.engine.pairs)."""
 
 import math
 
@@ -6,8 +7,8 @@ import numpy as np
 import pytest
 
 import vimpact as v
-from vimpact.model.pair import Body, Wall, pair_material, pair_scene, simulate_pair, \
-    simulate_pair_batch
+from vimpact.engine.pairs import simulate_pair, simulate_pair_batch
+from vimpact.model.pair import Body, Wall, pair_material, pair_scene
 
 FAST = v.Numerics.preset("fast")
 KV = v.Material.kelvin_voigt(nu=0.4, E=1e9, eta=2000.0)

@@ -73,7 +73,7 @@ def _creep_of_prony(mat, t_end, n=400):
     else:
         # instantaneous response e(0+) = 1/glassy; then e' from the constraint
         def rhs(_, y):
-            e, s = y[0], y[1:]
+            s = y[1:]
             # sigma = G_inf e + sum s_i = 1 with s_i' = G_i e' - s_i/tau_i
             de = np.sum(s / tau) / glassy
             return np.concatenate(([de], G * de - s / tau))

@@ -1,4 +1,4 @@
-"""Issue 5, part 1: the cases that break naive solvers give a finite, converged,
+"""The cases that break naive solvers give a finite, converged,
 physically admissible answer with the default numerics.
 
 A matrix of impacts, one batch per axis (each axis swept with the others at
@@ -35,7 +35,7 @@ the dashpot at a fraction of ``d`` (``a_max`` about 0.18 ``a_H``), it does not
 sink in. So the allowed statuses are ``ok`` and, for ``v_c0 = 0`` only,
 ``vc0_zero``.
 
-``e_z <= 1`` is checked with the tolerance 1e-6 that the issue gives for the
+``e_z <= 1`` is checked with the tolerance 1e-6 required of the
 elastic limit (``e_z = 1`` within 1e-6): the time discretization of an
 (almost) elastic impact may return the normal speed to about 1e-10 above 1,
 which is neither a failure nor avoidable by a second-order integrator; a
@@ -51,8 +51,16 @@ from typing import NamedTuple
 import pytest
 
 import vimpact as v
-from tests.oracles.hard_cases import (ELASTIC_EZ_TOL, EZ_MAX, fmt, hertz_unit, invariant_violations, material,
-                        scene, tighter)
+from tests.oracles.hard_cases import (
+    ELASTIC_EZ_TOL,
+    EZ_MAX,
+    fmt,
+    hertz_unit,
+    invariant_violations,
+    material,
+    scene,
+    tighter,
+)
 
 #: ``|e_z(default) - e_z(tighter)|`` and the same for ``beta_x`` (hence ``e_x``).
 #: The default numerics aim at about 1e-4 (README, Numerics); for a second-order
@@ -313,9 +321,9 @@ def test_elastic_limit_of_every_rheology_is_the_elastic_material():
 
 
 def test_normal_problem_ignores_tangential_state_and_nu():
-    """docs/physics.md#energy-and-passivity, docs/physics.md#dimensionless-parameters: the normal problem does not depend on the
-    tangential one, and in Hertz units not on nu. Across grazing, spin, spin
-    against sliding and v_c0 = 0, and across nu and theta, e_z is one number
+    """docs/physics.md#energy-and-passivity, docs/physics.md#dimensionless-parameters: the
+    normal problem does not depend on the tangential one, and in Hertz units not on nu.
+    Across grazing, spin, spin against sliding and v_c0 = 0, and across nu and theta, e_z is one number
     (up to the accuracy aim of the numerics, should they refine differently)."""
     tangential = _by_id("tangential")
     for mname in TANGENTIAL_MATERIALS:
@@ -364,7 +372,8 @@ def _theta_for_same_tangential_stiffness(nu_a, theta_a, nu_b):
                                   lambda nu: material("standard_solid", nu, q1=1.0, q2=0.3)],
                          ids=["kv-Q1=1e-3", "sls-Q1=1-Q2=0.3"])
 def test_tangential_depends_on_nu_and_theta_only_through_one_stiffness(nu_a, theta_a, nu_b, make):
-    """docs/physics.md#method-of-dimensionality-reduction, docs/physics.md#full-stick, docs/physics.md#energy-and-passivity: the tangential elements have stiffness c_t G,
+    """docs/physics.md#method-of-dimensionality-reduction, docs/physics.md#full-stick,
+    docs/physics.md#energy-and-passivity: the tangential elements have stiffness c_t G,
     the normal ones c_n G, and the contact point has the mass 1 / (1/m + R^2/Theta);
     in Hertz units the normal contact does not depend on nu. So beta_x depends on
     nu and Theta / (m R^2) only through (c_t / c_n)(1 + m R^2 / Theta): two scenes

@@ -6,9 +6,12 @@ import numpy as np
 import pytest
 
 import vimpact as v
-from vimpact.reference.closed_forms import (hertz_time_factor_quadrature, kelvin_voigt_continuum,
-                              kelvin_voigt_small_damping_slope)
 from vimpact.model.hertz import Q1_PER_TAU
+from vimpact.reference.closed_forms import (
+    hertz_time_factor_quadrature,
+    kelvin_voigt_continuum,
+    kelvin_voigt_small_damping_slope,
+)
 
 RNG_SEED = 20261121
 

@@ -1,4 +1,4 @@
-"""Issue 5, part 1: property-based tests over the whole admissible space.
+"""Property-based tests over the whole admissible space.
 
 Hypothesis draws random scenes (rheology, log-uniform ``Q1`` in [1e-5, 1e2],
 ``Q2`` in [1e-4, 1e4], ``nu`` in [0, 0.5] with both ends, ``Theta / (m R^2)``

@@ -21,7 +21,7 @@ import math
 import numpy as np
 import pytest
 
-from vimpact.reference.numpy_elements import naive_impact
+from tests.oracles.naive import naive_impact
 from vimpact import Material, Numerics, Scene, hertz_scales, simulate, simulate_batch
 
 STEPS, ELEMENTS = 150, 30

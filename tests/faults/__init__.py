@@ -1,1 +1,1 @@
-"""Issue 15: a catalogue of bad inputs and extreme admissible inputs."""
+"""A catalogue of bad inputs and extreme admissible inputs."""

@@ -1,4 +1,4 @@
-"""Issue 15: the Python API's catalogue of bad inputs, one case per id.
+"""The Python API's catalogue of bad inputs, one case per id.
 
 - Constructors and ``simulate``: a bad input raises :class:`vimpact.InputError`
   (a ``ValueError``) whose message names the parameter; nothing else escapes.

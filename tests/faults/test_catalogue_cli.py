@@ -1,4 +1,4 @@
-"""Issue 15: the command line's catalogue of bad inputs, one case per id.
+"""The command line's catalogue of bad inputs, one case per id.
 
 Every bad input ends with exit code 2 and exactly one line on stderr that
 names the option as the user typed it and the value (no traceback, nothing on

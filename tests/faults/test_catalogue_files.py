@@ -1,4 +1,4 @@
-"""Issue 15: the catalogue of bad scene files and sweep specifications, one case per id.
+"""The catalogue of bad scene files and sweep specifications, one case per id.
 
 A bad file is a ``ValueError`` on one line that names the file and the key (as
 written in the file) and shows the value; through the command line it is exit

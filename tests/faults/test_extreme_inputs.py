@@ -1,9 +1,10 @@
-"""Issue 15, part 2: extreme but admissible inputs end in a converged answer or a status.
+"""Extreme but admissible inputs end in a converged answer or a status.
 
 Hypothesis draws batches of scenes whose physical inputs span about 30 decades
 (``G_inf``, ``R``, ``v_z0`` each log-uniform over [1e-15, 1e15] in its SI
 unit; ``m`` mostly the mass whose Hertz indentation is 1e-24 ... 0.03 times ``R``, so
-that most rows stay inside the half-space model, else also over 30 decades; ``v_x0`` and ``R omega0`` up to 1e15 ``v_z0`` of either sign, ``nu``
+that most rows stay inside the half-space model, else also over 30 decades; ``v_x0`` and
+``R omega0`` up to 1e15 ``v_z0`` of either sign, ``nu``
 anywhere in [0, 0.5] with both ends) for every model, and runs each batch with
 one :func:`vimpact.simulate_batch` call. The viscous inputs are drawn as raw
 SI numbers too (``eta`` over 30 decades around the scene's own ``G_inf T``), so

@@ -13,15 +13,36 @@ import math
 import numpy as np
 import pytest
 
-from vimpact.reference.closed_forms import (hertz_time_factor_quadrature, kelvin_voigt_continuum,
-                              kelvin_voigt_small_damping_slope)
 from vimpact.kernels import continuum_kv as C
 from vimpact.kernels.continuum_kv import kv_normal_batch, kv_normal_impact
-from vimpact.kernels.elements import (N_OUT, N_REC, OUT_B_MAX, OUT_N_REC, OUT_STATUS, OUT_STEPS,
-                                 OUT_T_CONTACT, OUT_U_MAX, OUT_VC_END, OUT_VZ_END,
-                                 REC_B, REC_FX, REC_FZ, REC_T, REC_U, REC_V, REC_VC,
-                                 STATUS_NON_FINITE, STATUS_OK, STATUS_TIME_LIMIT)
+from vimpact.kernels.elements import (
+    N_OUT,
+    N_REC,
+    OUT_B_MAX,
+    OUT_N_REC,
+    OUT_STATUS,
+    OUT_STEPS,
+    OUT_T_CONTACT,
+    OUT_U_MAX,
+    OUT_VC_END,
+    OUT_VZ_END,
+    REC_B,
+    REC_FX,
+    REC_FZ,
+    REC_T,
+    REC_U,
+    REC_V,
+    REC_VC,
+    STATUS_NON_FINITE,
+    STATUS_OK,
+    STATUS_TIME_LIMIT,
+)
 from vimpact.model.hertz import HERTZ_TIME_FACTOR, Q1_PER_TAU
+from vimpact.reference.closed_forms import (
+    hertz_time_factor_quadrature,
+    kelvin_voigt_continuum,
+    kelvin_voigt_small_damping_slope,
+)
 
 MAX_STEPS = 100_000
 NO_REC = np.zeros((0, N_REC))
@@ -60,7 +81,8 @@ def test_elastic_is_hertz():
 
 
 def test_small_damping_slope():
-    """(1 - e_z) / tau0 -> 1.5 B(3/5, 3/2) = 1.8917 (docs/physics.md#kelvin-voigt-continuum), linearly in tau0."""
+    """(1 - e_z) / tau0 -> 1.5 B(3/5, 3/2) = 1.8917 (docs/physics.md#kelvin-voigt-continuum),
+    linearly in tau0."""
     slope = kelvin_voigt_small_damping_slope()
     assert abs(slope - 1.8917) < 1e-4
     s = {tau: (1.0 + run(tau, 1e-13)[OUT_VZ_END]) / tau for tau in (1e-4, 2e-4)}

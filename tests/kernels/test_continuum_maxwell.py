@@ -17,10 +17,25 @@ import pytest
 
 from tests.oracles.maxwell_continuum_scipy import maxwell_continuum_reference
 from vimpact.kernels.continuum_maxwell import maxwell_stick_batch, maxwell_stick_impact
-from vimpact.kernels.layout import (N_OUT, N_REC, OUT_B_MAX, OUT_N_REC, OUT_STATUS, OUT_STEPS,
-                                    OUT_T_CONTACT, OUT_U_MAX, OUT_VC_END, OUT_VZ_END, REC_B,
-                                    REC_FX, REC_FZ, REC_T, STATUS_NON_FINITE, STATUS_OK,
-                                    STATUS_TIME_LIMIT)
+from vimpact.kernels.layout import (
+    N_OUT,
+    N_REC,
+    OUT_B_MAX,
+    OUT_N_REC,
+    OUT_STATUS,
+    OUT_STEPS,
+    OUT_T_CONTACT,
+    OUT_U_MAX,
+    OUT_VC_END,
+    OUT_VZ_END,
+    REC_B,
+    REC_FX,
+    REC_FZ,
+    REC_T,
+    STATUS_NON_FINITE,
+    STATUS_OK,
+    STATUS_TIME_LIMIT,
+)
 from vimpact.model.hertz import HERTZ_TIME_FACTOR, Q1_PER_TAU
 from vimpact.reference.closed_forms import kelvin_voigt_continuum
 

@@ -16,8 +16,17 @@ import math
 import numpy as np
 import pytest
 
-from vimpact.kernels.elements import (N_OUT, N_REC, OUT_STATUS, OUT_VC_END, OUT_VZ_END,
-                                      STATUS_OK, VERLET, KernelSpec, element_kernel)
+from vimpact.kernels.elements import (
+    N_OUT,
+    N_REC,
+    OUT_STATUS,
+    OUT_VC_END,
+    OUT_VZ_END,
+    STATUS_OK,
+    VERLET,
+    KernelSpec,
+    element_kernel,
+)
 
 HERTZ_TIME = 2.9432751843  # t_H / T, docs/physics.md#hertz-scales
 Q1_PER_TAU = math.sqrt(15.0 / 32.0)  # docs/physics.md#dimensionless-parameters

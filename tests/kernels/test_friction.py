@@ -21,9 +21,17 @@ import numpy as np
 import pytest
 
 from tests.kernels.test_elements_accuracy import HERTZ_TIME, run_rows
-from vimpact.kernels.elements import (N_OUT, OUT_T_CONTACT, OUT_T_GROSS_SLIP, OUT_VC_END,
-                                      OUT_VZ_END, OUT_W_FRICTION, REC_SLIP, VERLET, KernelSpec,
-                                      element_kernel)
+from vimpact.kernels.elements import (
+    OUT_T_CONTACT,
+    OUT_T_GROSS_SLIP,
+    OUT_VC_END,
+    OUT_VZ_END,
+    OUT_W_FRICTION,
+    REC_SLIP,
+    VERLET,
+    KernelSpec,
+    element_kernel,
+)
 
 # kernel-unit rheologies: (tau0, g, tau); the default run compiles two friction
 # kernels (elastic; arms and dashpot), the others are slow
@@ -156,8 +164,9 @@ def test_friction_converges_second_order_at_every_edge_position(rheology):
 
 @pytest.mark.slow
 def test_hypothesis_sweep_finite_and_passive():
-    hypothesis = pytest.importorskip("hypothesis")
-    from hypothesis import given, settings, strategies as st
+    pytest.importorskip("hypothesis")
+    from hypothesis import given, settings
+    from hypothesis import strategies as st
 
     @settings(derandomize=True, max_examples=20, deadline=None)
     @given(psi=st.floats(0.1, 20.0), chi_ratio=st.floats(0.1, 2.0),
@@ -193,8 +202,8 @@ def _scene(mu, material=None, v_x0=1.5):
 def test_reference_with_friction_agrees_with_kernel(mu):
     """The engine (element kernel with friction) against the SI reference,
     which also checks |f_t| <= mu f_n per element at every step."""
+    from tests.oracles.naive import naive_impact
     from vimpact import Numerics, simulate
-    from vimpact.reference.numpy_elements import naive_impact
 
     scene = _scene(mu)
     num = Numerics(steps=150, elements=30, continuum=False)
@@ -206,7 +215,7 @@ def test_reference_with_friction_agrees_with_kernel(mu):
 
 def test_reference_gross_slip_and_cone():
     """The SI reference alone: gross slip closed form and the cone check."""
-    from vimpact.reference.numpy_elements import naive_impact
+    from tests.oracles.naive import naive_impact
 
     scene = _scene(0.02, v_x0=2.0)
     ref = naive_impact(scene, 120, 20)
@@ -278,8 +287,8 @@ def test_flat_punch_is_a_stick_slip_oscillator(mu):
     """docs/physics.md#linear-model, docs/physics.md#coulomb-friction in the SI reference: a flat punch (every
     element enters at once and leaves together) with friction against the
     independent 1-DOF stick-slip oscillator."""
+    from tests.oracles.naive import naive_impact
     from vimpact import Material, Scene
-    from vimpact.reference.numpy_elements import naive_impact
 
     G, nu, R, m = 1e9, 0.3, 0.01, 0.004
     scene = Scene(Material.elastic(nu=nu, G=G), R=R, m=m, v_z0=1.0, v_x0=0.8, omega0=0.0,

@@ -29,8 +29,9 @@ def test_reproduces_cubics_exactly_on_an_uneven_3d_grid():
     th = np.array([0.2, 0.4, 0.5, 0.9, 1.0])
     q1 = np.array([1e-3, 3e-3, 1e-2, 0.1, 0.2, 1.0, 10.0])
     X, Y, Z = np.meshgrid(nu, th, np.log(q1), indexing="ij")
+    # theta_ratio linear here (a table interpolates it in log: LOG_AXES)
     grid = HermiteGrid(["nu", "theta_ratio", "Q1"], [nu, th, q1], {"f": cubic(X, Y, Z)},
-                       monotone=False)
+                       monotone=False, log_axes=("Q1",))
     rng = np.random.default_rng(3)
     p = [rng.uniform(0, 0.5, 2000), rng.uniform(0.2, 1.0, 2000),
          np.exp(rng.uniform(np.log(1e-3), np.log(10.0), 2000))]

@@ -15,16 +15,15 @@ Live since the tables were regenerated with the final sweep driver and verified
 remade.
 """
 
-from pathlib import Path
-
 import dataclasses
+from pathlib import Path
 
 import numpy as np
 import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
 SHIPPED = ("kelvin_voigt", "standard_solid")
-#: Set to True once the shipped tables are regenerated (issue 11); then this guard is live.
+#: Set to True once the shipped tables are regenerated; then this guard is live.
 REGENERATED = True
 SAMPLE = 12
 NODE_TOLERANCE = 1e-6
@@ -63,7 +62,7 @@ def _stale_reasons(model: str) -> list[str]:
 
 
 @pytest.mark.xfail(not REGENERATED, strict=True,
-                   reason="issue 11: shipped tables predate today's numerics; regenerate them, "
+                   reason="shipped tables predate today's numerics; regenerate them, "
                           "then set REGENERATED = True")
 @pytest.mark.parametrize("model", SHIPPED)
 def test_shipped_table_is_what_its_spec_makes_today(model):

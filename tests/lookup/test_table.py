@@ -19,8 +19,7 @@ import pyarrow.parquet as pq
 import pytest
 
 import vimpact
-from vimpact import Material, Numerics, Scene, simulate, simulate_batch
-from vimpact import cli
+from vimpact import Material, Numerics, Scene, cli, simulate, simulate_batch
 from vimpact.lookup.table import RestitutionTable
 from vimpact.model.validation import InputError
 
@@ -171,7 +170,10 @@ def test_lookup_returns_the_rows_at_grid_points(which, kv_path, ss_path):
 
 def test_interpolation_is_linear_in_log_q1_and_nu(kv):
     rows = kv.ok
-    at = lambda q1, nu: rows[np.isclose(rows.Q1, q1, rtol=1e-9) & np.isclose(rows.nu, nu)].iloc[0]
+
+    def at(q1, nu):
+        return rows[np.isclose(rows.Q1, q1, rtol=1e-9) & np.isclose(rows.nu, nu)].iloc[0]
+
     a, b = Q1_GRID[2], Q1_GRID[3]
     mid = kv.lookup(np.sqrt(a * b), 0.5, method="linear")  # halfway in log Q1
     assert mid["e_z"] == pytest.approx(0.5 * (at(a, 0.5).e_z + at(b, 0.5).e_z), abs=1e-12)
@@ -240,8 +242,11 @@ def test_model_mismatch_errors(kv, ss_path):
 def test_standard_solid_interpolates_in_log_q2(ss_path):
     ss = RestitutionTable.open(ss_path)
     rows = ss.ok
-    sel = lambda q2: rows[np.isclose(rows.Q2, q2) & np.isclose(rows.Q1, 0.1)
-                          & np.isclose(rows.nu, 0.0)].iloc[0]
+
+    def sel(q2):
+        return rows[np.isclose(rows.Q2, q2) & np.isclose(rows.Q1, 0.1)
+                    & np.isclose(rows.nu, 0.0)].iloc[0]
+
     mid = ss.lookup(0.1, 0.0, Q2=np.sqrt(0.1 * 1.0), method="linear")
     assert mid["e_z"] == pytest.approx(0.5 * (sel(0.1).e_z + sel(1.0).e_z), abs=1e-12)
 

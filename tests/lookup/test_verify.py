@@ -12,8 +12,13 @@ import pytest
 
 from vimpact.lookup.refine import grid_table, refine_grid
 from vimpact.lookup.table import RestitutionTable
-from vimpact.lookup.verify import (held_out_errors, held_out_points, interpolation_error,
-                                   simulate_dimensionless, write_interpolation_error)
+from vimpact.lookup.verify import (
+    held_out_errors,
+    held_out_points,
+    interpolation_error,
+    simulate_dimensionless,
+    write_interpolation_error,
+)
 from vimpact.model.numerics import Numerics
 from vimpact.model.validation import InputError
 

@@ -1,5 +1,5 @@
 """Scene builders and invariant checks shared by ``test_hard_cases.py`` and
-``test_properties.py`` (issue 5: hard cases stay numerically stable).
+``test_properties.py`` (hard cases stay numerically stable).
 
 Every scene is built on the dimensionless base of
 ``Scene.from_dimensionless`` (``R = 1 m``, ``m = 1 kg``, ``v_z0 = 1 m/s``,
@@ -20,10 +20,10 @@ import vimpact as v
 #: the time step of the default numerics in units of T (t_H / 1000)
 H_DEFAULT = v.HERTZ_TIME_FACTOR / v.Numerics().steps
 
-#: invariant tolerances (issue 5): energy passivity and |beta_x| <= 1
+#: invariant tolerances: energy passivity and |beta_x| <= 1
 ENERGY_TOL = 1e-6
 BETA_TOL = 1e-9
-#: an elastic impact returns the normal speed (issue 5: e_z = 1 within 1e-6)
+#: an elastic impact returns the normal speed (e_z = 1 within 1e-6)
 ELASTIC_EZ_TOL = 1e-6
 #: ``e_z <= 1`` with that tolerance: the time discretization of an (almost)
 #: elastic impact returns the normal speed to about 1e-10 above 1 (default
@@ -103,7 +103,7 @@ def fmt(x: float) -> str:
 
 
 def invariant_violations(row, scene_: v.Scene, allowed=("ok", "vc0_zero")) -> list[str]:
-    """Every issue-5 invariant that result ``row`` (dict-like) of ``scene_`` breaks.
+    """Every invariant that result ``row`` (dict-like) of ``scene_`` breaks.
 
     - status in ``allowed`` (never a silent failure status);
     - finite outputs (NaN only for e_x, beta_x with ``vc0_zero``);

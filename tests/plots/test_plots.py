@@ -8,8 +8,8 @@ import pytest
 
 from tests.lookup.test_table import make_table, results_frame, run, vimpact_main, write_table  # noqa: F401
 from vimpact import Material, Scene
-from vimpact.plots.figures import FIGURE_NAMES, FIGURES, figure_name, plot_figure
 from vimpact.lookup.table import RestitutionTable
+from vimpact.plots.figures import FIGURE_NAMES, FIGURES, figure_name, plot_figure
 
 
 def random_draws_table(path, n=40, seed=3):
@@ -105,13 +105,14 @@ def test_figure_names():
     assert all(FIGURES[n].spec for n in FIGURE_NAMES if n.startswith("fig5"))
 
 
-def test_cli_plot(vimpact_main, tables, tmp_path, capsys):
+def test_cli_plot(vimpact_main, tables, tmp_path, capsys):  # noqa: F811 (the imported fixture)
     out = tmp_path / "f.png"
     code, text, err = run(vimpact_main, ["plot", "fig5_5", "--out", str(out), "--table",
                                          str(tables["fig5_4"]), "--table", str(tables["fig5_2"])],
                           capsys)
     assert code == 0 and out.stat().st_size > 10_000 and str(out) in text, err
     code, text, err = run(vimpact_main, ["plot", "fig5_1", "--out", str(out)], capsys)
-    assert code == 2 and "sweeps/fig5_1_kelvin_voigt_random.toml" in err and len(err.strip().splitlines()) == 1
+    assert (code == 2 and "sweeps/fig5_1_kelvin_voigt_random.toml" in err
+            and len(err.strip().splitlines()) == 1)
     code, _, err = run(vimpact_main, ["plot", "nope", "--out", str(out)], capsys)
     assert code == 2 and "fig3_2" in err

@@ -15,6 +15,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.integrate import quad, solve_ivp
 
+from vimpact.model.hertz import HERTZ_TIME_FACTOR, Q1_PER_TAU
 from vimpact.reference import closed_forms as analytic
 from vimpact.reference.closed_forms import (
     hertz_time_factor_quadrature,
@@ -24,7 +25,6 @@ from vimpact.reference.closed_forms import (
     linear_model_zeta,
     linear_tangential_frequency,
 )
-from vimpact.model.hertz import HERTZ_TIME_FACTOR, Q1_PER_TAU
 
 PHYSICS_HERTZ_TIME = 2.9432751843   # docs/physics.md#hertz-scales
 PHYSICS_KV_SLOPE = 1.8917            # docs/physics.md#kelvin-voigt-continuum, per tau/T
@@ -172,7 +172,8 @@ def test_linear_tangential_frequency():
     m, R, k = 2.0, 0.1, 800.0
     Theta = 0.4 * m * R**2
     # solid sphere: effective mass 1/(1/m + R^2/Theta) = 2/7 m
-    assert linear_tangential_frequency(k, m, R, Theta) == pytest.approx(math.sqrt(k / (2.0 / 7.0 * m)), rel=1e-14)
+    assert linear_tangential_frequency(k, m, R, Theta) == pytest.approx(
+        math.sqrt(k / (2.0 / 7.0 * m)), rel=1e-14)
     assert linear_tangential_frequency(k, m, R, 1e30) == pytest.approx(math.sqrt(k / m), rel=1e-14)
 
 

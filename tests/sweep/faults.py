@@ -50,7 +50,7 @@ def _compressed_page_size(path: Path, header: int) -> int:
         f.seek(header)
         raw = f.read(32)
     pos, values = 0, []
-    for field in (1, 2, 3):
+    for _field in (1, 2, 3):
         assert raw[pos] == (1 << 4) | 5, f"unexpected page header byte at {header + pos}"
         pos += 1
         shift = value = 0
@@ -151,7 +151,7 @@ class FullDisk:
         self.failures = 0
 
     def __call__(self, file, mode="r", *args, **kwargs):
-        real = io.open(file, mode, *args, **kwargs)
+        real = open(file, mode, *args, **kwargs)
         if "w" not in mode and "a" not in mode and "+" not in mode:
             return real
         self.opened += 1

@@ -10,14 +10,13 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
-import pyarrow.parquet as pq
 import pytest
 
 import vimpact as v
+from tests.sweep import write
 from vimpact import cli
 from vimpact.sweep import load_spec, parts_dir, read_metadata, run_sweep, runner, store
 from vimpact.sweep.parameters import chunk_parameters
-from tests.sweep import write
 
 ROOT = Path(__file__).resolve().parents[2]
 

@@ -9,9 +9,9 @@ import pandas as pd
 import pytest
 
 import vimpact as v
+from tests.sweep import write
 from vimpact.sweep import load_spec, run_sweep
 from vimpact.sweep.parameters import engine_columns
-from tests.sweep import write
 
 SWEEPS = Path(__file__).resolve().parents[2] / "sweeps"
 EXAMPLE = SWEEPS / "friction_psi.toml"

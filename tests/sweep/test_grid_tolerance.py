@@ -16,8 +16,7 @@ from vimpact.lookup import refine
 from vimpact.lookup.table import RestitutionTable
 from vimpact.lookup.verify import held_out_errors
 from vimpact.model.validation import InputError
-from vimpact.sweep import SweepInterrupted, load_spec, parts_dir, read_metadata, run_sweep
-from vimpact.sweep import runner
+from vimpact.sweep import SweepInterrupted, load_spec, parts_dir, read_metadata, run_sweep, runner
 
 TOL = 1e-4
 KV = """

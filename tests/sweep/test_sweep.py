@@ -10,10 +10,10 @@ import pyarrow.parquet as pq
 import pytest
 
 import vimpact as v
-from vimpact import cli
-from vimpact.sweep import runner, spec as sweep
-from vimpact.sweep import SweepInterrupted, load_spec, parts_dir, read_metadata, run_sweep
 from tests.sweep import write
+from vimpact import cli
+from vimpact.sweep import SweepInterrupted, load_spec, parts_dir, read_metadata, run_sweep, runner
+from vimpact.sweep import spec as sweep
 
 SWEEPS = Path(__file__).resolve().parents[2] / "sweeps"
 TINY = v.Numerics(steps=100, elements=20)

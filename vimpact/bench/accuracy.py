@@ -64,8 +64,8 @@ import numba
 import numpy as np
 
 import vimpact as v
-from vimpact.reference.closed_forms import kelvin_voigt_continuum
 from vimpact.engine.result import FINISHED
+from vimpact.reference.closed_forms import kelvin_voigt_continuum
 
 from .machine import figure, load_average, machine_info, progress, save_figure, use_agg
 
@@ -641,7 +641,7 @@ def _orders(rows, floors) -> dict:
     e_fix = max((e for e in elements if all((s, e) in have for s in steps)), default=None)
     s_fix = max((s for s in steps if all((s, e) in have for e in elements)), default=None)
     lines = {
-        "diagonal_steps_eq_5_elements": sorted((k for k in have if k[0] == 5 * k[1])),
+        "diagonal_steps_eq_5_elements": sorted(k for k in have if k[0] == 5 * k[1]),
         f"steps_at_elements_{e_fix}": [(s, e_fix) for s in steps] if e_fix else [],
         f"elements_at_steps_{s_fix}": [(s_fix, e) for e in elements] if s_fix else [],
     }
@@ -742,7 +742,7 @@ def run(quick: bool = False) -> dict:
     out["table_4_1"] = table_4_1(cfg["table_steps"])
 
     timer.passes()
-    for name, g in out["integrators"].items():
+    for g in out["integrators"].values():
         rows = g["settings"]
         front = pareto([r["seconds_per_impact"] for r in rows], [_num(r["error"]) for r in rows])
         for i, r in enumerate(rows):

@@ -18,7 +18,7 @@ packing, unpacking and the ``DataFrame``. Measured on
 
 both on 2 numba threads (or 1 where numba has only one), after a warm-up
 call that compiles or loads the kernels; median over the repeats. Also the
-Kelvin-Voigt normal-only throughput, rows / ``total_s``. Targets (issue 9):
+Kelvin-Voigt normal-only throughput, rows / ``total_s``. Targets:
 overhead <= 5 microseconds per row, throughput >= 50,000 rows/s on 2 threads.
 
 Rows: ``nu`` uniform in [0, 0.5], ``R`` log-uniform in [1 mm, 10 cm], steel
@@ -41,7 +41,7 @@ from .machine import figure, load_average, machine_info, progress, save_figure, 
 
 TITLE = "Python overhead per row outside the kernels (columnar simulate_batch) and KV rows/s"
 
-#: issue 9: Python time per row outside the kernels, s; Kelvin-Voigt normal-only rows/s
+#: targets: Python time per row outside the kernels, s; Kelvin-Voigt normal-only rows/s
 TARGET_OVERHEAD_US_PER_ROW = 5.0
 TARGET_KV_ROWS_PER_SECOND = 50_000.0
 THREADS = 2

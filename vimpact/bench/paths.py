@@ -5,7 +5,7 @@ repository is ``python -m benchmarks.paths`` (``benchmarks/results/``).
 
 - Kelvin-Voigt normal-only at equal accuracy (1e-6 on e_z against the
   closed-form continuum solution): the continuum 1-DOF path
-  against the element kernel (issue target: >= 50x);
+  against the element kernel (target: >= 50x);
 - specialization at equal numerics: each scene's specialized element kernel
   against the general kernel compiled with the tangential problem and the
   arms on (and the rows' own dashpot flag, :func:`general_spec`) run on the

@@ -61,6 +61,14 @@ def _advance(q: float, w0: float, w1: float, c: tuple[float, float, float]) -> f
     return E * q + one_minus_E * w0 + phi * (w1 - w0)
 
 
+def kernel_refinement(scene: Scene, steps: int, elements: int, row_width: float = 1.05,
+                      ) -> tuple[float, float]:
+    """The element kernel's ``(time_factor, element_factor)`` for ``scene``
+    (:func:`vimpact.engine.routing.refinement`), dimensionless, >= 1."""
+    numerics = Numerics(steps=steps, elements=elements, row_width=row_width, continuum=False)
+    return refinement(scene, numerics, choose_path(scene, numerics).spec)
+
+
 def refined_row(scene: Scene, steps: int, elements: int, row_width: float = 1.05,
                 ) -> tuple[float, int, int]:
     """The discretization of ``scene`` as the kernel and ``naive_impact`` refine it.
@@ -70,8 +78,7 @@ def refined_row(scene: Scene, steps: int, elements: int, row_width: float = 1.05
     half row (all dimensionless), from :func:`vimpact.engine.routing.refinement`
     (finer for a stiff tangential mode or a glassy contact).
     """
-    numerics = Numerics(steps=steps, elements=elements, row_width=row_width, continuum=False)
-    time_factor, element_factor = refinement(scene, numerics, choose_path(scene, numerics).spec)
+    time_factor, element_factor = kernel_refinement(scene, steps, elements, row_width)
     per_a_H = int(math.ceil(elements * element_factor))
     return time_factor, per_a_H, int(math.ceil(row_width * per_a_H))
 

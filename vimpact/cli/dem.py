@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import argparse
 
+from vimpact.model.numerics import CONVERGED_PRESETS
+
 
 def add_parser(sub) -> None:
     from vimpact.dem import CODES  # the light list: the exports load scipy
@@ -24,7 +26,7 @@ def add_parser(sub) -> None:
                    help="temperature of the DEM run, kelvin (> 0): every viscoelastic "
                         "material is shifted to it by its shift law (overrides the set-up's "
                         "temperature_K)")
-    p.add_argument("--preset", default="fast", choices=("fast", "default", "precise"),
+    p.add_argument("--preset", default="fast", choices=CONVERGED_PRESETS,
                    help="vimpact numerics for the restitution curves (default: fast)")
     p.add_argument("--steps-per-contact", type=int, default=None, metavar="N",
                    help="time steps per shortest contact in the exported time step (lammps: "
@@ -40,13 +42,12 @@ def add_parser(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from vimpact.dem.export import export
-    from vimpact.dem.problem import load_problem
-    from vimpact.model.numerics import Numerics
-
     import json
     import sys
 
+    from vimpact.dem.export import export
+    from vimpact.dem.problem import load_problem
+    from vimpact.model.numerics import Numerics
     from vimpact.model.validation import InputError, message
 
     if args.steps_per_contact is not None and args.steps_per_contact < 4:

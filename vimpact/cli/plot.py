@@ -6,7 +6,6 @@ import argparse
 import textwrap
 
 
-
 def add_parser(subparsers) -> argparse.ArgumentParser:
     """Register ``vimpact plot NAME --out FILE [--table TABLE]`` on ``subparsers``."""
     from vimpact.plots.catalogue import CATALOGUE  # titles only: no drawing code yet

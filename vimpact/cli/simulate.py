@@ -14,9 +14,14 @@ from vimpact import __version__
 from vimpact.cli.material_args import add_material_arguments, material_from_args, missing
 from vimpact.engine.result import STATUSES, UNITS
 from vimpact.model.material import MODELS
-from vimpact.model.numerics import INTEGRATORS, PRESETS, Numerics
-from vimpact.model.scene import (DEFAULT_THETA_RATIO, TANGENTIAL_EFFECTS, TANGENTIAL_MEMORY,
-                                 ScaleError, Scene)
+from vimpact.model.numerics import INTEGRATORS, PRESETS, Numerics, preset_summary
+from vimpact.model.scene import (
+    DEFAULT_THETA_RATIO,
+    TANGENTIAL_EFFECTS,
+    TANGENTIAL_MEMORY,
+    ScaleError,
+    Scene,
+)
 from vimpact.model.validation import InputError, positive
 
 
@@ -61,7 +66,7 @@ def add_parser(sub) -> argparse.ArgumentParser:
                    help="stiffness ratio G1/G2 of the standard solid, dimensionless, > 0 "
                         "(omit for Kelvin-Voigt)")
     g.add_argument("--theta-ratio", type=float, default=None, metavar="RATIO",
-                   help="Theta / (m R^2), dimensionless (default 0.4, solid sphere; "
+                   help=f"Theta / (m R^2), dimensionless (default {DEFAULT_THETA_RATIO}, solid sphere; "
                         "instead of --Theta)")
     g = sim.add_argument_group("effects")
     g.add_argument("--tangential", choices=TANGENTIAL_EFFECTS, default=None,
@@ -77,8 +82,7 @@ def add_parser(sub) -> argparse.ArgumentParser:
                         "(thesis eq. 4.16, total displacement)")
     g = sim.add_argument_group("numerics")
     g.add_argument("--numerics", choices=tuple(PRESETS), default=None,
-                   help="numerics preset: fast (about 1e-3), default (about 1e-4), precise, "
-                        "thesis (explicit Euler as in the thesis)")
+                   help="numerics preset: " + ", ".join(preset_summary(p) for p in PRESETS))
     g.add_argument("--tolerance", type=float, metavar="TOL",
                    help="numerics for this absolute accuracy on e_z and beta_x on the path "
                         "that runs (instead of a preset; between 1e-9 and 1e-2); refused where "

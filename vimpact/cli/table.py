@@ -1,6 +1,7 @@
 """The ``vimpact table`` subcommand: info, lookup, verify and e(v) export of restitution tables.
 
-``add_parser(subparsers)`` registers it on the subparsers object of :func:`vimpact.cli.main.build_parser`; each sets
+``add_parser(subparsers)`` registers it on the subparsers object of
+:func:`vimpact.cli.main.build_parser`; each sets
 ``func`` to its handler, which returns the exit code and raises
 ``ValueError`` on bad input (``vimpact.cli.main.main`` prints it as one line and
 exits with 2).
@@ -11,7 +12,6 @@ from __future__ import annotations
 import argparse
 import json
 import math
-import textwrap
 
 import numpy as np
 

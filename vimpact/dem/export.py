@@ -14,7 +14,6 @@ from vimpact.dem.problem import DemProblem
 from vimpact.model.validation import one_of
 
 
-
 @dataclass
 class Export:
     """What :func:`export` produced: the fits, the targets and the files written."""

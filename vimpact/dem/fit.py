@@ -18,7 +18,7 @@ from scipy.optimize import minimize_scalar
 
 from vimpact.dem import laws
 from vimpact.dem.problem import Contact, DemProblem
-from vimpact.model.pair import pair_restitution
+from vimpact.engine.pairs import pair_restitution
 
 
 @dataclass
@@ -44,7 +44,7 @@ class Targets:
     t_contact: np.ndarray
     status: np.ndarray
 
-    def subset(self, mask: np.ndarray) -> "Targets":
+    def subset(self, mask: np.ndarray) -> Targets:
         """The points selected by ``mask``."""
         pick = lambda a: None if a is None else a[mask]  # noqa: E731
         return Targets(self.contact, self.v[mask], self.level[mask], self.R[mask], self.m[mask],
@@ -97,7 +97,7 @@ class Residual:
     rms: float
 
     @classmethod
-    def of(cls, predicted, target) -> "Residual":
+    def of(cls, predicted, target) -> Residual:
         d = np.asarray(predicted, dtype=float) - np.asarray(target, dtype=float)
         return cls(float(np.max(np.abs(d))), float(np.sqrt(np.mean(d * d))))
 

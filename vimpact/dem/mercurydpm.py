@@ -53,7 +53,7 @@ def render(problem: DemProblem, fits: list[ContactFit]) -> dict[str, str]:
     ident.update({w.index: f"s_{w.name}" for w in problem.walls})
     lines = ["// MercuryDPM species written by `vimpact dem` (SI units)",
              f"// from {problem.source}; speeds {problem.speeds.min():g}..{problem.speeds.max():g} m/s",
-             f"// Put the #include at the top of your driver and the rest inside setupInitialConditions()",
+             "// Put the #include at the top of your driver and the rest inside setupInitialConditions()",
              "// (or your constructor), before particles and walls are created.",
              f"#include \"{HEADER}\""]
     for t in problem.types:
@@ -71,6 +71,7 @@ def render(problem: DemProblem, fits: list[ContactFit]) -> dict[str, str]:
         lines.append(f"// {f.contact.key}")
         lines.append(f"{target}->setEffectiveElasticModulus({p['effectiveElasticModulus']:.10g});  // Pa")
         lines.append(f"{target}->setDissipation({p['dissipation']:.10g});  // A, s")
-        lines.append(f"{target}->setEffectiveShearModulus({p['effectiveShearModulus']:.10g});  // Pa, Mindlin")
+        lines.append(f"{target}->setEffectiveShearModulus({p['effectiveShearModulus']:.10g});"
+                     "  // Pa, Mindlin")
         lines.append(f"{target}->setSlidingFrictionCoefficient({mu:.6g});")
     return {"mercurydpm_species.cpp": "\n".join(lines) + "\n"}

@@ -43,9 +43,13 @@ from pathlib import Path
 import numpy as np
 
 from vimpact.model.material import Material
-from vimpact.model.material_file import at_temperature, resolve_material
-from vimpact.model.material_file import bad_value as _err, toml_number as _num
-from vimpact.model.material_file import material_from_table  # noqa: F401 (its former home)
+from vimpact.model.material_file import (
+    at_temperature,
+    material_from_table,  # noqa: F401 (its former home)
+    resolve_material,
+)
+from vimpact.model.material_file import bad_value as _err
+from vimpact.model.material_file import toml_number as _num
 from vimpact.model.pair import Body, Wall, pair_material
 from vimpact.model.scene import DEFAULT_THETA_RATIO
 from vimpact.model.validation import InputError, message
@@ -176,7 +180,7 @@ class DemProblem:
         """Some type has a radius range (it can be split into size classes)."""
         return any(len(t.radii) > 1 for t in self.types)
 
-    def with_size_classes(self, k: int) -> "DemProblem":
+    def with_size_classes(self, k: int) -> DemProblem:
         """The same set-up with every size-range type split into ``k`` types of equal
         radius ratio (``NAME_1`` .. ``NAME_k``, smallest first; friction as the type's)."""
         return problem_from_toml(self.toml, self.source, base=self.base,
@@ -326,7 +330,7 @@ def problem_from_toml(text: str, source: str = "<string>", *, base: Path | None 
             contacts.append(Contact(a, w, mu_of(a.name, w.name)))
     for c in contacts:  # refuse unmappable material pairs now, naming the contact
         try:
-            c.material
+            _ = c.material  # the property maps the pair (or raises)
         except InputError as exc:
             raise InputError(f"{source}: contact {c.key}: {exc}") from None
     return DemProblem(tuple(types), tuple(walls), tuple(contacts), speeds,

@@ -18,7 +18,7 @@ import numpy as np
 
 from vimpact.dem.fit import ContactFit, Residual, Targets
 from vimpact.dem.problem import DemProblem
-from vimpact.model.pair import pair_restitution
+from vimpact.engine.pairs import pair_restitution
 
 CODE = "rebound"
 TANGENTIAL = False

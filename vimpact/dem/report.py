@@ -83,7 +83,7 @@ def markdown(code: str, problem: DemProblem, targets: dict[str, Targets],
     lines = [f"# vimpact dem: {code}", "",
              f"Input: `{problem.source}`; normal impact speeds {problem.speeds.min():g} to "
              f"{problem.speeds.max():g} m/s ({problem.speeds.size} points, log-spaced)"
-             + (f"; size levels min/nominal/max where a radius range is given" if any(
+             + ("; size levels min/nominal/max where a radius range is given" if any(
                  len(t.radii) > 1 for t in problem.types) else "") + ".",
              f"Written: {', '.join(f'`{x}`' for x in files)}.", "",
              "Residual = code minus vimpact over all points (max |.|, RMS).", "",

@@ -47,9 +47,14 @@ import numpy as np
 
 from vimpact.model.hertz import Q1_PER_TAU, hertz_scales
 from vimpact.model.material import MODELS
-from vimpact.model.scene import (DEFAULT_THETA_RATIO, MAX_DASHPOT_TIME, TANGENTIAL_EFFECTS,
-                                 TANGENTIAL_MEMORY, Scene)
-from vimpact.model.validation import InputError, check_column, message
+from vimpact.model.scene import (
+    DEFAULT_THETA_RATIO,
+    MAX_DASHPOT_TIME,
+    TANGENTIAL_EFFECTS,
+    TANGENTIAL_MEMORY,
+    Scene,
+)
+from vimpact.model.validation import InputError, check_column, is_none, message
 
 #: numeric input columns: name -> (validation rule, default or None if required)
 NUMERIC = {
@@ -108,10 +113,10 @@ class SceneColumns:
     rotation: np.ndarray
     allow_large_contact: np.ndarray
     reasons: np.ndarray
-    d: np.ndarray = None
-    a_H: np.ndarray = None
-    T: np.ndarray = None
-    t_H: np.ndarray = None
+    d: np.ndarray = None  # type: ignore[assignment]  # set by __post_init__
+    a_H: np.ndarray = None  # type: ignore[assignment]  # set by __post_init__
+    T: np.ndarray = None  # type: ignore[assignment]  # set by __post_init__
+    t_H: np.ndarray = None  # type: ignore[assignment]  # set by __post_init__
 
     def __post_init__(self):
         with np.errstate(all="ignore"):  # out-of-range rows are marked by check_scales
@@ -121,10 +126,12 @@ class SceneColumns:
     def __len__(self) -> int:
         return self.nu.shape[0]
 
-    # ---- derived, vectorized (docs/physics.md#method-of-dimensionality-reduction, docs/physics.md#energy-and-passivity, docs/physics.md#dimensionless-parameters) ------------------
+    # ---- derived, vectorized (docs/physics.md#method-of-dimensionality-reduction,
+    # docs/physics.md#energy-and-passivity, docs/physics.md#dimensionless-parameters) ------
     @property
     def valid(self) -> np.ndarray:
-        return np.equal(self.reasons, None)
+        """Rows without a reason to refuse them (valid scenes), bool."""
+        return is_none(self.reasons)
 
     @property
     def v_c0(self) -> np.ndarray:
@@ -133,6 +140,7 @@ class SceneColumns:
 
     @property
     def theta_ratio(self) -> np.ndarray:
+        """``Theta / (m R^2)``, dimensionless."""
         return self.Theta / (self.m * self.R**2)
 
     @property
@@ -152,7 +160,8 @@ class SceneColumns:
 
     @property
     def has_arms(self) -> np.ndarray:
-        return (self.G_arm > 0.0).any(axis=1)
+        """Rows with at least one Maxwell arm, bool."""
+        return np.any(self.G_arm > 0.0, axis=1)
 
     @property
     def dashpot_time(self) -> np.ndarray:
@@ -174,14 +183,14 @@ class SceneColumns:
             q2 = np.where(G2 > 0.0, self.G_inf / np.where(G2 > 0.0, G2, 1.0), np.inf)
         return np.where(self.model == MODEL_STANDARD_SOLID, q2, np.nan)
 
-    def take(self, index) -> "SceneColumns":
+    def take(self, index) -> SceneColumns:
         """The rows ``index`` (an integer array or a mask) as a new batch."""
         fields = {k: getattr(self, k)[index] for k in _FIELDS}
         return SceneColumns(**fields)
 
     # ---- constructors ---------------------------------------------------------
     @classmethod
-    def from_scenes(cls, scenes: Sequence[Scene]) -> "SceneColumns":
+    def from_scenes(cls, scenes: Sequence[Scene]) -> SceneColumns:
         """Columns of validated :class:`Scene` objects (one Python pass over them)."""
         n = len(scenes)
         k = max((len(s.material.arms) for s in scenes if isinstance(s, Scene)), default=0)
@@ -215,7 +224,7 @@ class SceneColumns:
         return out
 
     @classmethod
-    def from_columns(cls, data) -> "SceneColumns":
+    def from_columns(cls, data) -> SceneColumns:
         """Validate scene columns (module docstring); bad rows get a reason, never an exception.
 
         Raises :class:`InputError` only for a malformed batch: not a mapping, columns of
@@ -261,8 +270,8 @@ class SceneColumns:
             G_arm[:, i - 1] = check_column(f"G_arm{i}_Pa", pair["G"], "non_negative", reasons)
             tau_arm[:, i - 1] = check_column(f"tau_arm{i}_s", pair["tau"], "positive", reasons)
         codes = {}
-        for name, (choices, default) in CHOICES.items():
-            codes[name] = _codes(name, arrays.get(name), choices, default, n, reasons)
+        for name, (choices, choice) in CHOICES.items():
+            codes[name] = _codes(name, arrays.get(name), choices, choice, n, reasons)
         rotation = _flags("rotation", arrays.get("rotation"), True, n, reasons)
         if "Theta_kg_m2" in arrays and "theta_ratio" in arrays:
             raise InputError("give Theta_kg_m2 or theta_ratio, not both")
@@ -347,7 +356,7 @@ def _as_array(values) -> np.ndarray:
 
 
 def _neutralize(cols: dict) -> None:
-    bad = ~np.equal(cols["reasons"], None)
+    bad = ~is_none(cols["reasons"])
     if not bad.any():
         return
     for name, value in _NEUTRAL.items():
@@ -367,7 +376,7 @@ def _codes(name: str, values, choices, default: str, n: int, reasons) -> np.ndar
         hit = values == choice
         out[hit] = code
         known |= hit
-    for i in np.flatnonzero(~known & np.equal(reasons, None)):
+    for i in np.flatnonzero(~known & is_none(reasons)):
         reasons[i] = message(name, values[i], "one of " + ", ".join(map(repr, choices)))
     return out
 
@@ -380,7 +389,7 @@ def _flags(name: str, values, default: bool, n: int, reasons) -> np.ndarray:
         return values.copy()
     obj = values.astype(object)
     ok = np.array([isinstance(v, (bool, np.bool_)) for v in obj], dtype=bool)
-    for i in np.flatnonzero(~ok & np.equal(reasons, None)):
+    for i in np.flatnonzero(~ok & is_none(reasons)):
         reasons[i] = message(name, obj[i], "True or False")
     return np.where(ok, obj == True, default)  # noqa: E712 - elementwise
 
@@ -399,7 +408,7 @@ def _model(values, G_arm: np.ndarray, eta0: np.ndarray, n: int, reasons) -> np.n
                                    "at most one Maxwell arm and eta0 = 0"),
             MODEL_PRONY: (np.ones(n, dtype=bool), "")}
     for code, (ok, what) in fits.items():
-        for i in np.flatnonzero((codes == code) & ~ok & np.equal(reasons, None)):
+        for i in np.flatnonzero((codes == code) & ~ok & is_none(reasons)):
             reasons[i] = (f"model = {MODELS[code]!r} is not allowed for this row: it needs "
                           f"{what} (the row has {n_arms[i]} arms, eta0 = {eta0[i]:g} Pa s)")
     return codes

@@ -12,8 +12,7 @@ import numpy as np
 from vimpact.engine import discretization
 from vimpact.engine.columns import SceneColumns
 from vimpact.engine.routing import CONTINUUM_STICK, Path
-from vimpact.kernels import continuum_kv, continuum_maxwell
-from vimpact.kernels import layout
+from vimpact.kernels import continuum_kv, continuum_maxwell, layout
 from vimpact.kernels.elements import KernelSpec, element_kernel
 from vimpact.model.numerics import Numerics
 

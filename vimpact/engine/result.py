@@ -6,6 +6,8 @@ import math
 from dataclasses import dataclass, field, fields
 from typing import TYPE_CHECKING
 
+from vimpact.kernels.status import TABLE as STATUS_TABLE
+
 if TYPE_CHECKING:  # the trajectory is a DataFrame; pandas is loaded only where one is made
     import pandas as pd
 
@@ -37,37 +39,12 @@ UNITS = {
     "error": "",
 }
 
-#: Meaning of each status value.
-STATUSES = {
-    "ok": "finished; all outputs valid",
-    "vc0_zero": "finished; v_c0 = 0, so no tangential force and e_x, beta_x are undefined (NaN)",
-    "normal_only": "finished; the scene asked for the normal impact only (tangential = 'none'): "
-                   "e_x, beta_x not computed (NaN)",
-    "half_space": "finished, but the contact half-width exceeded 0.2 R: outside the half-space model",
-    "time_limit": "the impact had not ended at the time limit (Numerics.max_time); outputs NaN",
-    "row_exceeded": "the contact reached the end of the element row; outputs NaN",
-    "non_finite": "the integration produced a non-finite value; outputs NaN",
-    "unstable": "the numerical solution gained energy (the contact energy, normal plus the "
-                "contact point's effective tangential energy, rose above 1 + 1e-6 of its start) "
-                "although the material and the incremental tangential rule are passive: the "
-                "step was too coarse for this scene; outputs NaN (refine: more steps or "
-                "elements)",
-    "energy_gain": "finished, but explicit Euler gained energy (more than 1e-6 of the contact "
-                   "energy), as it does by construction: numbers kept as the thesis's integrator "
-                   "gives them, not converged (use verlet)",
-    "unresolved": "the contact lasted fewer time steps than the element path needs to resolve "
-                  "it (numerics.MIN_CONTACT_STEPS); outputs NaN (more steps, or the continuum path)",
-    "too_costly": "the element path would need more steps or elements than its cost bounds "
-                  "(numerics.MAX_STEPS_PER_T_H, MAX_ELEMENTS_IN_ROW) for this scene; outputs NaN "
-                  "(reason in the error column)",
-    "tolerance_unreachable": "the numerics' tolerance is below what the element path this scene "
-                             "needs can reach, or its error is not bounded there (the seed "
-                             "memory); reason in the error column; outputs NaN",
-    "invalid": "the row's inputs are not a valid scene (reason in the error column); outputs NaN",
-}
+#: Meaning of each status value an impact can have (from the status table,
+#: :mod:`vimpact.kernels.status`).
+STATUSES = {s.name: s.message for s in STATUS_TABLE if not s.sweep_only}
 
 #: Statuses whose numbers are results (the others carry NaN).
-FINISHED = ("ok", "vc0_zero", "normal_only", "half_space", "energy_gain")
+FINISHED = tuple(s.name for s in STATUS_TABLE if s.finished and not s.sweep_only)
 
 
 @dataclass(frozen=True)
@@ -124,7 +101,7 @@ class ImpactResult:
     gross_slip_fraction: float = math.nan
     friction_energy: float = math.nan
     error: str | None = None
-    trajectory: "pd.DataFrame | None" = field(default=None, repr=False, compare=False)
+    trajectory: pd.DataFrame | None = field(default=None, repr=False, compare=False)
 
     def to_dict(self) -> dict:
         """Outputs as a plain dict (NaN kept as float NaN; no trajectory)."""

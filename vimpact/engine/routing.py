@@ -48,8 +48,8 @@ def friction_rows(cols: SceneColumns) -> np.ndarray:
 
 
 @dataclass(frozen=True)
-class Path:
-    """The kernel chosen for a scene.
+class KernelPath:
+    """The kernel chosen for a scene (``vimpact.KernelPath``; not a file path).
 
     Attributes
     ----------
@@ -85,6 +85,11 @@ class Path:
     def explain(self) -> str:
         """Multi-line explanation: the path and the reasons."""
         return "\n".join([f"path: {self.name}"] + [f"  - {r}" for r in self.reasons])
+
+
+#: the short name inside the engine (the public name, :class:`KernelPath`, does not
+#: shadow :class:`pathlib.Path`)
+Path = KernelPath
 
 
 _INTEGRATOR_NAMES = {code: name for name, code in INTEGRATORS.items()}

@@ -7,15 +7,14 @@ import numpy as np
 from vimpact.engine.columns import SceneColumns
 from vimpact.engine.result import FINISHED, RESULT_FIELDS, STATUSES
 from vimpact.kernels import layout
+from vimpact.kernels import status as status_table
 from vimpact.model.numerics import MIN_CONTACT_STEPS
 from vimpact.model.scene import HALF_SPACE_LIMIT, TANGENTIAL_EFFECTS, TANGENTIAL_MEMORY
+from vimpact.model.validation import is_none
 
-#: kernel status code -> status name
+#: kernel status code -> status name (the status table's codes)
 KERNEL_STATUSES = {
-    layout.STATUS_OK: "ok",
-    layout.STATUS_TIME_LIMIT: "time_limit",
-    layout.STATUS_ROW_EXCEEDED: "row_exceeded",
-    layout.STATUS_NON_FINITE: "non_finite",
+    **status_table.BY_CODE,
     layout.STATUS_ASSUMPTION: "non_finite",  # only reached if a hand-over failed
 }
 
@@ -50,8 +49,8 @@ def unpack(cols: SceneColumns, out: np.ndarray, path_names: np.ndarray, explicit
     n = len(cols)
     valid = cols.valid
     kstatus = out[:, layout.OUT_STATUS].astype(np.int64)
-    status = np.full(n, "invalid", dtype=object)
-    ran = valid & np.equal(refused, None)
+    status = np.full(n, status_table.INVALID, dtype=object)
+    ran = valid & is_none(refused)
     for code, name in KERNEL_STATUSES.items():
         status[ran & (kstatus == code)] = name
     for i in np.flatnonzero(valid & ~ran):
@@ -149,7 +148,7 @@ def _explain(status: np.ndarray, error: np.ndarray, contact_steps: np.ndarray,
              relative_gain: np.ndarray) -> None:
     """A reason for every row whose status is not finished and has none yet: no row
     ends without numbers and without saying why."""
-    for i in np.flatnonzero(~np.isin(status, FINISHED) & np.equal(error, None)):
+    for i in np.flatnonzero(~np.isin(status, FINISHED) & is_none(error)):
         if status[i] == "unresolved":
             error[i] = (f"the contact lasted {contact_steps[i]:.3g} time steps on the element "
                         f"path: at least {MIN_CONTACT_STEPS} are needed to resolve it (more "

@@ -87,7 +87,6 @@ from vimpact.kernels.layout import (
     OUT_STEPS,
     OUT_T_CONTACT,
     OUT_U_MAX,
-    OUT_VC_END,
     OUT_VZ_END,
     STATUS_NON_FINITE,
     STATUS_OK,

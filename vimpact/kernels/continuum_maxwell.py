@@ -134,14 +134,56 @@ import numpy as np
 from numba import prange
 
 from vimpact.kernels.continuum_kv import (
-    _A21, _A31, _A32, _A41, _A42, _A43, _A51, _A52, _A53, _A54, _A61, _A62, _A63, _A64, _A65,
-    _B1, _B3, _B4, _B5, _B6, _E1, _E3, _E4, _E5, _E6, _E7, RTOL_MAX, RTOL_MIN,
-    accepted_step_factor, rejected_step_factor)
+    _A21,
+    _A31,
+    _A32,
+    _A41,
+    _A42,
+    _A43,
+    _A51,
+    _A52,
+    _A53,
+    _A54,
+    _A61,
+    _A62,
+    _A63,
+    _A64,
+    _A65,
+    _B1,
+    _B3,
+    _B4,
+    _B5,
+    _B6,
+    _E1,
+    _E3,
+    _E4,
+    _E5,
+    _E6,
+    _E7,
+    RTOL_MAX,
+    RTOL_MIN,
+    accepted_step_factor,
+    rejected_step_factor,
+)
 from vimpact.kernels.jit import jit
 from vimpact.kernels.layout import (
-    ELEMENT_STIFFNESS, N_REC, OUT_B_MAX, OUT_N_REC, OUT_STATUS, OUT_STEPS, OUT_T_CONTACT,
-    OUT_T_GROSS_SLIP, OUT_U_MAX, OUT_VC_END, OUT_VZ_END, OUT_W_FRICTION, STATUS_ASSUMPTION,
-    STATUS_NON_FINITE, STATUS_OK, STATUS_TIME_LIMIT)
+    ELEMENT_STIFFNESS,
+    N_REC,
+    OUT_B_MAX,
+    OUT_N_REC,
+    OUT_STATUS,
+    OUT_STEPS,
+    OUT_T_CONTACT,
+    OUT_T_GROSS_SLIP,
+    OUT_U_MAX,
+    OUT_VC_END,
+    OUT_VZ_END,
+    OUT_W_FRICTION,
+    STATUS_ASSUMPTION,
+    STATUS_NON_FINITE,
+    STATUS_OK,
+    STATUS_TIME_LIMIT,
+)
 from vimpact.kernels.record import _record
 
 __all__ = ["maxwell_stick_impact", "maxwell_stick_batch", "GN"]

@@ -2,7 +2,8 @@
 
 Unit-free numba kernels; nothing here imports the user-facing layer.
 
-Kernel units (docs/physics.md#hertz-scales, docs/physics.md#method-of-dimensionality-reduction, docs/physics.md#energy-and-passivity): indentation ``u`` and normal
+Kernel units (docs/physics.md#hertz-scales, docs/physics.md#method-of-dimensionality-reduction,
+docs/physics.md#energy-and-passivity): indentation ``u`` and normal
 surface displacements ``w`` in units of the Hertz indentation ``d``; element
 positions ``xi`` in units of the Hertz radius ``a_H`` (so the MDR profile is
 ``g = xi^2``); time in units of ``T = d / v_z0``; normal velocity in units of
@@ -45,7 +46,7 @@ Integrators (the value of ``integrator``):
     stress over its ramp; the force that decides whether an element still
     pushes at the step end takes the arms' damping part at the end velocity.
 
-Compile-time specialization (issue 5): the impact body :func:`_impact` takes
+Compile-time specialization: the impact body :func:`_impact` takes
 the scene's effects as its first arguments (``tangential``, ``memory``,
 ``integrator``, ``arms``, ``dashpot``) and is inlined into a batch kernel
 built by :func:`element_kernel` for one :class:`KernelSpec`, where these are
@@ -62,18 +63,52 @@ from typing import NamedTuple
 import numpy as np
 from numba import prange
 
-from vimpact.kernels.arms import (_arm_coefficient, _arm_start, _arm_stress, _follow,
-                                  _follow_over, _follow_over_impulse, _follow_value, _free_rate,
-                                  _relax, _to_stress,
-                                  arm_coefficients, arm_implicit_coefficients)
+from vimpact.kernels.arms import (
+    _arm_coefficient,
+    _arm_start,
+    _arm_stress,
+    _follow,
+    _follow_over,
+    _follow_over_impulse,
+    _follow_value,
+    _free_rate,
+    _relax,
+    _to_stress,
+    arm_coefficients,
+    arm_implicit_coefficients,
+)
 from vimpact.kernels.jit import jit
 from vimpact.kernels.layout import (  # noqa: F401 - re-exported: the kernels' common layout
-    ELEMENT_STIFFNESS, EULER, N_OUT, N_REC, OUT_B_MAX, OUT_N_REC, OUT_STATUS, OUT_STEPS,
-    OUT_T_CONTACT, OUT_T_GROSS_SLIP, OUT_U_MAX, OUT_VC_END, OUT_VZ_END, OUT_W_FRICTION, REC_B,
-    REC_FX, REC_FZ, REC_SLIP, REC_T, REC_U, REC_V, REC_VC, STATUS_NON_FINITE, STATUS_OK, STATUS_ROW_EXCEEDED, STATUS_TIME_LIMIT, SYMPLECTIC_EULER,
-    VERLET)
+    ELEMENT_STIFFNESS,
+    EULER,
+    N_OUT,
+    N_REC,
+    OUT_B_MAX,
+    OUT_N_REC,
+    OUT_STATUS,
+    OUT_STEPS,
+    OUT_T_CONTACT,
+    OUT_T_GROSS_SLIP,
+    OUT_U_MAX,
+    OUT_VC_END,
+    OUT_VZ_END,
+    OUT_W_FRICTION,
+    REC_B,
+    REC_FX,
+    REC_FZ,
+    REC_SLIP,
+    REC_T,
+    REC_U,
+    REC_V,
+    REC_VC,
+    STATUS_NON_FINITE,
+    STATUS_OK,
+    STATUS_ROW_EXCEEDED,
+    STATUS_TIME_LIMIT,
+    SYMPLECTIC_EULER,
+    VERLET,
+)
 from vimpact.kernels.record import _record
-
 
 
 @jit(inline="always")
@@ -612,7 +647,7 @@ class KernelSpec(NamedTuple):
     friction: bool = False
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def element_kernel(spec: KernelSpec):
     """The batch kernel specialized for ``spec`` (compiled on first use, cached on disk).
 
@@ -620,7 +655,8 @@ def element_kernel(spec: KernelSpec):
     max_steps, rec, rec_every, out)`` with per-set arrays of length ``n``
     (``g``, ``tau`` padded to ``(n, max_arms)``; ``h``, ``n_elem``, ``dxi``
     per set; ``mu`` the friction coefficient in tangential kernel units,
-    ``mu v_z0 / |v_c0|``, read only by kernels with ``spec.friction``), shared ``rec_every``, a trajectory buffer ``rec`` of shape
+    ``mu v_z0 / |v_c0|``, read only by kernels with ``spec.friction``), shared ``rec_every``,
+    a trajectory buffer ``rec`` of shape
     ``(n, n_rec, N_REC)`` (``n_rec`` may be 0) and ``out`` of shape
     ``(n, N_OUT)``. ``prange`` runs over the parameter sets; each writes its
     own row.

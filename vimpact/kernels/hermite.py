@@ -27,7 +27,9 @@ from numba import prange
 from vimpact.kernels.jit import jit
 
 #: Two coordinates closer than ``NODE_RTOL |node| + NODE_ATOL`` are the same node
-#: (the point gets that node's values exactly).
+#: (the point gets that node's values exactly): the numbers of
+#: ``vimpact.lookup.interpolate.NODE_RTOL`` / ``NODE_ATOL``, written out here because
+#: kernels import numpy and numba only (``tests/lookup/test_node_tolerance.py``).
 NODE_RTOL = 1e-9
 NODE_ATOL = 1e-12
 #: Points per parallel work item (each item evaluates its own rows of ``out``).

@@ -4,22 +4,26 @@ of the per-impact output row and of a trajectory record.
 Kernel units are described in :mod:`vimpact.kernels.elements`. Everything here
 is plain numbers (no numba: the command line's parser and the value objects
 read these codes without loading numba); the record writer is
-:func:`vimpact.kernels.record._record`. Nothing imports the API side.
+:func:`vimpact.kernels.record._record`, which imports this module (not the
+other way round). Nothing imports the API side.
 """
 
 from __future__ import annotations
+
+from vimpact.kernels.status import BY_CODE, code
 
 EULER = 0
 SYMPLECTIC_EULER = 1
 VERLET = 2
 
-# status codes written to OUT_STATUS
-STATUS_OK = 0
-STATUS_TIME_LIMIT = 1
-STATUS_ROW_EXCEEDED = 2
-STATUS_NON_FINITE = 3
-# a continuum kernel met a scene outside its assumptions (the element path takes it over)
-STATUS_ASSUMPTION = 4
+# status codes written to OUT_STATUS: those of the status table
+STATUS_OK = code("ok")
+STATUS_TIME_LIMIT = code("time_limit")
+STATUS_ROW_EXCEEDED = code("row_exceeded")
+STATUS_NON_FINITE = code("non_finite")
+# not a status of a result: a continuum kernel met a scene outside its assumptions (the
+# engine hands the row to the element path); a code of its own, after the table's
+STATUS_ASSUMPTION = max(BY_CODE) + 1
 
 # columns of the per-impact output row
 OUT_VZ_END = 0  # normal velocity at the end / v_z0 (negative: rebound)
@@ -49,13 +53,3 @@ N_REC = 8
 #: Element stiffness per unit length in kernel units (both halves of the row counted by the caller).
 ELEMENT_STIFFNESS = 15.0 / 16.0
 
-
-def __getattr__(name: str):
-    """``_record`` moved to :mod:`vimpact.kernels.record`; kernels of earlier commits
-    (the before/after benchmarks compile them from ``git show``) still import it
-    from here, which loads numba only then."""
-    if name == "_record":
-        from vimpact.kernels.record import _record
-
-        return _record
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -38,19 +38,56 @@ import numpy as np
 
 from vimpact.model.validation import InputError
 
-__all__ = ["BACKENDS", "HermiteGrid", "LOG_AXES", "derivative_matrix", "hermite_slopes"]
+__all__ = ["BACKENDS", "HermiteGrid", "LOG_AXES", "NODE_ATOL", "NODE_RTOL", "cluster_nodes",
+           "derivative_matrix", "hermite_slopes", "same_node"]
 
-#: Axes interpolated in the logarithm of the value by default (> 0 required).
-LOG_AXES = ("Q1", "Q2")
+#: Axes interpolated in the logarithm of the value (> 0 required; the one list for
+#: tables, their verification and refinement: held-out mid-points and inserted nodes
+#: are geometric means there): the damping parameters, which span decades, and
+#: ``theta_ratio = Theta / (m R^2)``, which enters the tangential dynamics through the
+#: effective mass factor ``1 + m R^2 / Theta``, smoother in ``log theta_ratio`` than in
+#: ``theta_ratio`` on nodes spaced by ratios. ``nu`` and ``psi`` (which is 0 at normal
+#: incidence) are interpolated as they are.
+LOG_AXES = ("Q1", "Q2", "theta_ratio")
 #: Evaluations of :meth:`HermiteGrid.__call__`: the numba kernel, the NumPy reference.
 BACKENDS = ("numba", "numpy")
 #: Points evaluated per block (bounds the temporary memory).
 _BLOCK = 1 << 16
 #: Nodes of a slope stencil (the degree of the local polynomial + 1).
 _STENCIL = 5
-#: Two coordinates closer than this (relative) are the same node.
-_NODE_RTOL = 1e-9
-_NODE_ATOL = 1e-12
+#: Two coordinates closer than ``NODE_RTOL |x| + NODE_ATOL`` are the same node (the
+#: one rule for tables, grids and the interpolation kernel: ``vimpact.kernels.hermite``
+#: writes the same numbers out, as kernels import no other folder; a test checks them).
+NODE_RTOL = 1e-9
+NODE_ATOL = 1e-12
+
+
+def same_node(a, b) -> np.ndarray:
+    """Elementwise: ``a`` and ``b`` are the same grid coordinate."""
+    a, b = np.asarray(a, float), np.asarray(b, float)
+    return np.abs(a - b) <= NODE_RTOL * np.maximum(np.abs(a), np.abs(b)) + NODE_ATOL
+
+
+def cluster_nodes(values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Distinct values up to round-off: ``(nodes, index of each value)``.
+
+    Values that are :func:`same_node` as a cluster's first member join it;
+    the node is the cluster's median member (a value that occurs in the data).
+    """
+    order = np.argsort(values, kind="stable")
+    s = values[order]
+    starts = [0]
+    for i in range(1, len(s)):
+        if not same_node(s[starts[-1]], s[i]):
+            starts.append(i)
+    bounds = starts + [len(s)]
+    nodes = np.array([s[(bounds[k] + bounds[k + 1] - 1) // 2] for k in range(len(starts))])
+    labels = np.empty(len(s), dtype=np.int64)
+    for k in range(len(starts)):
+        labels[bounds[k]:bounds[k + 1]] = k
+    index = np.empty(len(values), dtype=np.int64)
+    index[order] = labels
+    return nodes, index
 
 
 def _fmt(x: float) -> str:
@@ -229,8 +266,8 @@ class HermiteGrid:
             return
         name, nodes = self.axes[k], self.nodes[k]
         lo, hi = nodes[0], nodes[-1]
-        tol_lo = _NODE_RTOL * abs(lo) + _NODE_ATOL
-        tol_hi = _NODE_RTOL * abs(hi) + _NODE_ATOL
+        tol_lo = NODE_RTOL * abs(lo) + NODE_ATOL
+        tol_hi = NODE_RTOL * abs(hi) + NODE_ATOL
         if not extrapolate and (x.min() < lo - tol_lo or x.max() > hi + tol_hi):
             inside = (x >= lo - tol_lo) & (x <= hi + tol_hi)
             bad = float(x[~inside].flat[0])
@@ -267,9 +304,9 @@ class HermiteGrid:
         h = b - a
         t = np.clip((u - a) / h, 0.0, 1.0)
         # a value within round-off of a node gives that node's row exactly
-        near = np.abs(x - nodes[i0]) <= _NODE_RTOL * np.abs(nodes[i0]) + _NODE_ATOL
+        near = np.abs(x - nodes[i0]) <= NODE_RTOL * np.abs(nodes[i0]) + NODE_ATOL
         t = np.where(near, 0.0, t)
-        near = np.abs(x - nodes[i0 + 1]) <= _NODE_RTOL * np.abs(nodes[i0 + 1]) + _NODE_ATOL
+        near = np.abs(x - nodes[i0 + 1]) <= NODE_RTOL * np.abs(nodes[i0 + 1]) + NODE_ATOL
         t = np.where(near, 1.0, t)
         t2, t3 = t * t, t * t * t
         w0 = 2 * t3 - 3 * t2 + 1

@@ -22,18 +22,20 @@ import math
 import numpy as np
 import pandas as pd
 
+from vimpact.lookup.interpolate import LOG_AXES
+from vimpact.model.scene import DEFAULT_THETA_RATIO
 from vimpact.model.validation import InputError
 
 __all__ = ["grid_table", "refine_grid"]
 
-_LOG_AXES = ("Q1", "Q2")
 #: Node budget of a refinement: grid points (rows of the table) at most ...
 MAX_NODES = 200_000
 #: ... and nodes per axis at most.
 MAX_AXIS_NODES = 200
 
 
-def grid_table(model: str, axes: dict[str, np.ndarray], numerics, theta_ratio: float = 0.4,
+def grid_table(model: str, axes: dict[str, np.ndarray], numerics,
+               theta_ratio: float = DEFAULT_THETA_RATIO,
                tangential: str = "auto", tangential_memory: str = "incremental",
                rotation: bool = True, simulate=None):
     """Simulate every node of the grid ``axes`` and return it as a restitution table.
@@ -111,7 +113,7 @@ def _mid(a: np.ndarray, log: bool) -> np.ndarray:
 
 
 def refine_grid(model: str, axes: dict, tolerance: float, numerics=None, *,
-                theta_ratio: float = 0.4, tangential: str = "auto",
+                theta_ratio: float = DEFAULT_THETA_RATIO, tangential: str = "auto",
                 tangential_memory: str = "incremental", rotation: bool = True,
                 outputs=("e_z", "beta_x"), method: str = "cubic", max_rounds: int = 6,
                 max_nodes: int = MAX_NODES, max_axis_nodes: int = MAX_AXIS_NODES,
@@ -174,7 +176,7 @@ def refine_grid(model: str, axes: dict, tolerance: float, numerics=None, *,
     nodes = {}
     for a in need:
         v = np.unique(np.asarray(axes[a], dtype=float))
-        if a in _LOG_AXES and np.any(v <= 0):
+        if a in LOG_AXES and np.any(v <= 0):
             raise InputError(f"{a} = {v[v <= 0][0]!r} is not allowed: the {a} axis is "
                              f"logarithmic, give {a} > 0")
         nodes[a] = v
@@ -210,7 +212,7 @@ def refine_grid(model: str, axes: dict, tolerance: float, numerics=None, *,
                 continue
             mids = err.loc[sel, a].to_numpy()[bad]
             # each failing mid-point splits the cell it sits in
-            cell_mids = _mid(nodes[a], a in _LOG_AXES)
+            cell_mids = _mid(nodes[a], a in LOG_AXES)
             cell = np.unique(np.argmin(np.abs(cell_mids[None, :] - mids[:, None]), axis=1))
             new[a] = cell_mids[cell]
             entry["inserted"][a] = [

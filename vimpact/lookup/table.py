@@ -45,7 +45,10 @@ import numpy as np
 import pandas as pd
 
 from vimpact.engine.result import STATUSES
-from vimpact.model.scene import HALF_SPACE_LIMIT, Scene
+from vimpact.kernels.status import INVALID
+from vimpact.kernels.status import TABLE as STATUS_TABLE
+from vimpact.lookup.interpolate import LOG_AXES, cluster_nodes, same_node
+from vimpact.model.scene import DEFAULT_THETA_RATIO, HALF_SPACE_LIMIT, Scene
 from vimpact.model.validation import InputError, positive, require
 
 __all__ = ["AXES", "DATA_STATUSES", "LOG_AXES", "LOOKUP_METHODS", "LOOKUP_MODELS",
@@ -56,7 +59,7 @@ __all__ = ["AXES", "DATA_STATUSES", "LOG_AXES", "LOOKUP_METHODS", "LOOKUP_MODELS
 LOOKUP_METHODS = ("cubic", "linear")
 
 #: Statuses whose rows are data (all others are failures and are skipped).
-DATA_STATUSES = ("ok",)
+DATA_STATUSES = tuple(s.name for s in STATUS_TABLE if s.has_data)
 
 #: Models whose tables :meth:`RestitutionTable.lookup` can interpolate.
 LOOKUP_MODELS = ("kelvin_voigt", "standard_solid")
@@ -74,12 +77,6 @@ OUTPUTS = ("e_z", "e_x", "beta_x")
 #: several values, ``psi`` when it has a ``psi`` column (friction incidence).
 AXES = ("Q1", "Q2", "nu", "theta_ratio", "psi")
 
-#: Axes interpolated in the logarithm of the value: the damping parameters, which span
-#: decades, and ``theta_ratio = Theta / (m R^2)``, which enters the tangential dynamics
-#: through the effective mass factor ``1 + m R^2 / Theta``, smoother in ``log theta_ratio``
-#: than in ``theta_ratio`` on nodes spaced by ratios. ``nu`` and ``psi`` (which is 0
-#: at normal incidence) are interpolated as they are.
-LOG_AXES = ("Q1", "Q2", "theta_ratio")
 
 #: The most points of an e(v) curve (:meth:`RestitutionTable.restitution_curve`,
 #: ``vimpact table export --n``).
@@ -91,12 +88,6 @@ BOUND_SLACK = 1e-6
 
 _REQUIRED = ("Q1", "nu", "e_z", "e_x", "beta_x", "status")
 _META_PREFIX = "vimpact."  # the sweep's vimpact.sweep.store.META_PREFIX
-#: Theta / (m R^2) of a table without a ``theta_ratio`` column (the solid sphere,
-#: ``Scene``'s default).
-DEFAULT_THETA_RATIO = 0.4
-#: Two parameter values closer than this (relative) are the same grid node.
-_NODE_RTOL = 1e-9
-_NODE_ATOL = 1e-12
 
 
 def _axis_is_log(name: str) -> bool:
@@ -110,33 +101,6 @@ def _fmt(x: float) -> str:
 # --------------------------------------------------------------------------
 # grid helpers
 # --------------------------------------------------------------------------
-
-def _same(a, b) -> np.ndarray:
-    """Elementwise: ``a`` and ``b`` are the same grid coordinate."""
-    a, b = np.asarray(a, float), np.asarray(b, float)
-    return np.abs(a - b) <= _NODE_RTOL * np.maximum(np.abs(a), np.abs(b)) + _NODE_ATOL
-
-
-def _cluster(values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Distinct values up to round-off: ``(nodes, index of each value)``.
-
-    Values within ``1e-9`` (relative) of a cluster's first member join it;
-    the node is the cluster's median member (a value that occurs in the data).
-    """
-    order = np.argsort(values, kind="stable")
-    s = values[order]
-    starts = [0]
-    for i in range(1, len(s)):
-        if not _same(s[starts[-1]], s[i]):
-            starts.append(i)
-    bounds = starts + [len(s)]
-    nodes = np.array([s[(bounds[k] + bounds[k + 1] - 1) // 2] for k in range(len(starts))])
-    labels = np.empty(len(s), dtype=np.int64)
-    for k in range(len(starts)):
-        labels[bounds[k]:bounds[k + 1]] = k
-    index = np.empty(len(values), dtype=np.int64)
-    index[order] = labels
-    return nodes, index
 
 
 class _Grid:
@@ -158,7 +122,7 @@ class _Grid:
         ``value = (1 - t) f[i0] + t f[i1]``."""
         name, nodes = self.axes[k], self.nodes[k]
         lo, hi = nodes[0], nodes[-1]
-        inside = ((x >= lo) | _same(x, lo)) & ((x <= hi) | _same(x, hi))
+        inside = ((x >= lo) | same_node(x, lo)) & ((x <= hi) | same_node(x, hi))
         if not extrapolate and not np.all(inside):
             bad = float(x[~inside].flat[0])
             covered = (f"{name} = {_fmt(lo)} only (a single grid value)" if len(nodes) == 1
@@ -187,7 +151,7 @@ class _Grid:
         else:
             t = (x - a) / (b - a)
         # a value within round-off (1e-9) of a node gives that node's row exactly
-        t = np.where(_same(x, a), 0.0, np.where(_same(x, b), 1.0, t))
+        t = np.where(same_node(x, a), 0.0, np.where(same_node(x, b), 1.0, t))
         return i0, i0 + 1, t
 
     def interpolate(self, coords: list[np.ndarray], extrapolate: bool) -> dict[str, np.ndarray]:
@@ -316,7 +280,7 @@ def validate_table(data: pd.DataFrame, metadata: dict, path=None) -> None:
                          f"{_rows_text(i)} is not a vimpact status (known: "
                          + ", ".join(STATUSES) + ")")
     ok = np.isin(status, DATA_STATUSES)
-    ran = status != "invalid"  # every other row is an impact at its inputs
+    ran = status != INVALID  # every other row is an impact at its inputs
     bounds = {"e_z": (0.0, 1.0 + BOUND_SLACK, "in [0, 1 + 1e-6]"),
               "e_x": (0.0, 1.0 + BOUND_SLACK, "in [0, 1 + 1e-6]"),
               "beta_x": (-1.0 - BOUND_SLACK, 1.0 + BOUND_SLACK, "|beta_x| <= 1 + 1e-6")}
@@ -422,7 +386,7 @@ class RestitutionTable:
 
     # ---- reading and writing -------------------------------------------
     @classmethod
-    def open(cls, path, validate: bool = True) -> "RestitutionTable":
+    def open(cls, path, validate: bool = True) -> RestitutionTable:
         """Read a restitution table and its ``vimpact.*`` metadata: one Parquet file, or a
         partitioned dataset written by a large sweep (a directory of part files plus
         ``_common_metadata``, which holds the metadata).
@@ -474,7 +438,7 @@ class RestitutionTable:
             table.validate()
         return table
 
-    def validate(self) -> "RestitutionTable":
+    def validate(self) -> RestitutionTable:
         """Check the rows and metadata (:func:`validate_table`); return the table.
 
         Raises
@@ -594,12 +558,12 @@ class RestitutionTable:
     # ---- lookup ----------------------------------------------------------
     def _theta_values(self) -> np.ndarray:
         v = self.data["theta_ratio"].to_numpy(float)
-        return _cluster(v[np.isfinite(v)])[0] if np.isfinite(v).any() else np.array([])
+        return cluster_nodes(v[np.isfinite(v)])[0] if np.isfinite(v).any() else np.array([])
 
     def _resolve_theta(self, theta_ratio) -> float | None:
         """The theta_ratio slice to use (None: the table has one value / no column)."""
         if "theta_ratio" not in self.data.columns:
-            if theta_ratio is not None and not _same(theta_ratio, DEFAULT_THETA_RATIO):
+            if theta_ratio is not None and not same_node(theta_ratio, DEFAULT_THETA_RATIO):
                 raise InputError(
                     f"theta_ratio = {theta_ratio!r} is not allowed: the table has no theta_ratio "
                     f"column, so it is for Theta / (m R^2) = {DEFAULT_THETA_RATIO} (a solid sphere)")
@@ -611,7 +575,7 @@ class RestitutionTable:
                     "theta_ratio is missing: the table holds several Theta / (m R^2) = "
                     + ", ".join(_fmt(v) for v in values) + "; give one of them")
             return None
-        match = values[_same(values, theta_ratio)]
+        match = values[same_node(values, theta_ratio)]
         if not len(match):
             raise InputError(
                 f"theta_ratio = {theta_ratio!r} is not allowed: the table holds Theta / (m R^2) = "
@@ -624,7 +588,7 @@ class RestitutionTable:
         if "psi" not in self.data.columns:
             return np.array([])
         v = self.data["psi"].to_numpy(float)
-        return _cluster(v[np.isfinite(v)])[0] if np.isfinite(v).any() else np.array([])
+        return cluster_nodes(v[np.isfinite(v)])[0] if np.isfinite(v).any() else np.array([])
 
     def _base_axes(self) -> list[str]:
         model = self.model
@@ -641,7 +605,7 @@ class RestitutionTable:
         axes = self._base_axes() + (["psi"] if len(self._psi_values()) else [])
         rows = self.data
         if theta is not None:
-            rows = rows[_same(rows["theta_ratio"].to_numpy(float), theta)]
+            rows = rows[same_node(rows["theta_ratio"].to_numpy(float), theta)]
         grid = self._build_grid(axes, rows)
         self._grids[theta] = grid
         return grid
@@ -673,7 +637,7 @@ class RestitutionTable:
         if not len(rows):
             raise InputError("lookup needs a grid table, and this one has no rows with finite "
                              + ", ".join(axes))
-        nodes, index = zip(*(_cluster(coords[:, k]) for k in range(len(axes))))
+        nodes, index = zip(*(cluster_nodes(coords[:, k]) for k in range(len(axes))))
         shape = tuple(len(n) for n in nodes)
         flat = np.ravel_multi_index(tuple(index), shape)
         covered = np.unique(flat).size
@@ -859,8 +823,8 @@ class RestitutionTable:
         arrays = dict(zip(arrays, bcast))
         # one theta_ratio node: the slice at it (a table need not be a grid across thetas)
         theta = None
-        if theta_axis and np.ndim(theta_ratio) == 0 and _same(thetas, theta_ratio).any():
-            theta = float(thetas[_same(thetas, theta_ratio)][0])
+        if theta_axis and np.ndim(theta_ratio) == 0 and same_node(thetas, theta_ratio).any():
+            theta = float(thetas[same_node(thetas, theta_ratio)][0])
         if theta_axis and theta is None:
             grid, key = self._lookup_grid(), "all axes"
         else:
@@ -1050,7 +1014,7 @@ def format_info(info: dict) -> str:
     if unknown:
         lines.append(f"                  (unknown status: {', '.join(unknown)})")
     for name, r in info["ranges"].items():
-        one = r is not None and (r[0] == r[1] or (np.isfinite(r[1]) and _same(r[0], r[1])))
+        one = r is not None and (r[0] == r[1] or (np.isfinite(r[1]) and same_node(r[0], r[1])))
         text = "no data" if r is None else (_fmt(r[0]) if one else f"{_fmt(r[0])} .. {_fmt(r[1])}")
         lines.append(f"  {name:<15} {text}")
     if info["grid"]:

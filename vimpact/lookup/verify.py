@@ -29,6 +29,8 @@ import math
 import numpy as np
 import pandas as pd
 
+from vimpact.lookup.interpolate import LOG_AXES
+from vimpact.model.scene import DEFAULT_THETA_RATIO, REFERENCE_INDENTATION
 from vimpact.model.validation import InputError
 
 __all__ = ["KINDS", "held_out_errors", "held_out_points", "interpolation_error",
@@ -42,8 +44,6 @@ BOUND_FACTOR = 1.5
 #: Kinds of held-out points (see the module text).
 KINDS = ("axis", "centre", "random")
 _OUTPUTS = ("e_z", "beta_x", "e_x")
-#: Hertz indentation of the reference scene (Scene.from_dimensionless), m.
-_D_REF = 1e-4
 
 
 def numerics_of(table):
@@ -66,7 +66,7 @@ def numerics_of(table):
 
 
 def simulate_dimensionless(model: str, Q1, nu, Q2=None, *, numerics=None,
-                           theta_ratio: float = 0.4, tangential: str = "auto",
+                           theta_ratio: float = DEFAULT_THETA_RATIO, tangential: str = "auto",
                            tangential_memory: str = "incremental",
                            rotation: bool = True, psi=None, mu: float = 1.0) -> pd.DataFrame:
     """Simulate impacts given by their dimensionless parameters, columnar.
@@ -100,9 +100,9 @@ def simulate_dimensionless(model: str, Q1, nu, Q2=None, *, numerics=None,
     nu = np.asarray(nu, dtype=float)
     n = nu.size
     Q1 = np.broadcast_to(np.asarray(Q1, dtype=float), (n,))
-    E_star = 15.0 / (16.0 * _D_REF**2.5)  # m = R = v_z0 = 1
+    E_star = 15.0 / (16.0 * REFERENCE_INDENTATION**2.5)  # m = R = v_z0 = 1
     G = E_star * (1.0 - nu) / 2.0
-    eta = Q1 / Q1_PER_TAU * _D_REF * G
+    eta = Q1 / Q1_PER_TAU * REFERENCE_INDENTATION * G
     cols = {"nu": nu, "G_inf_Pa": G, "R_m": np.ones(n), "m_kg": np.ones(n),
             "v_z0_m_s": np.ones(n), "v_x0_m_s": np.ones(n), "omega0_rad_s": np.zeros(n),
             "theta_ratio": np.full(n, float(theta_ratio)),
@@ -128,7 +128,7 @@ def held_out_points(axes: list[str], nodes: list[np.ndarray], n_random: int = 20
 
     Parameters
     ----------
-    axes : axis names (``Q1``, ``Q2`` are log axes)
+    axes : axis names (those in :data:`~vimpact.lookup.interpolate.LOG_AXES` are log axes)
     nodes : increasing node values per axis
     n_random : number of random interior points
     seed : seed of the random points
@@ -139,7 +139,7 @@ def held_out_points(axes: list[str], nodes: list[np.ndarray], n_random: int = 20
     DataFrame with one column per axis, ``kind`` and ``axis`` (the axis an
     ``axis`` point is mid-way along; empty otherwise).
     """
-    log = [a in ("Q1", "Q2") for a in axes]
+    log = [a in LOG_AXES for a in axes]
     mids = [np.sqrt(n[:-1] * n[1:]) if lg else 0.5 * (n[:-1] + n[1:])
             for n, lg in zip(nodes, log)]
     frames = []
@@ -216,7 +216,7 @@ def held_out_errors(table, numerics=None, n: int = 200, seed: int = 0, theta_rat
     if theta is None:
         t = theta_ratio if theta_ratio is not None else (
             float(table._theta_values()[0]) if "theta_ratio" in table.data.columns
-            and len(table._theta_values()) else 0.4)
+            and len(table._theta_values()) else DEFAULT_THETA_RATIO)
     else:
         t = theta
     psi = pts["psi"].to_numpy() if "psi" in pts else None
@@ -247,7 +247,8 @@ def _node_error(table, numerics, theta_ratio, n_nodes: int, seed: int, simulate=
         return {}
     pick = np.random.default_rng(seed).choice(len(rows), min(n_nodes, len(rows)), replace=False)
     rows = rows.iloc[np.sort(pick)]
-    t = float(rows["theta_ratio"].iloc[0]) if "theta_ratio" in rows.columns else 0.4
+    t = (float(rows["theta_ratio"].iloc[0]) if "theta_ratio" in rows.columns
+         else DEFAULT_THETA_RATIO)
     Q2 = rows["Q2"].to_numpy(float) if table.model == "standard_solid" else None
     psi = rows["psi"].to_numpy(float) if "psi" in rows.columns else None
     sim = (simulate or simulate_dimensionless)(
@@ -285,7 +286,8 @@ def interpolation_error(table, numerics=None, n: int = 200, seed: int = 0, theta
     dict (JSON-serializable): ``method``, ``points`` (held-out points simulated),
     ``failed`` (points whose simulation or lookup failed, left out), ``kinds``,
     ``seed``, ``numerics``, ``outputs`` (name -> ``max``, ``rms``, ``bound`` =
-    :data:`BOUND_FACTOR` x ``max``, dimensionless, and ``at``: the point of the max), ``per_axis`` (axis -> name -> max over
+    :data:`BOUND_FACTOR` x ``max``, dimensionless, and ``at``: the point of the max),
+    ``per_axis`` (axis -> name -> max over
     that axis's mid-points), ``node_error`` (name -> max over the node sample),
     ``vimpact_version``.
     """

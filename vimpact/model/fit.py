@@ -233,7 +233,7 @@ def load_measurements(path) -> tuple[str, dict[str, np.ndarray]]:
     if kind is None:
         raise InputError(f"{path}: " + message("columns", ", ".join(header), " or ".join(
             ", ".join(c) for c in MEASUREMENT_COLUMNS.values()) + " (shear moduli)"))
-    data = {c: [] for c in header}
+    data: dict[str, list[float]] = {c: [] for c in header}
     for line, row in rows[1:]:
         if len(row) != len(header):
             raise InputError(f"{path}: line {line}: " + message(

@@ -61,6 +61,6 @@ def hertz_scales(G, nu, R, m, v_z0) -> HertzScales:
     a_H = np.sqrt(R * d)
     T = d / v_z0
     out = HertzScales(d, a_H, T, HERTZ_TIME_FACTOR * T)
-    if out.d.ndim == 0:
+    if np.ndim(out.d) == 0:
         out = HertzScales(*(float(x) for x in out))
     return out

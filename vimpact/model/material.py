@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, cast
 
 from vimpact.model.temperature import ShiftLaw
 from vimpact.model.validation import non_negative, poisson_ratio, positive, require
@@ -81,20 +81,20 @@ class Material:
 
     # ---- constructors -------------------------------------------------
     @classmethod
-    def elastic(cls, nu: float, G: float | None = None, E: float | None = None) -> "Material":
+    def elastic(cls, nu: float, G: float | None = None, E: float | None = None) -> Material:
         """Elastic half-space with shear modulus ``G`` or Young's modulus ``E`` (Pa)."""
         nu = poisson_ratio("nu", nu)
         return cls("elastic", nu, _modulus(G, E, nu))
 
     @classmethod
     def kelvin_voigt(cls, nu: float, eta: float, G: float | None = None,
-                     E: float | None = None) -> "Material":
+                     E: float | None = None) -> Material:
         """Kelvin-Voigt body: spring ``G`` (or ``E``, Pa) parallel to a dashpot ``eta`` (Pa s)."""
         nu = poisson_ratio("nu", nu)
         return cls("kelvin_voigt", nu, _modulus(G, E, nu), (), non_negative("eta", eta))
 
     @classmethod
-    def standard_solid(cls, nu: float, G1: float, G2: float, eta: float) -> "Material":
+    def standard_solid(cls, nu: float, G1: float, G2: float, eta: float) -> Material:
         """Standard linear solid: spring ``G1`` parallel to a Maxwell arm (spring ``G2``,
         dashpot ``eta``). Moduli in Pa, ``eta`` in Pa s; arm time ``tau = eta / G2``."""
         nu = poisson_ratio("nu", nu)
@@ -105,7 +105,7 @@ class Material:
         return cls("standard_solid", nu, G1, ((G2, eta / G2),))
 
     @classmethod
-    def prony(cls, nu: float, G_inf: float, arms, eta0: float = 0.0) -> "Material":
+    def prony(cls, nu: float, G_inf: float, arms, eta0: float = 0.0) -> Material:
         """Prony series: relaxed modulus ``G_inf`` (Pa), arms ``[(G_i [Pa], tau_i [s]), ...]``,
         optional parallel dashpot ``eta0`` (Pa s)."""
         nu = poisson_ratio("nu", nu)
@@ -122,7 +122,7 @@ class Material:
     @classmethod
     def from_dma(cls, frequency_Hz, storage_Pa, loss_Pa, nu: float, *,
                  per_decade: float = 2.0, dashpot: bool = False,
-                 shift: ShiftLaw | None = None) -> "PronyFit":
+                 shift: ShiftLaw | None = None) -> PronyFit:
         """A Prony material fitted to a dynamic (DMA) master curve of the shear moduli.
 
         Non-negative least squares on log-spaced relaxation times
@@ -145,7 +145,7 @@ class Material:
 
     @classmethod
     def from_relaxation(cls, time_s, modulus_Pa, nu: float, *, per_decade: float = 2.0,
-                        shift: ShiftLaw | None = None) -> "PronyFit":
+                        shift: ShiftLaw | None = None) -> PronyFit:
         """A Prony material fitted to a shear relaxation modulus ``G(t)`` (Pa at ``t`` in s).
 
         Non-negative least squares on log-spaced relaxation times
@@ -157,12 +157,12 @@ class Material:
         return fit_relaxation(time_s, modulus_Pa, nu, per_decade=per_decade, shift=shift)
 
     # ---- temperature --------------------------------------------------
-    def with_shift(self, shift: ShiftLaw | None) -> "Material":
+    def with_shift(self, shift: ShiftLaw | None) -> Material:
         """This material with the temperature shift law ``shift`` (its ``T_ref`` is the
         temperature of this material's times)."""
         return dataclasses.replace(self, shift=shift)
 
-    def at_temperature(self, T: float) -> "Material":
+    def at_temperature(self, T: float) -> Material:
         """This material at the temperature ``T`` (K): every relaxation time and the
         dashpot viscosity times the shift factor ``a_T`` of :attr:`shift`, moduli
         unchanged; the result's shift law is referenced to ``T``.
@@ -173,13 +173,14 @@ class Material:
         require("temperature (K)", T, self.shift is not None,
                 "used only with a material that has a temperature shift law (T_ref and "
                 "WLF or Arrhenius constants)")
-        a_T = self.shift.shift_factor(T)
+        shift = cast(ShiftLaw, self.shift)  # checked above
+        a_T = shift.shift_factor(T)
         arms = tuple((G, a_T * tau) for G, tau in self.arms)
         for i, (_, tau) in enumerate(arms, start=1):
             positive(f"tau_{i} at temperature {T!r} K (arm {i} relaxation time a_T tau_i, s; "
                      f"a_T = {a_T:.4g})", tau)
         return dataclasses.replace(self, arms=arms, eta0=a_T * self.eta0,
-                                   shift=self.shift.referenced_to(T))
+                                   shift=shift.referenced_to(T))
 
     # ---- derived ------------------------------------------------------
     @property

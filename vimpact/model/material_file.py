@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
+from typing import Any
 
 from vimpact.model.material import Material, shear_modulus
 from vimpact.model.temperature import LAWS, ShiftLaw
@@ -89,8 +90,8 @@ def material_from_table(table, where: str = "material", source: str = "<string>"
     """A :class:`vimpact.Material` from a material table (keys in the module doc)."""
     if not isinstance(table, dict):
         raise _err(source, where, table, 'a table with "model" and its moduli')
-    model = table.get("model")
-    require(f"{source}: {where}.model", model, model in MATERIAL_TABLE_KEYS,
+    model = str(table.get("model"))
+    require(f"{source}: {where}.model", table.get("model"), model in MATERIAL_TABLE_KEYS,
             "one of " + ", ".join(map(repr, MATERIAL_TABLE_KEYS)))
     unknown = sorted(set(table) - set(MATERIAL_TABLE_KEYS[model]))
     if unknown:
@@ -116,7 +117,7 @@ def material_from_table(table, where: str = "material", source: str = "<string>"
         else:
             G_inf = v["G_inf"] if "G_inf" in v else shear_modulus(positive("E_inf", v.get("E_inf")),
                                                                   nu)
-            arms = v.get("arms", [])
+            arms: Any = v.get("arms", [])
             require(f"{where}.arms", arms, isinstance(arms, list) and all(
                 isinstance(a, list) and len(a) == 2 for a in arms),
                 "a list of [G_i (Pa), tau_i (s)]")

@@ -5,11 +5,13 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, replace
 
-from vimpact.kernels.layout import EULER, SYMPLECTIC_EULER, VERLET
 from vimpact.model.validation import one_of, positive, require
 
 #: Integrators by name (see :mod:`vimpact.kernels.elements`) and their nominal order.
-INTEGRATORS = {"euler": EULER, "symplectic_euler": SYMPLECTIC_EULER, "verlet": VERLET}
+#: The numbers are the kernels' integrator codes (``EULER``, ``SYMPLECTIC_EULER``,
+#: ``VERLET`` of :mod:`vimpact.kernels.layout`), written out because the model
+#: imports no other folder; ``tests/model/test_numerics_codes.py`` checks they agree.
+INTEGRATORS = {"euler": 0, "symplectic_euler": 1, "verlet": 2}
 ORDER = {"euler": 1, "symplectic_euler": 1, "verlet": 2}
 
 
@@ -70,7 +72,7 @@ class Numerics:
                     "between 1e-9 and 1e-2")
 
     @classmethod
-    def for_tolerance(cls, tolerance: float, integrator: str = "verlet") -> "Numerics":
+    def for_tolerance(cls, tolerance: float, integrator: str = "verlet") -> Numerics:
         """Numerics that reach ``tolerance`` on e_z and beta_x on the path that runs.
 
         The continuum paths (every full-stick scene with incremental memory;
@@ -134,7 +136,7 @@ class Numerics:
         return None
 
     @classmethod
-    def preset(cls, name: str) -> "Numerics":
+    def preset(cls, name: str) -> Numerics:
         """Named settings (:data:`PRESETS`): ``fast`` (2.3e-4 on e_z, e_x on the
         element path), ``default`` (3.1e-5 there), ``precise`` (1e-9 and better
         on the continuum paths; 4.9e-7 on the element path at its caps, the best
@@ -150,12 +152,13 @@ class Numerics:
         one_of("numerics preset", name, tuple(PRESETS))
         return PRESETS[name]
 
-    def with_(self, **changes) -> "Numerics":
+    def with_(self, **changes) -> Numerics:
         """A copy with some fields changed (validated)."""
         return replace(self, **changes)
 
     @property
     def integrator_code(self) -> int:
+        """The kernels' code of :attr:`integrator` (:data:`INTEGRATORS`)."""
         return INTEGRATORS[self.integrator]
 
 
@@ -236,3 +239,17 @@ PRESETS = {
     "precise": Numerics(steps=16000, elements=3200, rtol=1e-12),
     "thesis": Numerics(integrator="euler", steps=5000, elements=500),
 }
+
+
+#: The presets that converge (not the thesis's explicit Euler): for fits and exports.
+CONVERGED_PRESETS = tuple(n for n, p in PRESETS.items() if p.integrator != "euler")
+
+
+def preset_summary(name: str) -> str:
+    """One line on preset ``name`` for help texts: its error bound on the element
+    path (:func:`element_error_bound`, dimensionless), or what the thesis preset is."""
+    p = PRESETS[name]
+    if p.integrator == "euler":
+        return f"{name} (explicit Euler as in the thesis)"
+    bound = f"{element_error_bound(p.steps, p.elements):.0e}".replace("e-0", "e-")
+    return f"{name} (about {bound} on the element path)"

@@ -53,9 +53,7 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass, field
-from collections.abc import Sequence
-
-import numpy as np
+from typing import cast
 
 from vimpact.model.material import Material
 from vimpact.model.scene import DEFAULT_THETA_RATIO, Scene
@@ -106,7 +104,7 @@ class Body:
     @property
     def spin_compliance(self) -> float:
         """``R^2 / Theta`` (0 without rotation), 1/kg."""
-        return self.R**2 / self.Theta if self.rotation else 0.0
+        return self.R**2 / cast(float, self.Theta) if self.rotation else 0.0
 
 
 @dataclass(frozen=True)
@@ -180,7 +178,7 @@ def pair_material(mat1: Material | None, mat2: Material | None) -> Material:
         raise InputError("materials = (rigid, rigid) is not allowed: must be at least one "
                          "deformable body (two rigid bodies have no contact law)")
     if mat1 is None or mat2 is None:
-        return mat2 if mat1 is None else mat1
+        return cast(Material, mat2 if mat1 is None else mat1)  # not both: refused above
     lam = _proportion(mat1, mat2)
     if lam is not None:
         return _scaled(mat1, lam / (1.0 + lam))
@@ -276,118 +274,27 @@ class PairResult:
     result: object = field(default=None, repr=False)
 
 
-def _reconstruct(body1: Body, other: Body | Wall, scene: Scene, e_z: float, beta_x: float):
-    """Both bodies' end states from the relative result (momentum exactly conserved)."""
+def end_states(body1: Body, other: Body | Wall, scene: Scene, e_z: float, beta_x: float):
+    """Both bodies' end states from the relative result (momentum exactly conserved).
+
+    Returns ``(v_z, v_x, omega)`` of body 1 and of body 2 (``None`` for a wall;
+    m/s, m/s, rad/s) and the impulses ``J_z, J_x`` on body 1 (N s), from the
+    equivalent ``scene`` and its ``e_z``, ``beta_x`` (dimensionless).
+    """
     v_z_end = -e_z * scene.v_z0  # relative normal velocity after (moving apart)
     J_z = scene.m * (v_z_end - scene.v_z0)  # on body 1, along z
     if scene.computes_tangential and math.isfinite(beta_x):
         v_c_end = -beta_x * scene.v_c0
-        spin_total = scene.R**2 / scene.Theta if scene.rotation else 0.0
+        spin_total = scene.R**2 / cast(float, scene.Theta) if scene.rotation else 0.0
         P = (scene.v_c0 - v_c_end) / (1.0 / scene.m + spin_total)  # tangential impulse magnitude
     else:
         P = 0.0
     J_x = -P  # on body 1
     b1 = (body1.v_z + J_z / body1.m, body1.v_x + J_x / body1.m,
-          body1.omega + (body1.R * J_x / body1.Theta if body1.rotation else 0.0))
+          body1.omega + (body1.R * J_x / cast(float, body1.Theta) if body1.rotation else 0.0))
     if isinstance(other, Wall):
         return b1, None, J_z, J_x
     # body 2 gets -J at its contact point (-R2 along z): torque_y = -R2 * (-J_x)
     b2 = (other.v_z - J_z / other.m, other.v_x - J_x / other.m,
-          other.omega + (other.R * J_x / other.Theta if other.rotation else 0.0))
+          other.omega + (other.R * J_x / cast(float, other.Theta) if other.rotation else 0.0))
     return b1, b2, J_z, J_x
-
-
-def simulate_pair(body1: Body, other: Body | Wall, numerics=None, **scene_options) -> PairResult:
-    """Simulate body 1 hitting body 2 (or a wall).
-
-    Parameters
-    ----------
-    body1 : the first body; ``other`` : the second body or a :class:`Wall`
-    numerics : :class:`vimpact.Numerics` (default: the engine's default)
-    scene_options : ``tangential``, ``tangential_memory``, ``mu``,
-        ``allow_large_contact`` of the equivalent scene (:func:`pair_scene`)
-
-    Returns
-    -------
-    PairResult
-    """
-    from vimpact.engine.simulate import simulate
-
-    scene = pair_scene(body1, other, **scene_options)
-    res = simulate(scene, numerics)
-    b1, b2, J_z, J_x = _reconstruct(body1, other, scene, res.e_z, res.beta_x)
-    return PairResult(res.e_z, res.beta_x, b1, b2, J_z, J_x, res.status, scene, res)
-
-
-def simulate_pair_batch(pairs: Sequence[tuple[Body, Body | Wall]], numerics=None,
-                        **scene_options):
-    """Simulate many pair impacts in one batch.
-
-    Parameters
-    ----------
-    pairs : sequence of ``(body1, body2_or_wall)``
-    numerics, scene_options : as :func:`simulate_pair`
-
-    Returns
-    -------
-    pandas.DataFrame
-        one row per pair: ``e_z, beta_x, status, t_contact_s`` and the end
-        states ``v_z1, v_x1, omega1, v_z2, v_x2, omega2`` (m/s, rad/s; NaN for a
-        wall) and the impulses on body 1 ``J_z, J_x`` (N s).
-    """
-    import pandas as pd
-
-    from vimpact.engine.simulate import simulate_batch
-
-    scenes = [pair_scene(b1, b2, **scene_options) for b1, b2 in pairs]
-    df = simulate_batch(scenes, numerics)
-    rows = []
-    for (b1, b2), s, e_z, beta_x in zip(pairs, scenes, df["e_z"].to_numpy(),
-                                        df["beta_x"].to_numpy()):
-        end1, end2, J_z, J_x = _reconstruct(b1, b2, s, float(e_z), float(beta_x))
-        end2 = end2 or (np.nan, np.nan, np.nan)
-        rows.append((*end1, *end2, J_z, J_x))
-    ends = pd.DataFrame(rows, columns=["v_z1", "v_x1", "omega1", "v_z2", "v_x2", "omega2",
-                                       "J_z", "J_x"])
-    out = pd.concat([df[["e_z", "beta_x", "status", "t_contact"]].reset_index(drop=True), ends],
-                    axis=1)
-    bad = ~np.isfinite(out["e_z"].to_numpy(dtype=float))
-    out.loc[bad, ["v_z1", "v_x1", "omega1", "v_z2", "v_x2", "omega2", "J_z", "J_x"]] = np.nan
-    return out.rename(columns={"t_contact": "t_contact_s"})
-
-
-def pair_restitution(body1: Body, other: Body | Wall, speeds, *, tangential: bool = False,
-                     vc_ratio: float = 1.0, numerics=None, mu: float = math.inf):
-    """``e_z`` (and ``beta_x``) of a pair over approach speeds: the curves DEM fits need.
-
-    Parameters
-    ----------
-    body1, other : the pair (their velocities are ignored)
-    speeds : approach speeds ``v_z0``, m/s (array)
-    tangential : also solve the tangential problem (full stick unless ``mu``)
-        with ``v_c0 = vc_ratio * v_z0``; otherwise normal only (fast)
-    numerics : :class:`vimpact.Numerics`
-
-    Returns
-    -------
-    pandas.DataFrame with columns ``v_z0, e_z, beta_x, t_contact, a_max, status``.
-    """
-    from vimpact.engine.simulate import simulate_batch
-
-    speeds = np.asarray(speeds, dtype=float)
-    require("speeds", speeds, speeds.ndim == 1 and speeds.size > 0 and bool(np.all(speeds > 0))
-            and bool(np.all(np.isfinite(speeds))), "a non-empty 1-D array of finite speeds > 0")
-    base = pair_scene(Body(body1.material, body1.R, body1.m, body1.Theta, v_z=1.0,
-                           rotation=body1.rotation),
-                      other if isinstance(other, Wall) else
-                      Body(other.material, other.R, other.m, other.Theta, rotation=other.rotation),
-                      tangential="stick" if tangential else "none", mu=mu,
-                      allow_large_contact=True)
-    scenes = [Scene(base.material, R=base.R, m=base.m, v_z0=v, v_x0=vc_ratio * v if tangential
-                    else 0.0, Theta=base.Theta if base.rotation else None,
-                    rotation=base.rotation, tangential=base.tangential, mu=mu,
-                    allow_large_contact=True) for v in speeds]
-    df = simulate_batch(scenes, numerics)
-    out = df[["e_z", "beta_x", "t_contact", "a_max", "status"]].reset_index(drop=True)
-    out.insert(0, "v_z0", speeds)
-    return out

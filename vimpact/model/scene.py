@@ -3,14 +3,23 @@
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass, field
+from typing import cast
 
 import numpy as np
-from dataclasses import dataclass, field
 
-from vimpact.model.hertz import HertzScales, Q1_PER_TAU, effective_modulus, hertz_scales
+from vimpact.model.hertz import Q1_PER_TAU, HertzScales, effective_modulus, hertz_scales
 from vimpact.model.material import Material
-from vimpact.model.validation import (InputError, finite, flag, friction_coefficient, one_of,
-                                     poisson_ratio, positive, require)
+from vimpact.model.validation import (
+    InputError,
+    finite,
+    flag,
+    friction_coefficient,
+    one_of,
+    poisson_ratio,
+    positive,
+    require,
+)
 
 TANGENTIAL_MEMORY = ("incremental", "seed")
 
@@ -22,6 +31,9 @@ TANGENTIAL_EFFECTS = ("auto", "stick", "none")
 
 #: ``Theta / (m R^2)`` of a solid sphere, the default moment of inertia.
 DEFAULT_THETA_RATIO = 0.4
+#: Hertz indentation (m) of the reference scene of :meth:`Scene.from_dimensionless`
+#: (R = 1 m, m = 1 kg, v_z0 = 1 m/s): a_H = sqrt(R d) = 0.01 R.
+REFERENCE_INDENTATION = 1e-4
 
 #: The thesis's half-space limit: contact half-width at most this times R.
 HALF_SPACE_LIMIT = 0.2
@@ -98,7 +110,8 @@ class Scene:
         if self.Theta is None:
             theta = DEFAULT_THETA_RATIO * self.m * self.R**2 if self.R < 1e150 else math.inf
             require("R", self.R, 0.0 < theta < math.inf,
-                    f"large enough for the default Theta = 0.4 m R^2 to be a finite number > 0 "
+                    f"large enough for the default Theta = {DEFAULT_THETA_RATIO} m R^2 to be a "
+                    "finite number > 0 "
                     f"(with m = {self.m:g} kg; give Theta)")
             object.__setattr__(self, "Theta", theta)
         object.__setattr__(self, "Theta", positive("Theta", self.Theta))
@@ -142,7 +155,7 @@ class Scene:
     def from_dimensionless(cls, Q1: float, nu: float, Q2: float | None = None, *,
                            theta_ratio: float = DEFAULT_THETA_RATIO,
                            tangential_memory: str = "incremental", tangential: str = "auto",
-                           rotation: bool = True, mu: float = math.inf) -> "Scene":
+                           rotation: bool = True, mu: float = math.inf) -> Scene:
         """A physical scene with the given dimensionless parameters.
 
         Kelvin-Voigt for ``Q2 = None``, standard solid otherwise. Restitution
@@ -161,7 +174,7 @@ class Scene:
                     "e_z < 1e-160)")
         nu = poisson_ratio("nu", nu)  # a type check too: float("0.5") would take a string
         R, m, v_z0 = 1.0, 1.0, 1.0
-        d = 1e-4  # a_H = sqrt(R d) = 0.01 R
+        d = REFERENCE_INDENTATION  # a_H = sqrt(R d) = 0.01 R
         E_star = 15.0 * m * v_z0**2 / (16.0 * math.sqrt(R) * d**2.5)
         G = E_star * (1.0 - nu) / 2.0
         tau = Q1 / Q1_PER_TAU * d / v_z0  # eta / G_inf, s
@@ -187,7 +200,7 @@ class Scene:
     @property
     def theta_ratio(self) -> float:
         """``Theta / (m R^2)``, dimensionless."""
-        return self.Theta / (self.m * self.R**2)
+        return cast(float, self.Theta) / (self.m * self.R**2)
 
     @property
     def computes_tangential(self) -> bool:
@@ -217,7 +230,7 @@ class Scene:
     @property
     def Q1(self) -> float:
         """``Q1 = sqrt(15/32) (eta / G_inf) / T``, dimensionless (NaN for a general Prony series)."""
-        return Q1_PER_TAU * self.material.viscous_time() / self.hertz.T
+        return float(Q1_PER_TAU * self.material.viscous_time() / self.hertz.T)
 
     @property
     def Q2(self) -> float:
@@ -227,4 +240,5 @@ class Scene:
     @property
     def kinetic_energy(self) -> float:
         """Kinetic energy before the impact, J."""
-        return 0.5 * (self.m * (self.v_z0**2 + self.v_x0**2) + self.Theta * self.omega0**2)
+        return 0.5 * (self.m * (self.v_z0**2 + self.v_x0**2)
+                      + cast(float, self.Theta) * self.omega0**2)

@@ -80,10 +80,21 @@ from pathlib import Path
 from vimpact.model.material_file import inline_material
 from vimpact.model.numerics import Numerics
 from vimpact.model.scene import ScaleError, Scene
-from vimpact.model.toml_input import (ARM_KEYS, PHYSICAL_DEFAULTS,
-                                      SWEEP_TOP_KEYS, TomlSource, friction_coefficient,
-                                      impact_angle, input_keys, parse_header, parse_numerics,
-                                      parse_toml, read_toml, required_keys, scene_from_values)
+from vimpact.model.toml_input import (
+    ARM_KEYS,
+    PHYSICAL_DEFAULTS,
+    SWEEP_TOP_KEYS,
+    TomlSource,
+    friction_coefficient,
+    impact_angle,
+    input_keys,
+    parse_header,
+    parse_numerics,
+    parse_toml,
+    read_toml,
+    required_keys,
+    scene_from_values,
+)
 
 #: Top-level keys of a scene file.
 TOP_KEYS = ("model", "description", "tangential_memory", "tangential", "rotation",

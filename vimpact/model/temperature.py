@@ -80,13 +80,13 @@ class ShiftLaw:
 
     @classmethod
     def wlf(cls, T_ref: float, C1: float = UNIVERSAL_WLF[0],
-            C2: float = UNIVERSAL_WLF[1]) -> "ShiftLaw":
+            C2: float = UNIVERSAL_WLF[1]) -> ShiftLaw:
         """WLF law at ``T_ref`` (K) with ``C1`` (dimensionless) and ``C2`` (K); the
         defaults are the universal constants, meant for ``T_ref = T_g``."""
         return cls("wlf", float(T_ref), C1=float(C1), C2=float(C2))
 
     @classmethod
-    def arrhenius(cls, T_ref: float, E_a: float) -> "ShiftLaw":
+    def arrhenius(cls, T_ref: float, E_a: float) -> ShiftLaw:
         """Arrhenius law at ``T_ref`` (K) with activation energy ``E_a`` (J/mol)."""
         return cls("arrhenius", float(T_ref), E_a=float(E_a))
 
@@ -117,7 +117,7 @@ class ShiftLaw:
             return 10.0 ** log10_a
         return math.exp(self.E_a / GAS_CONSTANT * (1.0 / T - 1.0 / self.T_ref))
 
-    def referenced_to(self, T: float) -> "ShiftLaw":
+    def referenced_to(self, T: float) -> ShiftLaw:
         """The same law with ``T`` (K) as its reference temperature: for a material
         already shifted to ``T``. For WLF ``C1' = C1 C2 / (C2 + T - T_ref)`` and
         ``C2' = C2 + T - T_ref``, which give the same shift between any two temperatures."""

@@ -34,7 +34,7 @@ import numpy as np
 
 from vimpact.model.material import MODELS, Material
 from vimpact.model.numerics import PRESETS, Numerics
-from vimpact.model.scene import TANGENTIAL_EFFECTS, TANGENTIAL_MEMORY, Scene
+from vimpact.model.scene import DEFAULT_THETA_RATIO, TANGENTIAL_EFFECTS, TANGENTIAL_MEMORY, Scene
 from vimpact.model.validation import InputError
 
 #: Material keys per model (Pa, Pa s).
@@ -47,7 +47,7 @@ MATERIAL_KEYS = {
 #: Sphere and initial-velocity keys (m, kg, m/s, m/s, rad/s).
 SPHERE_KEYS = ("R_m", "m_kg", "v_z0_m_s", "v_x0_m_s", "omega0_rad_s")
 #: Defaults of the optional physical keys (``eta_Pa_s``: optional for Prony only).
-PHYSICAL_DEFAULTS = {"v_x0_m_s": 0.0, "omega0_rad_s": 0.0, "theta_ratio": 0.4}
+PHYSICAL_DEFAULTS = {"v_x0_m_s": 0.0, "omega0_rad_s": 0.0, "theta_ratio": DEFAULT_THETA_RATIO}
 #: Optional friction keys (after the physical keys, in this order): Coulomb friction
 #: coefficient (1; default inf, full stick) and impact angle from the normal (degrees;
 #: an alternative to ``v_x0_m_s``).
@@ -98,7 +98,7 @@ def tangential_speed(v_z0, angle_deg):
     return float(out) if out.ndim == 0 else out
 
 
-def friction_coefficient(source: "TomlSource", key: str, value) -> float:
+def friction_coefficient(source: TomlSource, key: str, value) -> float:
     """A Coulomb friction coefficient: a number >= 0, or ``inf`` (TOML ``inf`` or the
     string ``"inf"``) for full stick."""
     if isinstance(value, str) and value.strip().lower() in ("inf", "+inf", "infinity"):
@@ -108,7 +108,7 @@ def friction_coefficient(source: "TomlSource", key: str, value) -> float:
     return float(value)
 
 
-def impact_angle(source: "TomlSource", key: str, value) -> float:
+def impact_angle(source: TomlSource, key: str, value) -> float:
     """An impact angle from the normal, degrees, in [0, 90)."""
     lo, hi = ANGLE_RANGE_DEG
     return source.number(key, value, lambda x: lo <= x < hi,
@@ -127,12 +127,15 @@ class TomlSource:
         self.path = path
 
     def error(self, key: str, message: str) -> ValueError:
+        """The error for ``key`` of this file, with ``message``."""
         return ValueError(f"{self.path}: {key}: {message}")
 
     def bad(self, key: str, value, allowed: str) -> ValueError:
+        """The error for ``key = value``: not allowed, must be ``allowed``."""
         return ValueError(f"{self.path}: {key} = {value!r} is not allowed: must be {allowed}")
 
     def unknown(self, table: dict, allowed, where: str = "") -> None:
+        """Raise for the first key of ``table`` (under ``where``) not in ``allowed``."""
         for key in table:
             if key not in allowed:
                 name = f"{where}.{key}" if where else key
@@ -140,22 +143,26 @@ class TomlSource:
                                  f"{', '.join(allowed)})")
 
     def number(self, key: str, value, check=None, allowed="a finite number") -> float:
+        """``value`` as a finite float that passes ``check``, else the error naming ``key``."""
         if not is_number(value) or not math.isfinite(value) or (check and not check(value)):
             raise self.bad(key, value, allowed)
         return float(value)
 
     def integer(self, key: str, value, minimum: int) -> int:
+        """``value`` as an integer >= ``minimum`` (not a bool), else the error naming ``key``."""
         if not isinstance(value, int) or isinstance(value, bool) or value < minimum:
             raise self.bad(key, value, f"an integer >= {minimum}")
         return value
 
     def choice(self, data: dict, key: str, choices, default: str) -> str:
+        """``data[key]`` (``default`` if absent), one of ``choices``."""
         value = data.get(key, default)
         if value not in choices:
             raise self.bad(key, value, "one of " + ", ".join(map(repr, choices)))
         return value
 
     def flag(self, data: dict, key: str, default: bool) -> bool:
+        """``data[key]`` (``default`` if absent), a bool."""
         value = data.get(key, default)
         if not isinstance(value, bool):
             raise self.bad(key, value, "true or false")

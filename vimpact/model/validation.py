@@ -33,6 +33,12 @@ RULES = {
 }
 
 
+def is_none(values) -> np.ndarray:
+    """Elementwise ``value is None`` of an object array (e.g. the reasons column: no
+    reason yet), as a bool array."""
+    return np.equal(values, None)  # type: ignore[call-overload]  # (stubs: no None operand)
+
+
 def message(name: str, value, allowed: str) -> str:
     """The one wording of every input error."""
     return f"{name} = {value!r} is not allowed: must be {allowed}"
@@ -124,7 +130,7 @@ def check_column(name: str, values, rule: str, reasons: np.ndarray) -> np.ndarra
         bad = ~test(x)
     if raw.dtype.kind == "b":
         bad[:] = True
-    for i in np.flatnonzero(bad & np.equal(reasons, None)):
+    for i in np.flatnonzero(bad & is_none(reasons)):
         reasons[i] = message(name, raw.ravel()[i].item() if hasattr(raw.ravel()[i], "item")
                              else raw.ravel()[i], allowed if raw.dtype.kind != "b" else "a number")
     x[bad] = np.nan

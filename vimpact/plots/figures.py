@@ -16,44 +16,27 @@ scipy are imported only when a figure is drawn.
 
 from __future__ import annotations
 
-import contextlib
 import math
+from collections.abc import Callable
 from pathlib import Path
-from typing import Callable, NamedTuple
+from typing import NamedTuple
 
 import numpy as np
 import pandas as pd
 
+from vimpact.engine.simulate import simulate, simulate_batch
+from vimpact.lookup.interpolate import cluster_nodes, same_node
+from vimpact.lookup.table import DATA_STATUSES, RestitutionTable
 from vimpact.model.material import Material
-from vimpact.plots.catalogue import CATALOGUE, FIGURE_NAMES, figure_name  # noqa: F401 - re-exported
 from vimpact.model.numerics import Numerics
 from vimpact.model.scene import Scene
-from vimpact.engine.simulate import simulate, simulate_batch
-from vimpact.lookup.table import DATA_STATUSES, RestitutionTable, _cluster, _same
+from vimpact.plots.catalogue import CATALOGUE, FIGURE_NAMES, figure_name  # noqa: F401 - re-exported
+from vimpact.plots.style import FORMATS, STYLE  # noqa: F401
+from vimpact.plots.style import check_out as _check_out
+from vimpact.plots.style import drawing as _drawing
 
 __all__ = ["FIGURES", "FIGURE_NAMES", "FORMATS", "plot_figure", "figure_name",
            "fig3_2", "fig4_2", "fig4_4", "fig5_1", "fig5_2", "fig5_3", "fig5_4", "fig5_5"]
-
-#: Output formats, chosen by the extension of ``out``.
-FORMATS = (".png", ".svg", ".pdf")
-
-#: Sizes readable in print at about 8 cm to 16 cm width.
-STYLE = {
-    "font.size": 11,
-    "axes.titlesize": 12,
-    "axes.labelsize": 12,
-    "xtick.labelsize": 10,
-    "ytick.labelsize": 10,
-    "legend.fontsize": 9.5,
-    "legend.framealpha": 0.9,
-    "lines.linewidth": 1.6,
-    "lines.markersize": 5,
-    "axes.grid": True,
-    "grid.alpha": 0.3,
-    "savefig.dpi": 200,
-    "svg.fonttype": "none",
-    "pdf.fonttype": 42,
-}
 
 _DIMLESS = "(dimensionless)"
 _Q1_LABEL = r"$Q_1$ " + _DIMLESS
@@ -63,34 +46,6 @@ _MARKERS = ("o", "s", "^", "D", "v", "P", "X", "*")
 # --------------------------------------------------------------------------
 # helpers
 # --------------------------------------------------------------------------
-
-def _check_out(out) -> Path:
-    path = Path(out)
-    if path.suffix.lower() not in FORMATS:
-        raise ValueError(f"out = {str(out)!r} is not allowed: must end in "
-                         + ", ".join(FORMATS) + " (the format follows the extension)")
-    if not path.parent.is_dir():
-        raise ValueError(f"out = {str(out)!r} is not allowed: directory "
-                         f"{str(path.parent)!r} does not exist")
-    return path
-
-
-@contextlib.contextmanager
-def _drawing(out, nrows=1, ncols=1, figsize=(6.4, 4.4), **subplots):
-    """Yield ``(fig, axes)`` with the house style; save to ``out`` on exit."""
-    import matplotlib
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
-
-    path = _check_out(out)
-    with matplotlib.rc_context(STYLE):
-        fig = Figure(figsize=figsize, layout="constrained")
-        FigureCanvasAgg(fig)
-        axes = fig.subplots(nrows, ncols, squeeze=True, **subplots)
-        yield fig, axes
-        fig.savefig(path)
-    fig.clear()
-
 
 def _as_table(table, name: str) -> RestitutionTable:
     if table is None:
@@ -122,17 +77,17 @@ def _data(table: RestitutionTable, name: str) -> pd.DataFrame:
 def _values(df: pd.DataFrame, column: str) -> np.ndarray:
     v = df[column].to_numpy(float)
     v = v[np.isfinite(v)]
-    return _cluster(v)[0] if len(v) else v
+    return cluster_nodes(v)[0] if len(v) else v
 
 
 def _at(df: pd.DataFrame, column: str, value: float) -> pd.DataFrame:
     """Rows of ``df`` with ``column`` equal to ``value`` (up to round-off), sorted by Q1."""
-    return df[_same(df[column].to_numpy(float), value)].sort_values("Q1")
+    return df[same_node(df[column].to_numpy(float), value)].sort_values("Q1")
 
 
 def _pick_nus(df: pd.DataFrame, wanted, name: str) -> list[float]:
     present = _values(df, "nu")
-    nus = [float(n) for n in wanted if np.any(_same(present, n))]
+    nus = [float(n) for n in wanted if np.any(same_node(present, n))]
     if not nus:
         raise ValueError(f"figure {name} needs rows with nu = "
                          + ", ".join(f"{n:g}" for n in wanted) + "; the table has nu = "
@@ -143,16 +98,18 @@ def _pick_nus(df: pd.DataFrame, wanted, name: str) -> list[float]:
 def _default_nu(df: pd.DataFrame, nu) -> float:
     present = _values(df, "nu")
     if nu is not None:
-        if not np.any(_same(present, nu)):
+        if not np.any(same_node(present, nu)):
             raise ValueError(f"nu = {nu!r} is not allowed: the table has nu = "
                              + ", ".join(f"{n:g}" for n in present))
         return float(nu)
-    return 0.5 if np.any(_same(present, 0.5)) else float(present.max())
+    return 0.5 if np.any(same_node(present, 0.5)) else float(present.max())
 
 
 def _kv_curve(q1_min: float, q1_max: float, n: int = 48):
     """Kelvin-Voigt continuum ``e_z`` over ``[q1_min, q1_max]`` (log spaced)."""
-    from vimpact.reference.closed_forms import kelvin_voigt_continuum  # scipy: imported when drawing
+    from vimpact.reference.closed_forms import (
+        kelvin_voigt_continuum,  # scipy: imported when drawing
+    )
 
     q1 = np.geomspace(q1_min, q1_max, n)
     return q1, np.asarray(kelvin_voigt_continuum(q1, rtol=1e-10).e_z)
@@ -391,7 +348,7 @@ def _family_plot(table, out, name: str, column: str, nu, kv_table=None) -> Path:
     _need_model(table, name, "standard_solid")
     df = _data(table, name)
     nu = _default_nu(df, nu)
-    df = df[_same(df["nu"].to_numpy(float), nu)]
+    df = df[same_node(df["nu"].to_numpy(float), nu)]
     q2_rows = df[~_kelvin_voigt_rows(df)]
     family = _q2_family(q2_rows, name)
     kv_rows = df[_kelvin_voigt_rows(df)]
@@ -399,7 +356,7 @@ def _family_plot(table, out, name: str, column: str, nu, kv_table=None) -> Path:
         kv_table = _as_table(kv_table, name)
         _need_model(kv_table, name, "kelvin_voigt")
         kv_rows = _data(kv_table, name)
-        kv_rows = kv_rows[_same(kv_rows["nu"].to_numpy(float), nu)]
+        kv_rows = kv_rows[same_node(kv_rows["nu"].to_numpy(float), nu)]
         if not len(kv_rows):
             raise ValueError(f"figure {name}: the Kelvin-Voigt table has no rows with "
                              f"nu = {nu:g}")
@@ -441,7 +398,8 @@ def _family_plot(table, out, name: str, column: str, nu, kv_table=None) -> Path:
 def fig5_4(table, out, nu=None, kv_table=None) -> Path:
     """Thesis fig. 5.4: ``e_z`` over ``Q1`` for a family of ``Q2`` (standard
     solid) with the Kelvin-Voigt curve (``Q2 -> 0``, continuum limit) in black.
-    Table: ``sweeps/fig5_4_5_standard_solid_q2.toml (+ sweeps/fig5_4_5_kelvin_voigt.toml)``; ``nu`` default 0.5 if present
+    Table: ``sweeps/fig5_4_5_standard_solid_q2.toml (+ sweeps/fig5_4_5_kelvin_voigt.toml)``;
+    ``nu`` default 0.5 if present
     (``kv_table`` is accepted for symmetry with :func:`fig5_5`)."""
     return _family_plot(table, out, "fig5_4", "e_z", nu, kv_table)
 
@@ -451,7 +409,8 @@ def fig5_5(table, out, nu=None, kv_table=None) -> Path:
     solid) with the Kelvin-Voigt curve in black: from ``kv_table`` (a
     Kelvin-Voigt table) if given, else from the table's own Kelvin-Voigt rows
     (``Q2`` 0 or NaN), else computed at the table's ``Q1`` values with its
-    numerics. Table: ``sweeps/fig5_4_5_standard_solid_q2.toml (+ sweeps/fig5_4_5_kelvin_voigt.toml)``; ``nu`` default 0.5 if present."""
+    numerics. Table: ``sweeps/fig5_4_5_standard_solid_q2.toml
+    (+ sweeps/fig5_4_5_kelvin_voigt.toml)``; ``nu`` default 0.5 if present."""
     return _family_plot(table, out, "fig5_5", "e_x", nu, kv_table)
 
 

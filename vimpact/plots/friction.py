@@ -21,7 +21,8 @@ import numpy as np
 
 from vimpact.engine.simulate import simulate_batch
 from vimpact.model.numerics import Numerics
-from vimpact.plots.figures import _drawing
+from vimpact.model.scene import REFERENCE_INDENTATION
+from vimpact.plots.style import drawing
 
 #: Numerics of these figures: about 1e-3 on beta_x, so that a figure takes seconds.
 FIGURE_NUMERICS = Numerics.preset("fast")
@@ -48,8 +49,8 @@ def _columns(nu, G, eta, R, m, v_z0, v_x0, theta_ratio, mu) -> dict:
 def _exit_incidence(nu, theta_ratio, Q1, psi1, mu=0.3) -> np.ndarray:
     """``psi2`` for incidences ``psi1`` (a dimensionless scene: v_z0 = 1 m/s, R = 1 m,
     m = 1 kg, a_H = 0.01 R)."""
-    d = 1e-4
-    G = 15.0 / (16.0 * d**2.5) * (1.0 - nu) / 2.0  # E* from d = 1e-4 m at 1 m/s
+    d = REFERENCE_INDENTATION  # m
+    G = 15.0 / (16.0 * d**2.5) * (1.0 - nu) / 2.0  # E* from d at 1 m/s
     T = d / 1.0
     eta = Q1 / np.sqrt(15.0 / 32.0) * T * G
     v_c = psi1 * mu * (2.0 - nu) / (2.0 * (1.0 - nu))
@@ -65,7 +66,7 @@ def fig_mbf(out) -> Path:
     """``psi2`` over ``psi1`` for an elastic sphere (nu = 0.3) at three ``chi``."""
     nu = 0.3
     psi1 = np.linspace(0.05, 8.0, 40)
-    with _drawing(out) as (fig, ax):
+    with drawing(out) as (fig, ax):
         for theta_ratio in (0.4, 1.0, 4.0):
             chi = chi_of(nu, theta_ratio)
             psi2 = _exit_incidence(nu, theta_ratio, 0.0, psi1)
@@ -84,7 +85,7 @@ def fig_beta_psi(out) -> Path:
     """``beta_x`` over ``psi`` for several ``Q1`` (Kelvin-Voigt, nu = 0.5, solid sphere)."""
     nu, theta_ratio = 0.5, 0.4
     psi1 = np.geomspace(0.05, 30.0, 40)
-    with _drawing(out) as (fig, ax):
+    with drawing(out) as (fig, ax):
         for Q1 in (0.0, 0.01, 0.1, 0.5):
             beta = -_exit_incidence(nu, theta_ratio, Q1, psi1) / psi1
             ax.semilogx(psi1, beta, marker="o", ms=3, label=f"Q1 = {Q1:g}")
@@ -118,7 +119,7 @@ def fig_chung_ooi(out) -> Path:
     """Rebound angle and spin over the impact angle, Chung-Ooi test 4 geometry."""
     angles = np.linspace(5.0, 85.0, 33)
     res = chung_ooi_angles(angles)
-    with _drawing(out, 1, 2, figsize=(10.0, 4.2)) as (fig, (ax1, ax2)):
+    with drawing(out, 1, 2, figsize=(10.0, 4.2)) as (fig, (ax1, ax2)):
         ax1.plot(angles, res["rebound_angle_deg"], marker="o", ms=3, label="vimpact")
         ax1.plot(angles, angles, color="0.6", ls=":", lw=1.0, label="mirror (no friction)")
         ax1.set_xlabel("impact angle from the normal, deg")

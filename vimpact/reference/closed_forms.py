@@ -331,7 +331,8 @@ def _kv_single(tau_hat: float, rtol: float) -> tuple[float, float, float]:
 def kelvin_voigt_continuum(q1, rtol: float = 1e-12) -> KelvinVoigtResult:
     """Normal impact of a rigid sphere on a Kelvin-Voigt half-space, continuum limit.
 
-    Kernel units (docs/physics.md#hertz-scales, docs/physics.md#kelvin-voigt-continuum, docs/physics.md#dimensionless-parameters): indentation ``u`` in units of
+    Kernel units (docs/physics.md#hertz-scales, docs/physics.md#kelvin-voigt-continuum,
+    docs/physics.md#dimensionless-parameters): indentation ``u`` in units of
     ``d``, velocity in ``v_z0``, time in ``T = d / v_z0``, force in
     ``m v_z0^2 / d``; ``tau_hat = tau / T = q1 / Q1_PER_TAU``. The ODE
 

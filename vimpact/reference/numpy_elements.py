@@ -1,12 +1,15 @@
 """Slow, independent reference of the MDR impact in physical (SI) units.
 
 This is the documentation-grade restatement of the element model of
-docs/physics.md (method of dimensionality reduction to energy and passivity), written directly in metres, seconds, kilograms and
+docs/physics.md (method of dimensionality reduction to energy and passivity), written
+directly in metres, seconds, kilograms and
 pascals. It shares no code with :mod:`vimpact.kernels.elements` and does not
 nondimensionalize anything: it only takes the discretization (``t_H`` and
 ``a_H`` for the step and the element spacing) from
-:func:`vimpact.model.hertz.hertz_scales` and the refinement rule from
-:func:`vimpact.engine.routing.refinement`. In particular it
+:func:`vimpact.model.hertz.hertz_scales`; how much finer than that the kernel
+resolves a scene is the caller's ``refinement`` (the engine's rule,
+:func:`vimpact.engine.routing.refinement`, which the reference does not
+import: it sits below the engine). In particular it
 
 - uses the element stiffnesses ``c_n G`` and ``c_t G`` per unit length with
   ``c_n = 2 / (1 - nu)``, ``c_t = 4 / (2 - nu)`` and the material moduli in Pa,
@@ -37,7 +40,8 @@ displacement (and arms) solved so that the force sits on the cone (the
 force is affine in the end displacement: two evaluations give the line).
 A slipping element pushes with ``mu`` times its normal force, whose dashpot
 part moves with the normal velocity of each half-kick. ``check_cone``
-asserts ``|f_t| <= mu f_n (1 + 1e-12)`` for every element at every step. It is vectorized over elements with NumPy and loops
+asserts ``|f_t| <= mu f_n (1 + 1e-12)`` for every element at every step. It is vectorized
+over elements with NumPy and loops
 over time steps in Python: slow on purpose, keep the sizes small.
 
 Sign convention: ``v_z > 0`` into the half-space, indentation ``u > 0``
@@ -51,9 +55,7 @@ import math
 
 import numpy as np
 
-from vimpact import Numerics
 from vimpact.model.hertz import hertz_scales
-from vimpact.engine.routing import choose_path, refinement
 
 #: docs/physics.md#the-problem: the half-space model holds up to a = 0.2 R.
 HALF_SPACE_LIMIT = 0.2
@@ -198,7 +200,7 @@ def stick_path_in_cone(L0, L1, C0, C1, alpha):
 
 
 def naive_impact(scene, steps, elements, row_width=1.05, max_time=100.0, mu=None,
-                 check_cone=True, flat_punch=None):
+                 check_cone=True, flat_punch=None, refinement=(1.0, 1.0)):
     """Simulate ``scene`` (a :class:`vimpact.Scene`) in SI units with the
     Stormer-Verlet scheme of the kernel.
 
@@ -216,6 +218,11 @@ def naive_impact(scene, steps, elements, row_width=1.05, max_time=100.0, mu=None
     flat_punch : radius ``a0`` (m) of a flat punch instead of the sphere's
         MDR profile (docs/physics.md#linear-model): ``g = 0`` on ``|x| < a0``, no
         element outside; every element enters at once and leaves together
+    refinement : ``(time_factor, element_factor)``, both >= 1 (dimensionless):
+        the step is ``t_H / steps / time_factor``, the spacing ``a_H /
+        ceil(elements element_factor)``; the kernel's own factors for this
+        scene come from :func:`vimpact.engine.routing.refinement` (a stiff
+        tangential mode or a glassy contact is resolved more finely)
 
     Returns
     -------
@@ -235,10 +242,9 @@ def naive_impact(scene, steps, elements, row_width=1.05, max_time=100.0, mu=None
     R, m, Theta = float(scene.R), float(scene.m), float(scene.Theta)
 
     hz = hertz_scales(mat.G_inf, nu, R, m, scene.v_z0)
-    # the discretization rule of the kernel (finer steps and elements for a
+    # the caller's refinement (the kernel's rule: finer steps and elements for a
     # stiffer tangential mode or a glassy contact): taken, not re-derived
-    numerics = Numerics(steps=steps, elements=elements, row_width=row_width, continuum=False)
-    time_factor, element_factor = refinement(scene, numerics, choose_path(scene, numerics).spec)
+    time_factor, element_factor = (float(f) for f in refinement)
     h = hz.t_H / steps / time_factor  # s
     elements = int(math.ceil(elements * element_factor))
     dx = hz.a_H / elements  # m

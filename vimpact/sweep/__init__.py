@@ -9,10 +9,8 @@ Modules: :mod:`~vimpact.sweep.spec` (TOML -> :class:`SweepSpec`),
     from vimpact.sweep import run_sweep, load_spec, read_metadata
 """
 
-from vimpact.sweep.runner import (  # noqa: F401
-    SweepInterrupted, chunk_summary, compute_chunk, run_sweep)
-from vimpact.sweep.spec import (  # noqa: F401
-    COLUMNS, SCHEMA_VERSION, SWEEP_STATUSES, Draw, SweepSpec, load_spec)
+from vimpact.sweep.runner import SweepInterrupted, chunk_summary, compute_chunk, run_sweep  # noqa: F401
+from vimpact.sweep.spec import COLUMNS, SCHEMA_VERSION, SWEEP_STATUSES, Draw, SweepSpec, load_spec  # noqa: F401
 from vimpact.sweep.store import parts_dir, read_metadata, summary  # noqa: F401
 
 __all__ = ["COLUMNS", "Draw", "SCHEMA_VERSION", "SWEEP_STATUSES", "SweepInterrupted",

@@ -29,12 +29,12 @@ import numpy as np
 
 from vimpact.model.hertz import Q1_PER_TAU
 from vimpact.model.material import shear_modulus
+from vimpact.model.scene import REFERENCE_INDENTATION
 from vimpact.model.toml_input import tangential_speed
 
 #: The reference scene of :meth:`vimpact.Scene.from_dimensionless`: R = 1 m,
 #: m = 1 kg, v_z0 = v_x0 = 1 m/s, omega0 = 0, Hertz indentation d = 1e-4 m.
 REFERENCE = {"R_m": 1.0, "m_kg": 1.0, "v_z0_m_s": 1.0, "v_x0_m_s": 1.0, "omega0_rad_s": 0.0}
-_D_REF = 1e-4
 
 
 def chunk_generator(seed: int, chunk: int) -> np.random.Generator:
@@ -126,10 +126,10 @@ def engine_columns(spec, p: dict[str, np.ndarray]) -> tuple[list[tuple[np.ndarra
     if spec.mode == "grid":
         # Scene.from_dimensionless, vectorized with the same floating-point operations
         R, m, v_z0 = 1.0, 1.0, 1.0
-        E_star = 15.0 * m * v_z0**2 / (16.0 * math.sqrt(R) * _D_REF**2.5)
+        E_star = 15.0 * m * v_z0**2 / (16.0 * math.sqrt(R) * REFERENCE_INDENTATION**2.5)
         G = E_star * (1.0 - nu) / 2.0
         Q1 = p.get("Q1", np.zeros(n))
-        tau = Q1 / Q1_PER_TAU * _D_REF / v_z0
+        tau = Q1 / Q1_PER_TAU * REFERENCE_INDENTATION / v_z0
         eta = tau * G
         sphere = {k: np.full(n, v) for k, v in REFERENCE.items()}
         if "psi" in p:

@@ -53,11 +53,19 @@ from pathlib import Path
 
 import numpy as np
 
+from vimpact.model.scene import DEFAULT_THETA_RATIO
 from vimpact.model.validation import InputError
 from vimpact.sweep import store
 from vimpact.sweep.progress import Progress
-from vimpact.sweep.spec import (LABELS, OUTPUTS, RELATIVE, RESULTS, TANGENTIAL_OUTPUTS, SweepSpec,
-                                 load_spec)
+from vimpact.sweep.spec import (
+    LABELS,
+    OUTPUTS,
+    RELATIVE,
+    RESULTS,
+    TANGENTIAL_OUTPUTS,
+    SweepSpec,
+    load_spec,
+)
 
 
 class SweepInterrupted(KeyboardInterrupt):
@@ -309,7 +317,7 @@ def refined_spec(spec: SweepSpec, parts: Path, log: Callable[[str], None] | None
     if spec.model not in REFINABLE:
         raise InputError(f"grid.tolerance = {tol!r} is not allowed for a {spec.model} grid: "
                          f"only {' and '.join(REFINABLE)} grids are refined (remove it)")
-    theta = np.asarray(spec.axes.get("theta_ratio", [0.4]), dtype=float)
+    theta = np.asarray(spec.axes.get("theta_ratio", [DEFAULT_THETA_RATIO]), dtype=float)
     if theta.size != 1:
         raise InputError(f"grid.tolerance = {tol!r} is not allowed with {theta.size} "
                          "theta_ratio values: a refined grid has one theta_ratio (one "
@@ -347,7 +355,7 @@ def refined_spec(spec: SweepSpec, parts: Path, log: Callable[[str], None] | None
                                    "axes": {a: [float(x) for x in v] for a, v in axes.items()},
                                    "report": report})
         if log is not None:
-            log(f"refined grid: " + " x ".join(f"{a} {len(v)}" for a, v in axes.items())
+            log("refined grid: " + " x ".join(f"{a} {len(v)}" for a, v in axes.items())
                 + f" nodes, held-out error {_reached(report)}")
     new_axes = {k: (np.asarray(axes[k], dtype=float) if k in axes else v)
                 for k, v in spec.axes.items()}

@@ -130,14 +130,28 @@ from pathlib import Path
 import numpy as np
 
 from vimpact import __version__
+from vimpact.kernels.status import TABLE as STATUS_TABLE
 from vimpact.model.material_file import inline_material
 from vimpact.model.numerics import Numerics
-from vimpact.model.scene import Scene
-from vimpact.model.toml_input import (ANGLE_RANGE_DEG, ARM_KEYS, FRICTION_KEYS, MATERIAL_KEYS,
-                                      PHYSICAL_DEFAULTS, SPHERE_KEYS, SWEEP_TOP_KEYS, TomlSource,
-                                      friction_coefficient, input_keys, is_number, parse_header,
-                                      parse_numerics, read_toml, required_keys,
-                                      scene_from_values)
+from vimpact.model.scene import DEFAULT_THETA_RATIO, Scene
+from vimpact.model.toml_input import (
+    ANGLE_RANGE_DEG,
+    ARM_KEYS,
+    FRICTION_KEYS,
+    MATERIAL_KEYS,
+    PHYSICAL_DEFAULTS,
+    SPHERE_KEYS,
+    SWEEP_TOP_KEYS,
+    TomlSource,
+    friction_coefficient,
+    input_keys,
+    is_number,
+    parse_header,
+    parse_numerics,
+    read_toml,
+    required_keys,
+    scene_from_values,
+)
 
 #: Version of the table layout (columns, metadata keys and random draws): 3 since
 #: the draws are made per chunk from ``SeedSequence(seed, spawn_key=(chunk,))``; 4 since
@@ -147,18 +161,9 @@ from vimpact.model.toml_input import (ANGLE_RANGE_DEG, ARM_KEYS, FRICTION_KEYS, 
 #: The random draws of version 3 are unchanged.
 SCHEMA_VERSION = 4
 
-#: Row statuses of a sweep table: those of :data:`vimpact.STATUSES` and two more.
-def _statuses() -> dict:
-    from vimpact.engine.result import STATUSES
-    return {
-        **STATUSES,
-        "invalid": "the parameters are not a valid scene (reason in the error column); "
-                   "outputs NaN",
-        "failed": "the simulation raised an error (message in the error column); outputs NaN",
-    }
-
-
-SWEEP_STATUSES = _statuses()
+#: Row statuses of a sweep table: those of :data:`vimpact.STATUSES` and ``failed``
+#: (the status table, :mod:`vimpact.kernels.status`).
+SWEEP_STATUSES = {s.name: s.message for s in STATUS_TABLE}
 
 DEFAULT_CHUNK_SIZE = 64
 #: Rows of one sweep at most (a grid axis has at most as many points).
@@ -729,7 +734,7 @@ def _grid(spec: TomlSource, model: str, table) -> tuple[dict[str, np.ndarray], f
             continue
         if key not in table:
             if key == "theta_ratio":
-                axes[key] = np.array([0.4])
+                axes[key] = np.array([DEFAULT_THETA_RATIO])
                 continue
             raise spec.error(f"grid.{key}", "missing")
         values = _axis(spec, f"grid.{key}", table[key])

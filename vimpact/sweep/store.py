@@ -179,7 +179,7 @@ class ContentHash:
         self.rows = 0
         self._streams: list[tuple] = []
 
-    def update(self, table) -> "ContentHash":
+    def update(self, table) -> ContentHash:
         """Add the rows of the ``pyarrow`` table (or record batch) ``table``: same
         column names, in the same order, as the rows before."""
         names = list(table.column_names)
@@ -834,7 +834,7 @@ class OutputLock:
         self.path = Path(out).with_name(Path(out).name + ".lock")
         self.fd: int | None = None
 
-    def __enter__(self) -> "OutputLock":
+    def __enter__(self) -> OutputLock:
         import fcntl
         self.path.parent.mkdir(parents=True, exist_ok=True)
         fd = os.open(self.path, os.O_RDWR | os.O_CREAT, 0o644)

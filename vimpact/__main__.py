@@ -1,0 +1,7 @@
+"""``python -m vimpact``: the same as the ``vimpact`` command (and ``python -m vimpact.cli``)."""
+
+import sys
+
+from vimpact.cli.main import main
+
+sys.exit(main())

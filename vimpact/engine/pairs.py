@@ -1,0 +1,108 @@
+"""Impacts of two bodies, or of a body on a wall, run through the engine.
+
+The mapping of a pair onto one rigid-sphere scene (and back to both bodies'
+end states) is plain data in :mod:`vimpact.model.pair`; this module runs the
+equivalent scenes (:func:`vimpact.engine.simulate.simulate`,
+:func:`~vimpact.engine.simulate.simulate_batch`).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+import numpy as np
+import pandas as pd
+
+from vimpact.engine.simulate import simulate, simulate_batch
+from vimpact.model.pair import Body, PairResult, Wall, end_states, pair_scene
+from vimpact.model.scene import Scene
+from vimpact.model.validation import require
+
+
+def simulate_pair(body1: Body, other: Body | Wall, numerics=None, **scene_options) -> PairResult:
+    """Simulate body 1 hitting body 2 (or a wall).
+
+    Parameters
+    ----------
+    body1 : the first body; ``other`` : the second body or a :class:`~vimpact.model.pair.Wall`
+    numerics : :class:`vimpact.Numerics` (default: the engine's default)
+    scene_options : ``tangential``, ``tangential_memory``, ``mu``,
+        ``allow_large_contact`` of the equivalent scene (:func:`~vimpact.model.pair.pair_scene`)
+
+    Returns
+    -------
+    PairResult
+    """
+    scene = pair_scene(body1, other, **scene_options)
+    res = simulate(scene, numerics)
+    b1, b2, J_z, J_x = end_states(body1, other, scene, res.e_z, res.beta_x)
+    return PairResult(res.e_z, res.beta_x, b1, b2, J_z, J_x, res.status, scene, res)
+
+
+def simulate_pair_batch(pairs: Sequence[tuple[Body, Body | Wall]], numerics=None,
+                        **scene_options):
+    """Simulate many pair impacts in one batch.
+
+    Parameters
+    ----------
+    pairs : sequence of ``(body1, body2_or_wall)``
+    numerics, scene_options : as :func:`simulate_pair`
+
+    Returns
+    -------
+    pandas.DataFrame
+        one row per pair: ``e_z, beta_x, status, t_contact_s`` and the end
+        states ``v_z1, v_x1, omega1, v_z2, v_x2, omega2`` (m/s, rad/s; NaN for a
+        wall) and the impulses on body 1 ``J_z, J_x`` (N s).
+    """
+    scenes = [pair_scene(b1, b2, **scene_options) for b1, b2 in pairs]
+    df = simulate_batch(scenes, numerics)
+    rows = []
+    for (b1, b2), s, e_z, beta_x in zip(pairs, scenes, df["e_z"].to_numpy(),
+                                        df["beta_x"].to_numpy()):
+        end1, end2, J_z, J_x = end_states(b1, b2, s, float(e_z), float(beta_x))
+        end2 = end2 or (np.nan, np.nan, np.nan)
+        rows.append((*end1, *end2, J_z, J_x))
+    ends = pd.DataFrame(rows, columns=["v_z1", "v_x1", "omega1", "v_z2", "v_x2", "omega2",
+                                       "J_z", "J_x"])
+    out = pd.concat([df[["e_z", "beta_x", "status", "t_contact"]].reset_index(drop=True), ends],
+                    axis=1)
+    bad = ~np.isfinite(out["e_z"].to_numpy(dtype=float))
+    out.loc[bad, ["v_z1", "v_x1", "omega1", "v_z2", "v_x2", "omega2", "J_z", "J_x"]] = np.nan
+    return out.rename(columns={"t_contact": "t_contact_s"})
+
+
+def pair_restitution(body1: Body, other: Body | Wall, speeds, *, tangential: bool = False,
+                     vc_ratio: float = 1.0, numerics=None, mu: float = math.inf):
+    """``e_z`` (and ``beta_x``) of a pair over approach speeds: the curves DEM fits need.
+
+    Parameters
+    ----------
+    body1, other : the pair (their velocities are ignored)
+    speeds : approach speeds ``v_z0``, m/s (array)
+    tangential : also solve the tangential problem (full stick unless ``mu``)
+        with ``v_c0 = vc_ratio * v_z0``; otherwise normal only (fast)
+    numerics : :class:`vimpact.Numerics`
+
+    Returns
+    -------
+    pandas.DataFrame with columns ``v_z0, e_z, beta_x, t_contact, a_max, status``.
+    """
+    speeds = np.asarray(speeds, dtype=float)
+    require("speeds", speeds, speeds.ndim == 1 and speeds.size > 0 and bool(np.all(speeds > 0))
+            and bool(np.all(np.isfinite(speeds))), "a non-empty 1-D array of finite speeds > 0")
+    base = pair_scene(Body(body1.material, body1.R, body1.m, body1.Theta, v_z=1.0,
+                           rotation=body1.rotation),
+                      other if isinstance(other, Wall) else
+                      Body(other.material, other.R, other.m, other.Theta, rotation=other.rotation),
+                      tangential="stick" if tangential else "none", mu=mu,
+                      allow_large_contact=True)
+    scenes = [Scene(base.material, R=base.R, m=base.m, v_z0=v, v_x0=vc_ratio * v if tangential
+                    else 0.0, Theta=base.Theta if base.rotation else None,
+                    rotation=base.rotation, tangential=base.tangential, mu=mu,
+                    allow_large_contact=True) for v in speeds]
+    df = simulate_batch(scenes, numerics)
+    out = df[["e_z", "beta_x", "t_contact", "a_max", "status"]].reset_index(drop=True)
+    out.insert(0, "v_z0", speeds)
+    return out
