@@ -621,6 +621,12 @@ def load_spec(path) -> SweepSpec:
         draws, arms = {}, ()
     if mode == "random":
         grid_tolerance = grid_mu = None
+    if header.tangential_memory == "seed" and ("psi" in axes or "mu" in draws):
+        key = "grid.psi" if "psi" in axes else "random.mu"
+        raise spec.error(key, "is not allowed with tangential_memory = \"seed\": the seed "
+                         "memory sets every element to the total contact-point displacement, "
+                         "which slip cannot change, so friction needs tangential_memory = "
+                         "\"incremental\"")
     return SweepSpec(path=path, text=text, model=model, mode=mode, seed=seed,
                      chunk_size=chunk_size, output=output, numerics=numerics,
                      tangential_memory=header.tangential_memory,
