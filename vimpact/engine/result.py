@@ -55,6 +55,9 @@ STATUSES = {
     "energy_gain": "finished, but explicit Euler gained energy (more than 1e-6 of the contact "
                    "energy), as it does by construction: numbers kept as the thesis's integrator "
                    "gives them, not converged (use verlet)",
+    "not_passive": "finished, but the seed tangential memory (not passive) gained energy or "
+                   "gave |e_z| or |beta_x| above 1 + 1e-6: numbers kept as its rule gives "
+                   "them, not physical (the incremental memory is passive)",
     "unresolved": "the contact lasted fewer time steps than the element path needs to resolve "
                   "it (numerics.MIN_CONTACT_STEPS); outputs NaN (more steps, or the continuum path)",
     "too_costly": "the element path would need more steps or elements than its cost bounds "
@@ -67,7 +70,7 @@ STATUSES = {
 }
 
 #: Statuses whose numbers are results (the others carry NaN).
-FINISHED = ("ok", "vc0_zero", "normal_only", "half_space", "energy_gain")
+FINISHED = ("ok", "vc0_zero", "normal_only", "half_space", "energy_gain", "not_passive")
 
 
 @dataclass(frozen=True)
@@ -84,7 +87,9 @@ class ImpactResult:
     a_max : maximum contact half-width, m
     t_hertz, d_hertz, a_hertz : Hertz contact time (s), indentation (m) and
         radius (m) of the elastic impact with the relaxed modulus
-    energy_ratio : kinetic energy after / before (translation and rotation)
+    energy_ratio : kinetic energy after / before (translation and rotation; with a held
+        spin, ``rotation=False``, the spin's energy is left out and the work of the
+        torque holding it counted as energy put in: docs/physics.md#energy-and-passivity)
     Q1, Q2, nu : dimensionless parameters (Q1 NaN for a general Prony series,
         Q2 NaN unless a standard solid)
     v_z_end, v_x_end, omega_end : end velocities, m/s, m/s, rad/s (v_z > 0 into the half-space)
