@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -142,3 +143,91 @@ def test_held_backspin_counts_the_work_that_holds_it(Q1):
     energy_in = 0.5 * m * (v_z0**2 + scene.v_x0**2) + work
     assert res.energy_ratio <= 1.0
     assert res.energy_ratio == pytest.approx(1.0 - lost / energy_in, abs=1e-9)
+
+
+# ---- item 7: a friction table is not a thesis chapter-5 table -------------------------
+
+PSI_SPEC = """model = "kelvin_voigt"
+chunk_size = 4
+numerics = "fast"
+[grid]
+Q1 = 0.1
+nu = 0.5
+psi = [0.0, 2.0]
+mu = 0.3
+"""
+
+
+@pytest.fixture(scope="module")
+def psi_table(tmp_path_factory):
+    """A 2-row friction table (psi grid, Kelvin-Voigt, the kernels of
+    tests/sweep/test_friction_sweep.py)."""
+    from vimpact.sweep import run_sweep
+    folder = tmp_path_factory.mktemp("psi")
+    (folder / "psi.toml").write_text(PSI_SPEC)
+    return run_sweep(folder / "psi.toml", progress=False)
+
+
+@pytest.mark.parametrize("figure", ["fig5_1", "fig5_2", "fig5_3", "fig5_4", "fig5_5"])
+def test_chapter_5_figures_refuse_a_friction_table(psi_table, tmp_path, capsys, figure):
+    out = tmp_path / "f.png"
+    code = main(["plot", figure, "--table", str(psi_table), "--out", str(out)])
+    err = capsys.readouterr().err
+    assert code == 2 and len(err.strip().splitlines()) == 1
+    assert f"--table = {str(psi_table)!r}" in err and "friction" in err
+    assert not out.exists()
+
+
+# ---- item 8: messages name the option as typed and the value --------------------------
+
+KV_TABLE = str(Path(__file__).resolve().parents[2] / "sweeps" / "tables"
+               / "kelvin_voigt_table.parquet")
+EXPORT = ["--E", "1e8", "--nu", "0.4", "--eta", "100", "--R", "0.01", "--m", "0.004",
+          "--vz0-min", "0.1", "--vz0-max", "1"]
+
+
+def typed_errors(psi_table):
+    psi = str(psi_table)
+    return [
+        ("lookup-psi-range", ["table", "lookup", psi, "--Q1", "0.1", "--nu", "0.5", "--psi",
+                              "50"], ["--psi = 50"]),
+        ("lookup-psi-negative", ["table", "lookup", psi, "--Q1", "0.1", "--nu", "0.5", "--psi",
+                                 "-1"], ["--psi = -1"]),
+        ("lookup-psi-missing", ["table", "lookup", psi, "--Q1", "0.1", "--nu", "0.5"],
+         ["--psi is missing"]),
+        ("lookup-Q1-range", ["table", "lookup", KV_TABLE, "--Q1", "1e9", "--nu", "0.4"],
+         ["--Q1 = 1e+09"]),
+        ("lookup-empty-list-value", ["table", "lookup", KV_TABLE, "--Q1", "0.1", "--nu",
+                                     "0.5,,0.3"], ["--nu", "'0.5,,0.3'"]),
+        ("export-out-folder", ["table", "export", KV_TABLE, "--out", "."] + EXPORT,
+         ["--out = '.'"]),
+        ("export-angle-90", ["table", "export", psi, "--out", "x.csv", "--angle-deg", "90",
+                             "--mu", "0.3"] + EXPORT, ["--angle-deg = 90"]),
+        ("export-angle-missing", ["table", "export", psi, "--out", "x.csv", "--mu", "0.3"]
+         + EXPORT, ["--angle-deg is missing"]),
+        ("export-mu-on-stick-table", ["table", "export", KV_TABLE, "--out", "x.csv", "--mu",
+                                      "0.3", "--angle-deg", "30"] + EXPORT, ["--mu = 0.3"]),
+        ("dem-not-utf8", ["dem", "bin.toml", "--for", "lammps"], ["bin.toml", "UTF-8"]),
+        ("sweep-not-utf8", ["sweep", "bin.toml"], ["bin.toml", "UTF-8"]),
+        ("scene-not-utf8", ["simulate", "--scene", "bin.toml"], ["bin.toml", "UTF-8"]),
+        ("dem-out-is-a-file", ["dem", "afile.toml", "--for", "lammps", "--out", "afile.toml"],
+         ["--out = 'afile.toml'", "a file"]),
+    ]
+
+
+@pytest.mark.parametrize("case", range(13))
+def test_messages_name_what_was_typed(psi_table, tmp_path, monkeypatch, capsys, case):
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "bin.toml").write_bytes(b"\xff\xfe\x00 not text")
+    (tmp_path / "afile.toml").write_text("")
+    name, argv, words = typed_errors(psi_table)[case]
+    try:
+        code = main(argv)
+    except SystemExit as exc:  # argparse's own checks
+        code = exc.code
+    err = capsys.readouterr().err
+    assert code == 2 and len(err.strip().splitlines()) == 1, (name, err)
+    for word in words:
+        assert word in err, (name, word, err)
+    for internal in ("array(", "angle_deg", "[Errno", "codec"):
+        assert internal not in err, (name, internal, err)

@@ -150,3 +150,138 @@ def test_scheduler_that_does_not_answer_is_one_line_and_leaves_nothing(tmp_path,
     one_line(code, err, f"--scheduler = {address!r}")
     assert "EiB" not in err
     nothing_written(tmp_path, "s.toml")
+
+
+# ---- item 5: no symlink followed, nothing written outside the named output -----------
+
+def victim(tmp_path: Path) -> Path:
+    """A file outside the output that a symbolic link points to; must stay as it is."""
+    target = tmp_path / "elsewhere" / "precious.txt"
+    target.parent.mkdir()
+    target.write_text("keep me")
+    return target
+
+
+@pytest.mark.parametrize("link", ["out.parquet", "out.parquet.lock", "out.parquet.parts"])
+def test_sweep_refuses_a_symlink_where_it_writes(tmp_path, capsys, link):
+    target = victim(tmp_path)
+    (tmp_path / link).symlink_to(target if link != "out.parquet.parts" else target.parent)
+    out = tmp_path / "out.parquet"
+    code, _, err = run(["sweep", str(sweep_spec(tmp_path)), "--out", str(out)], capsys)
+    one_line(code, err, f"--out = {str(out)!r}", "symbolic link")
+    assert target.read_text() == "keep me" and sorted(p.name for p in target.parent.iterdir()) \
+        == ["precious.txt"]
+
+
+def test_lock_file_is_not_followed_even_past_the_check(tmp_path, monkeypatch):
+    """The lock is opened with O_NOFOLLOW: a link made after the lstat check (here: the
+    check switched off) is still not followed."""
+    import errno
+
+    from vimpact.sweep import store
+    target = victim(tmp_path)
+    lock = store.OutputLock(tmp_path / "out.parquet")
+    lock.path.symlink_to(target)
+    monkeypatch.setattr(store, "refuse_symlink", lambda *a, **k: None)
+    with pytest.raises(OSError) as info:
+        lock._open()
+    assert info.value.errno == errno.ELOOP and target.read_text() == "keep me"
+
+
+def test_atomic_file_never_writes_through_a_planted_temporary(tmp_path):
+    """A symbolic link planted at the temporary name is replaced, not written through."""
+    from vimpact.sweep import store
+    target = victim(tmp_path)
+    out = tmp_path / "t.csv"
+    store._temporary(out).symlink_to(target)
+    with store.atomic_file(out, "out", mode="w") as f:
+        f.write("new")
+    assert out.read_text() == "new" and target.read_text() == "keep me"
+    assert not out.is_symlink() and not store._temporary(out).exists()
+
+
+@pytest.mark.parametrize("output", ["../escaped.parquet", "sub/../../escaped.parquet",
+                                    "/tmp/vimpact-escaped.parquet"])
+def test_spec_output_stays_in_the_spec_folder(tmp_path, capsys, output):
+    folder = tmp_path / "specs"
+    folder.mkdir()
+    code, _, err = run(["sweep", str(sweep_spec(folder, output))], capsys)
+    one_line(code, err, f"output = {output!r}", "--out")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["specs"]
+    nothing_written(folder, "s.toml")
+    assert not Path("/tmp/vimpact-escaped.parquet").exists()
+
+
+def test_plot_refuses_a_symlinked_out(tmp_path, capsys):
+    target = victim(tmp_path)
+    (tmp_path / "fig.png").symlink_to(target)
+    code, _, err = run(["plot", "fig3_2", "--out", str(tmp_path / "fig.png")], capsys)
+    one_line(code, err, "--out = ", "symbolic link")
+    assert target.read_text() == "keep me"
+
+
+def test_table_export_refuses_a_symlinked_out(tmp_path, capsys):
+    from tests.lookup.test_table import make_table
+    table = tmp_path / "kv.parquet"
+    make_table(table, Q1=[0.01, 0.1, 1.0], nu=(0.3, 0.5))
+    target = victim(tmp_path)
+    (tmp_path / "curve.csv").symlink_to(target)
+    code, _, err = run(["table", "export", str(table), "--out", str(tmp_path / "curve.csv"),
+                        "--E", "1e8", "--nu", "0.4", "--eta", "100", "--R", "0.01", "--m",
+                        "0.004", "--vz0-min", "0.1", "--vz0-max", "1", "--n", "3"], capsys)
+    one_line(code, err, "--out = ", "symbolic link")
+    assert target.read_text() == "keep me"
+
+
+# ---- item 6: shards take a lock that a plain run respects -----------------------------
+
+def test_plain_run_is_refused_while_shards_run_and_the_other_way(tmp_path, capsys):
+    from vimpact.sweep import store
+    spec, out = str(sweep_spec(tmp_path)), tmp_path / "out.parquet"
+    with store.OutputLock(out, shared=True), store.OutputLock(out, shared=True):  # 2 shards
+        code, _, err = run(["sweep", spec, "--out", str(out)], capsys)
+        one_line(code, err, "another sweep is writing", "--shard")
+        code, _, err = run(["sweep", spec, "--out", str(out), "--combine"], capsys)
+        one_line(code, err, "another sweep is writing")
+    with store.OutputLock(out):  # a plain run
+        code, _, err = run(["sweep", spec, "--out", str(out), "--shard", "0/2"], capsys)
+        one_line(code, err, "another sweep is writing", "pid")
+    nothing_written(tmp_path, "s.toml")
+
+
+def test_a_failed_part_write_says_make_room_only_for_a_full_disk(tmp_path):
+    import errno
+
+    from vimpact.sweep import load_spec, store
+    spec = load_spec(sweep_spec(tmp_path))
+    table = spec.schema().empty_table()
+    with pytest.raises(OSError) as info:  # the parts folder is gone (removed by another run)
+        store.write_part(spec, table, tmp_path / "gone", 0, {"counts": {}, "paths": {}})
+    assert "make room" not in str(info.value) and "--resume" in str(info.value)
+    full = store._kept(OSError(errno.ENOSPC, "No space left on device"), tmp_path)
+    assert "make room" in str(full)
+
+
+# ---- item 10: the end of a file-layout sweep needs room for the table and its parts ---
+
+def test_combine_without_room_for_table_and_parts_is_refused_up_front(tmp_path, capsys,
+                                                                      monkeypatch):
+    """The combined table is written while its parts exist (they go only after it is
+    verified): with less free disk than the parts' size the combination is refused
+    before it writes, says how much it needs, and keeps the parts."""
+    import shutil as real
+
+    from vimpact.sweep import store
+    spec, out = str(sweep_spec(tmp_path)), tmp_path / "out.parquet"
+    assert run(["sweep", spec, "--out", str(out), "--shard", "0/1"], capsys)[0] == 0
+    parts = sorted(store.parts_dir(out).glob("part-*.parquet"))
+    size = sum(p.stat().st_size for p in parts)
+    usage = real.disk_usage(tmp_path)
+    monkeypatch.setattr(store.shutil, "disk_usage",
+                        lambda p: usage._replace(free=size // 2))  # half the parts' size
+    code, _, err = run(["sweep", spec, "--out", str(out), "--combine"], capsys)
+    one_line(code, err, "not enough free disk", "MiB", "--resume")
+    assert not out.exists() and sorted(store.parts_dir(out).glob("part-*.parquet")) == parts
+    monkeypatch.undo()
+    code, stdout, err = run(["sweep", spec, "--out", str(out), "--combine"], capsys)
+    assert code == 0 and out.is_file() and not store.parts_dir(out).exists()

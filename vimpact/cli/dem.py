@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import os
 
 
 def add_parser(sub) -> None:
@@ -30,8 +31,13 @@ def run(args: argparse.Namespace) -> int:
     from vimpact.dem.problem import load_problem
     from vimpact.model.numerics import Numerics
 
-    problem = load_problem(args.file)
     out = args.out or f"vimpact-dem-{args.code}"
+    if args.out is not None and (os.path.lexists(out) and not os.path.isdir(out)
+                                 or os.path.islink(out)):
+        raise ValueError(f"--out = {out!r} is not allowed: it is "
+                         + ("a symbolic link" if os.path.islink(out) else "a file")
+                         + "; give a directory (created if missing)")
+    problem = load_problem(args.file)
     result = export(problem, args.code, out, Numerics.preset(args.preset))
     for f in result.fits:
         rb = f"; beta_x {f.res_beta_x}" if f.res_beta_x is not None else ""

@@ -330,5 +330,6 @@ def problem_from_toml(text: str, source: str = "<string>") -> DemProblem:
 
 def load_problem(path) -> DemProblem:
     """Read a DEM set-up TOML file (module doc)."""
+    from vimpact.model.toml_input import read_text
     path = Path(path)
-    return problem_from_toml(path.read_text(encoding="utf-8"), str(path))
+    return problem_from_toml(read_text(path, "DEM set-up"), str(path))

@@ -30,6 +30,7 @@ from vimpact.model.numerics import Numerics
 from vimpact.model.scene import Scene
 from vimpact.engine.simulate import simulate, simulate_batch
 from vimpact.lookup.table import DATA_STATUSES, RestitutionTable, _cluster, _same
+from vimpact.sweep.store import atomic_file, refuse_symlink
 
 __all__ = ["FIGURES", "FIGURE_NAMES", "FORMATS", "plot_figure", "figure_name",
            "fig3_2", "fig4_2", "fig4_4", "fig5_1", "fig5_2", "fig5_3", "fig5_4", "fig5_5"]
@@ -72,6 +73,7 @@ def _check_out(out) -> Path:
     if not path.parent.is_dir():
         raise ValueError(f"out = {str(out)!r} is not allowed: directory "
                          f"{str(path.parent)!r} does not exist")
+    refuse_symlink(path, "out")
     return path
 
 
@@ -88,7 +90,8 @@ def _drawing(out, nrows=1, ncols=1, figsize=(6.4, 4.4), **subplots):
         FigureCanvasAgg(fig)
         axes = fig.subplots(nrows, ncols, squeeze=True, **subplots)
         yield fig, axes
-        fig.savefig(path)
+        with atomic_file(path, "out") as f:  # never through a symbolic link
+            fig.savefig(f, format=path.suffix[1:].lower())
     fig.clear()
 
 
@@ -98,10 +101,17 @@ def _as_table(table, name: str) -> RestitutionTable:
         raise ValueError(f"figure {name} needs a restitution table: make it with "
                          f"`vimpact sweep {fig.spec}` and pass it (--table TABLE, or table=)")
     if isinstance(table, RestitutionTable):
-        return table
-    if isinstance(table, pd.DataFrame):
-        return RestitutionTable(table)
-    return RestitutionTable.open(table)
+        opened = table
+    elif isinstance(table, pd.DataFrame):
+        opened = RestitutionTable(table)
+    else:
+        opened = RestitutionTable.open(table)
+    if "psi" in opened.data.columns:  # the thesis's chapter 5 is full stick
+        shown = str(table) if isinstance(table, (str, Path)) else "the given table"
+        raise ValueError(f"table = {shown!r} is not allowed: figure {name} draws full-stick "
+                         "restitution and this table has friction (a psi column); give a "
+                         f"full-stick table, made by `vimpact sweep {FIGURES[name].spec}`")
+    return opened
 
 
 def _need_model(table: RestitutionTable, name: str, model: str) -> None:

@@ -456,9 +456,10 @@ def run_sweep(spec_path, out=None, resume: bool = False,
     if scheduler is not None and not combine:  # before anything is written
         scheduler = connect_scheduler(scheduler)
     try:
-        if shard is not None:  # shards run side by side (SLURM array): no output lock
-            return _run(spec, spec_path, out, parts, True, progress, workers, scheduler, shard,
-                        False, chunk_order, timings)
+        if shard is not None:  # shards run side by side (SLURM array): a shared lock
+            with store.OutputLock(out, shared=True):
+                return _run(spec, spec_path, out, parts, True, progress, workers, scheduler,
+                            shard, False, chunk_order, timings)
         with store.OutputLock(out):
             return _run(spec, spec_path, out, parts, resume, progress, workers, scheduler, None,
                         combine, chunk_order, timings)

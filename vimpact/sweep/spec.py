@@ -103,7 +103,9 @@ included: in full stick they are the impulse ratio, the rebound angle, 0 and 0),
 then ``path``, ``status``, ``error``.
 
 Output paths: ``output`` in the spec is relative to the spec file's
-directory; ``out=`` / ``--out`` is relative to the current directory. The
+directory and stays inside it (no ``..``, not absolute: a spec someone sends
+cannot make the sweep write elsewhere); ``out=`` / ``--out`` is relative to the
+current directory. The
 table layout and the runners are described in :mod:`vimpact.sweep.store` and
 :mod:`vimpact.sweep.runner`.
 
@@ -598,7 +600,11 @@ def load_spec(path) -> SweepSpec:
     output = data.get("output", path.with_suffix(".parquet").name)
     if not isinstance(output, str) or not output.strip():
         raise spec.bad("output", output, "a path (relative to the spec's directory)")
-    output = (path.parent / output) if not Path(output).is_absolute() else Path(output)
+    if Path(output).is_absolute() or ".." in Path(output).parts:
+        raise spec.bad("output", output, "a relative path inside the spec's directory "
+                       "(no '..', not absolute): a spec writes only beside itself; give "
+                       "--out to write elsewhere")
+    output = path.parent / output
     numerics = parse_numerics(spec, data.get("numerics", {}))
     layout = spec.choice(data, "layout", LAYOUTS, "auto")
 
