@@ -627,7 +627,8 @@ def load_spec(path) -> SweepSpec:
         draws, arms = {}, ()
     if mode == "random":
         grid_tolerance = grid_mu = None
-    if header.tangential_memory == "seed" and ("psi" in axes or "mu" in draws):
+    finite_mu = "mu" in draws and any(math.isfinite(x) for x in draws["mu"].values)
+    if header.tangential_memory == "seed" and ("psi" in axes or finite_mu):
         key = "grid.psi" if "psi" in axes else "random.mu"
         raise spec.error(key, "is not allowed with tangential_memory = \"seed\": the seed "
                          "memory sets every element to the total contact-point displacement, "
