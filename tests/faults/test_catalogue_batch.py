@@ -212,10 +212,13 @@ def typed_errors(psi_table):
         ("scene-not-utf8", ["simulate", "--scene", "bin.toml"], ["bin.toml", "UTF-8"]),
         ("dem-out-is-a-file", ["dem", "afile.toml", "--for", "lammps", "--out", "afile.toml"],
          ["--out = 'afile.toml'", "a file"]),
+        ("verify-n-1e9", ["table", "verify", KV_TABLE, "--n", "1000000000"],
+         ["--n = 1000000000", "100000"]),
+        ("verify-n-negative", ["table", "verify", KV_TABLE, "--n=-1"], ["--n = -1"]),
     ]
 
 
-@pytest.mark.parametrize("case", range(13))
+@pytest.mark.parametrize("case", range(15))
 def test_messages_name_what_was_typed(psi_table, tmp_path, monkeypatch, capsys, case):
     monkeypatch.chdir(tmp_path)
     (tmp_path / "bin.toml").write_bytes(b"\xff\xfe\x00 not text")

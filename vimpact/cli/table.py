@@ -242,8 +242,10 @@ def _cmd_lookup(a) -> int:
 def _cmd_verify(a) -> int:
     from vimpact.lookup.verify import interpolation_error, write_interpolation_error
 
-    if a.n < 0:
-        raise ValueError(f"--n = {a.n} is not allowed: must be an integer >= 0")
+    from vimpact.lookup.verify import MAX_POINTS
+    if not 0 <= a.n <= MAX_POINTS:
+        raise ValueError(f"--n = {a.n} is not allowed: must be an integer from 0 to "
+                         f"{MAX_POINTS} (random held-out points, each one direct simulation)")
     table = _open(a.table)
     result = interpolation_error(table, n=a.n, seed=a.seed, theta_ratio=a.theta_ratio,
                                  method=a.method)

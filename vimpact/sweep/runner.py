@@ -247,17 +247,8 @@ class RefinedSweepSpec(SweepSpec):
 
 
 def _write_json_atomic(path: Path, value: dict) -> None:
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    try:
-        with open(tmp, "w") as f:
-            json.dump(value, f)
-            f.flush()
-            os.fsync(f.fileno())
-        os.replace(tmp, path)
-    finally:
-        if tmp.exists():
-            tmp.unlink()
-    store.fsync_dir(path.parent)
+    with store.atomic_file(path, str(path), mode="w") as f:  # never through a symlink
+        json.dump(value, f)
 
 
 def _read_grid_cache(path: Path, spec: SweepSpec):
@@ -669,6 +660,9 @@ def _probe_scheduler(address: str, timeout: float) -> None:
                    else getattr(exc, "strerror", None) or str(exc))
             raise _scheduler_error(address, f"cannot connect to {host}:{port} ({why}; waited "
                                             f"at most {timeout:g} s)") from None
+
+    if scheme != "tcp":  # the handshake below is plain TCP; other schemes: Client's timeout
+        return
 
     async def identity():
         comm = await asyncio.wait_for(connect(address, timeout=timeout), timeout)
