@@ -285,3 +285,12 @@ def test_combine_without_room_for_table_and_parts_is_refused_up_front(tmp_path, 
     monkeypatch.undo()
     code, stdout, err = run(["sweep", spec, "--out", str(out), "--combine"], capsys)
     assert code == 0 and out.is_file() and not store.parts_dir(out).exists()
+
+
+def test_simulate_trajectory_refuses_a_symlink(tmp_path, capsys):
+    target = victim(tmp_path)
+    (tmp_path / "traj.csv").symlink_to(target)
+    code, _, err = run(["simulate", "--Q1", "0.1", "--nu", "0.5", "--trajectory",
+                        str(tmp_path / "traj.csv")], capsys)
+    one_line(code, err, "--trajectory = ", "symbolic link")
+    assert target.read_text() == "keep me"

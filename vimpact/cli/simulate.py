@@ -229,9 +229,12 @@ def numerics_from_args(a, base: Numerics | None = None) -> Numerics:
 def _check_output(flag: str, path: str, suffixes: tuple[str, ...]) -> Path:
     """Refuse an output path before any work: wrong extension, a directory, a
     missing or unwritable folder."""
+    from vimpact.sweep.store import refuse_symlink  # the one rule for files vimpact writes
+
     out = Path(path)
     if out.suffix.lower() not in suffixes:
         raise InputError(f"{flag} = {path!r} is not allowed: must end in {' or '.join(suffixes)}")
+    refuse_symlink(out, flag)
     if out.is_dir():
         raise InputError(f"{flag} = {path!r} is not allowed: it is a directory")
     folder = out.parent if str(out.parent) else Path(".")
@@ -264,11 +267,15 @@ def run(a) -> int:
     except InputError as exc:  # half-space exceeded, tolerance unreachable
         raise _as_flags(exc) from None
     if a.trajectory:
+        from vimpact.sweep.store import atomic_file
+
         out = Path(a.trajectory)
-        if out.suffix.lower() == ".csv":
-            res.trajectory.to_csv(out, index=False)
-        else:
-            res.trajectory.to_parquet(out, index=False)
+        csv = out.suffix.lower() == ".csv"
+        with atomic_file(out, "--trajectory", mode="w" if csv else "wb") as f:
+            if csv:
+                res.trajectory.to_csv(f, index=False)
+            else:
+                res.trajectory.to_parquet(f, index=False)
     if a.json:
         d = res.to_json_dict()
         if a.explain:
