@@ -215,10 +215,13 @@ def typed_errors(psi_table):
         ("verify-n-1e9", ["table", "verify", KV_TABLE, "--n", "1000000000"],
          ["--n = 1000000000", "100000"]),
         ("verify-n-negative", ["table", "verify", KV_TABLE, "--n=-1"], ["--n = -1"]),
+        ("verify-seed-negative", ["table", "verify", KV_TABLE, "--seed=-1"], ["--seed = -1"]),
+        ("bench-compare-not-utf8", ["bench", "compare", "bin.toml", "bin.toml"],
+         ["bin.toml", "UTF-8"]),
     ]
 
 
-@pytest.mark.parametrize("case", range(15))
+@pytest.mark.parametrize("case", range(17))
 def test_messages_name_what_was_typed(psi_table, tmp_path, monkeypatch, capsys, case):
     monkeypatch.chdir(tmp_path)
     (tmp_path / "bin.toml").write_bytes(b"\xff\xfe\x00 not text")

@@ -243,6 +243,8 @@ def _cmd_verify(a) -> int:
     from vimpact.lookup.verify import interpolation_error, write_interpolation_error
 
     from vimpact.lookup.verify import MAX_POINTS
+    if a.seed < 0:
+        raise ValueError(f"--seed = {a.seed} is not allowed: must be an integer >= 0")
     if not 0 <= a.n <= MAX_POINTS:
         raise ValueError(f"--n = {a.n} is not allowed: must be an integer from 0 to "
                          f"{MAX_POINTS} (random held-out points, each one direct simulation)")
