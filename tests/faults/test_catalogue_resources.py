@@ -294,3 +294,21 @@ def test_simulate_trajectory_refuses_a_symlink(tmp_path, capsys):
                         str(tmp_path / "traj.csv")], capsys)
     one_line(code, err, "--trajectory = ", "symbolic link")
     assert target.read_text() == "keep me"
+
+
+# ---- rows and chunks bounded before anything starts ---------------------------------
+
+@pytest.mark.parametrize("top, words", [
+    ("chunk_size = 64\nrows = 1000000000000", ["chunk_size = 64", "at least 1000000"]),
+    ("chunk_size = 100000000\nrows = 1000", ["chunk_size = 100000000", "at most 1000000"]),
+])
+def test_chunk_count_and_size_are_bounded(tmp_path, capsys, top, words):
+    """Before: 1e12 rows in chunks of 64 listed 1.6e10 chunks in memory (MemoryError)."""
+    chunk, rows = top.split("\n")
+    spec = tmp_path / "s.toml"
+    spec.write_text(f'model = "kelvin_voigt"\nseed = 1\n{chunk}\n[random]\n{rows}\n'
+                    "E_Pa = 1e7\neta_Pa_s = 1.0\nR_m = 0.1\nm_kg = 1.0\nv_z0_m_s = 1.0\n"
+                    "nu = 0.5\n")
+    code, _, err = run(["sweep", str(spec)], capsys)
+    one_line(code, err, "s.toml", *words)
+    nothing_written(tmp_path, "s.toml")

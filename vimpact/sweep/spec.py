@@ -20,7 +20,8 @@ parameters)::
     nu = [0.0, 0.1, 0.2, 0.3, 0.4, 0.5]
 
 Top-level keys: ``model`` (required), ``description``, ``seed``,
-``chunk_size`` (default 64), ``output`` (default: the spec's name with
+``chunk_size`` (default 64; at most :data:`MAX_CHUNK_SIZE` rows, and at most
+:data:`MAX_CHUNKS` chunks per sweep), ``output`` (default: the spec's name with
 ``.parquet`` beside it), ``layout``, ``tangential_memory``, ``tangential``,
 ``rotation``, ``numerics`` (a table, or a preset name as a string) and exactly
 one of ``[random]`` or ``[grid]``. Unknown keys and bad values are errors
@@ -159,6 +160,12 @@ SWEEP_STATUSES = _statuses()
 DEFAULT_CHUNK_SIZE = 64
 #: Rows of one sweep at most (a grid axis has at most as many points).
 MAX_ROWS = 10**12
+#: Chunks (part files) of one sweep at most: the runners list the chunks to do and the
+#: parts directory holds one file each; more rows need a larger ``chunk_size``.
+MAX_CHUNKS = 10**6
+#: Rows of one chunk at most: a chunk is held in memory (its inputs, outputs and the
+#: kernels' arrays, about a kilobyte a row).
+MAX_CHUNK_SIZE = 10**6
 #: Table layouts: one Parquet file, or a partitioned dataset (a directory).
 LAYOUTS = ("auto", "file", "dataset")
 #: ``layout = "auto"`` writes one file up to this many rows, a dataset above.
@@ -627,6 +634,13 @@ def load_spec(path) -> SweepSpec:
         draws, arms = {}, ()
     if mode == "random":
         grid_tolerance = grid_mu = None
+    if chunk_size > MAX_CHUNK_SIZE:
+        raise spec.bad("chunk_size", chunk_size, f"at most {MAX_CHUNK_SIZE} rows (a chunk is "
+                       "held in memory)")
+    if -(-rows // chunk_size) > MAX_CHUNKS:
+        raise spec.bad("chunk_size", chunk_size,
+                       f"at least {-(-rows // MAX_CHUNKS)} for {rows} rows: at most "
+                       f"{MAX_CHUNKS} chunks (part files) per sweep")
     finite_mu = "mu" in draws and any(math.isfinite(x) for x in draws["mu"].values)
     if header.tangential_memory == "seed" and ("psi" in axes or finite_mu):
         key = "grid.psi" if "psi" in axes else "random.mu"
