@@ -17,7 +17,6 @@ from __future__ import annotations
 
 import socket
 import threading
-import time
 from pathlib import Path
 
 import pytest
@@ -25,7 +24,6 @@ import pytest
 from vimpact.cli.main import main
 from vimpact.sweep import runner
 
-ROOT = Path(__file__).resolve().parents[2]
 
 SPEC = """model = "kelvin_voigt"
 chunk_size = 4
