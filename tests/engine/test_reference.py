@@ -108,7 +108,13 @@ def random_scene(rng, rheology, memory):
 
 
 def compare_with_naive(scene, res, ref, tag):
-    """Every output of a kernel result ``res`` against the naive dict ``ref``."""
+    """Every output of a kernel result ``res`` against the naive dict ``ref``; where the
+    naive solution itself leaves the elastic bound (``e_z > 1 + 1e-6``: this
+    discretization is too coarse for the scene) the kernel must say so (``unstable``
+    for the passive incremental memory) instead of a number."""
+    if scene.tangential_memory == "incremental" and ref["e_z"] > 1.0 + 1e-6:
+        assert (res.status, ref["status"]) == ("unstable", "ok") and math.isnan(res.e_z)
+        return
     assert res.status == ref["status"] == "ok", (res.status, ref["status"])
     velocity = max(abs(scene.v_x0), abs(scene.v_c0))  # tangential velocity scale, m/s
     scales = dict(v_x_end=velocity, omega_end=velocity / scene.R,

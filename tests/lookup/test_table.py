@@ -589,7 +589,7 @@ def test_cli_export_at_an_impact_angle_on_a_psi_table(vimpact_main, tmp_path, ca
             "--G", repr(material.G_inf), "--eta", repr(material.eta0), "--nu", str(nu),
             "--R", "1", "--m", "1", "--vz0-min", "0.5", "--vz0-max", "2", "--n", "5"]
     code, _, err = run(vimpact_main, args + ["--angle-deg", str(angle)], capsys)
-    assert code == 2 and "mu missing" in err
+    assert code == 2 and "--mu is missing" in err
     code, out, err = run(vimpact_main, args + ["--angle-deg", str(angle), "--mu", str(mu)],
                          capsys)
     assert code == 0, err

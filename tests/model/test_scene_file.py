@@ -88,21 +88,37 @@ BODIES = {
     "elastic_frictionless": ("elastic", "G_Pa = 8e8\nnu = 0.5\nR_m = 0.02\nm_kg = 0.05\n"
                                         "v_z0_m_s = 3.0\nangle_deg = 0\nmu = 0\n"),
 }
-TOP = 'tangential_memory = "seed"\n[numerics]\npreset = "fast"\nsteps = 500\n'
+TOP = 'tangential_memory = "{memory}"\n[numerics]\npreset = "fast"\nsteps = 500\n'
+#: Bodies with a finite friction coefficient: the seed memory refuses them.
+FRICTION = ("kelvin_voigt_friction_angle", "elastic_frictionless")
 
 
 @pytest.mark.parametrize("name", sorted(BODIES))
 def test_scene_file_equals_sweep_row_with_the_same_values(tmp_path, name):
     model, body = BODIES[name]
-    head = f'model = "{model}"\n' + TOP
+    memory = "incremental" if name in FRICTION else "seed"
+    head = f'model = "{model}"\n' + TOP.format(memory=memory)
     spec = load_spec(write(tmp_path, head.replace("[numerics]", "seed = 1\n[numerics]")
                            + "[random]\nrows = 1\n" + body, "sweep.toml"))
     scene, numerics = load_scene(write(tmp_path, head + "[scene]\n" + body))
     expected = spec.scene(spec.parameters(), 0)
     # a sweep row always allows a large contact; a scene file only when it says so
     assert scene == dataclasses.replace(expected, allow_large_contact=False)
-    assert (scene.tangential_memory, scene.Theta) == ("seed", expected.Theta)
+    assert (scene.tangential_memory, scene.Theta) == (memory, expected.Theta)
     assert numerics == spec.numerics == v.Numerics.preset("fast").with_(steps=500)
+
+
+@pytest.mark.parametrize("name", FRICTION)
+def test_seed_memory_with_finite_friction_is_refused_in_both(tmp_path, name):
+    """Coulomb friction needs the incremental memory: a scene file and a sweep spec
+    with the seed memory and a finite mu are refused, naming the file and mu."""
+    model, body = BODIES[name]
+    head = f'model = "{model}"\n' + TOP.format(memory="seed")
+    with pytest.raises(ValueError, match=r"scene\.toml: scene: mu = 0\.[02] is not allowed: .*seed"):
+        load_scene(write(tmp_path, head + "[scene]\n" + body, "scene.toml"))
+    with pytest.raises(ValueError, match=r"sweep\.toml: random\.mu.*seed"):
+        load_spec(write(tmp_path, head.replace("[numerics]", "seed = 1\n[numerics]")
+                        + "[random]\nrows = 1\n" + body, "sweep.toml"))
 
 
 def test_defaults_and_options():

@@ -33,14 +33,16 @@ def load_result(path: str | Path) -> dict:
 
     Raises
     ------
-    OSError
-        if the file cannot be read.
+    ValueError
+        naming the file if it is missing, unreadable or not UTF-8 text.
     vimpact.InputError
         if it is not JSON or not a vimpact benchmark result (no ``benchmark``
         name or no ``figures``).
     """
+    from vimpact.model.toml_input import read_text  # the one reading rule for input files
+
     path = Path(path)
-    text = path.read_text()
+    text = read_text(path, "benchmark result")
     try:
         data = json.loads(text)
     except json.JSONDecodeError as exc:

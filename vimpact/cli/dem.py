@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import os
 
 from vimpact.model.numerics import CONVERGED_PRESETS
 
@@ -53,6 +54,11 @@ def run(args: argparse.Namespace) -> int:
     if args.steps_per_contact is not None and args.steps_per_contact < 4:
         raise InputError(message("--steps-per-contact", args.steps_per_contact,
                                   "an integer >= 4"))
+    if args.out is not None and (os.path.lexists(args.out) and not os.path.isdir(args.out)
+                                 or os.path.islink(args.out)):
+        raise ValueError(f"--out = {args.out!r} is not allowed: it is "
+                         + ("a symbolic link" if os.path.islink(args.out) else "a file")
+                         + "; give a directory (created if missing)")
     problem = load_problem(args.file, temperature=args.temperature)
     out = args.out or f"vimpact-dem-{args.code}"
 

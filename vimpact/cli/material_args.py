@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import re
 
 from vimpact.model.material import Material
 
@@ -78,3 +79,16 @@ def material_from_args(a) -> Material:
     if a.eta is not None:
         raise ValueError("--eta is not used by --model elastic")
     return Material.elastic(nu=a.nu, G=a.G, E=a.E)
+
+
+def as_flags(exc: ValueError, flags: dict[str, str]) -> ValueError:
+    """The error of an API parameter named by its command-line flag: every ``name = ``
+    (or ``name missing``) of ``flags`` (parameter -> flag) at the message's start or
+    after ``(``, ``, `` or ``; `` becomes ``flag = `` (``flag is missing``); the value
+    stays as it is."""
+    named = re.compile(r"(^|\(|, |; )(" + "|".join(sorted(map(re.escape, flags), key=len,
+                                                           reverse=True))
+                       + r")( = | is missing| missing)")
+    return type(exc)(named.sub(lambda m: f"{m[1]}{flags[m[2]]}"
+                               + (" is missing" if "missing" in m[3] else m[3]), str(exc))) \
+        if isinstance(exc, ValueError) else exc

@@ -7,11 +7,10 @@ import dataclasses
 import json
 import math
 import os
-import re
 from pathlib import Path
 
 from vimpact import __version__
-from vimpact.cli.material_args import add_material_arguments, material_from_args, missing
+from vimpact.cli.material_args import add_material_arguments, as_flags, material_from_args, missing
 from vimpact.engine.result import STATUSES, UNITS
 from vimpact.model.material import MODELS
 from vimpact.model.numerics import INTEGRATORS, PRESETS, Numerics, preset_summary
@@ -131,16 +130,13 @@ _FLAGS = {"v_z0": "--vz0", "v_x0": "--vx0", "omega0": "--omega0", "theta_ratio":
           "Q2": "--Q2", "E": "--E", "G": "--G", "eta": "--eta", "G1": "--G1", "G2": "--G2",
           "steps": "--steps", "elements": "--elements", "rtol": "--rtol",
           "tolerance": "--tolerance", "integrator": "--integrator"}
-#: A parameter name where a message names one: at its start, or after "(", ", ", "; ".
-_NAMED = re.compile(r"(^|\(|, |; )(" + "|".join(sorted(map(re.escape, _FLAGS), key=len,
-                                                          reverse=True)) + r") = ")
 #: Options that set a scene's Hertz scales (named when those leave the float range).
 _SCALE_OPTIONS = ("E", "G", "G1", "G2", "eta", "prony", "R", "m", "Theta", "vz0", "theta_ratio")
 
 
 def _as_flags(exc: ValueError) -> InputError:
     """The error of a Scene/Material/Numerics parameter, named by its command-line flag."""
-    return InputError(_NAMED.sub(lambda m: f"{m[1]}{_FLAGS[m[2]]} = ", str(exc)))
+    return InputError(str(as_flags(exc, _FLAGS)))
 
 
 def scene_from_args(a) -> Scene:
@@ -274,9 +270,12 @@ def numerics_from_args(a, base: Numerics | None = None) -> Numerics:
 def _check_output(flag: str, path: str, suffixes: tuple[str, ...]) -> Path:
     """Refuse an output path before any work: wrong extension, a directory, a
     missing or unwritable folder."""
+    from vimpact.sweep.store import refuse_symlink  # the one rule for files vimpact writes
+
     out = Path(path)
     if out.suffix.lower() not in suffixes:
         raise InputError(f"{flag} = {path!r} is not allowed: must end in {' or '.join(suffixes)}")
+    refuse_symlink(out, flag)
     if out.is_dir():
         raise InputError(f"{flag} = {path!r} is not allowed: it is a directory")
     folder = out.parent if str(out.parent) else Path(".")
@@ -309,11 +308,15 @@ def run(a) -> int:
     except InputError as exc:  # half-space exceeded, tolerance unreachable
         raise _as_flags(exc) from None
     if a.trajectory:
+        from vimpact.sweep.store import atomic_file
+
         out = Path(a.trajectory)
-        if out.suffix.lower() == ".csv":
-            res.trajectory.to_csv(out, index=False)
-        else:
-            res.trajectory.to_parquet(out, index=False)
+        csv = out.suffix.lower() == ".csv"
+        with atomic_file(out, "--trajectory", mode="w" if csv else "wb") as f:
+            if csv:
+                res.trajectory.to_csv(f, index=False)
+            else:
+                res.trajectory.to_parquet(f, index=False)
     if a.json:
         d = res.to_json_dict()
         if a.explain:

@@ -15,7 +15,7 @@ import math
 
 import numpy as np
 
-from vimpact.cli.material_args import add_material_arguments, material_from_args
+from vimpact.cli.material_args import add_material_arguments, as_flags, material_from_args
 
 __all__ = ["add_parser"]
 
@@ -27,7 +27,7 @@ MAX_CURVE_POINTS = 100_000
 def _number_list(text: str) -> list[float]:
     """``"0.1,0.2, 1e-3"`` -> ``[0.1, 0.2, 0.001]`` (argparse type)."""
     try:
-        values = [float(x) for x in text.split(",") if x.strip()]
+        values = [float(x) for x in text.split(",")]
     except ValueError:
         raise argparse.ArgumentTypeError(
             f"{text!r} is not a number or a comma-separated list of numbers") from None
@@ -209,8 +209,12 @@ def _cmd_lookup(a) -> int:
     def column(values):
         return None if values is None else np.broadcast_to(np.array(values, dtype=float), (n,))
 
-    res = table.lookup(column(a.Q1), column(a.nu), column(a.Q2), extrapolate=a.extrapolate,
-                       theta_ratio=column(a.theta_ratio), method=a.method, psi=column(a.psi))
+    try:
+        res = table.lookup(column(a.Q1), column(a.nu), column(a.Q2), extrapolate=a.extrapolate,
+                           theta_ratio=column(a.theta_ratio), method=a.method,
+                           psi=column(a.psi))
+    except ValueError as exc:  # name the options as typed, not the API's arguments
+        raise as_flags(exc, _LOOKUP_FLAGS) from None
     bound = res.pop("error_bound")
     names = list(res)
     rows = [{k: _json_value(float(res[k][i])) for k in names} for i in range(len(res["Q1"]))]
@@ -236,10 +240,12 @@ def _cmd_lookup(a) -> int:
 
 
 def _cmd_verify(a) -> int:
-    from vimpact.lookup.verify import interpolation_error, write_interpolation_error
-
-    if a.n < 0:
-        raise ValueError(f"--n = {a.n} is not allowed: must be an integer >= 0")
+    from vimpact.lookup.verify import MAX_POINTS, interpolation_error, write_interpolation_error
+    if a.seed < 0:
+        raise ValueError(f"--seed = {a.seed} is not allowed: must be an integer >= 0")
+    if not 0 <= a.n <= MAX_POINTS:
+        raise ValueError(f"--n = {a.n} is not allowed: must be an integer from 0 to "
+                         f"{MAX_POINTS} (random held-out points, each one direct simulation)")
     table = _open(a.table)
     result = interpolation_error(table, n=a.n, seed=a.seed, theta_ratio=a.theta_ratio,
                                  method=a.method)
@@ -272,6 +278,15 @@ _MATERIAL_OPTIONS = {
 }
 
 
+#: ``RestitutionTable.lookup`` parameter -> the ``table lookup`` option.
+_LOOKUP_FLAGS = {"Q1": "--Q1", "Q2": "--Q2", "nu": "--nu", "theta_ratio": "--theta-ratio",
+                 "psi": "--psi", "extrapolate=True (--extrapolate)": "--extrapolate"}
+#: ``RestitutionTable.export_curve`` parameter -> the ``table export`` option.
+_EXPORT_FLAGS = {"out": "--out", "mu": "--mu", "angle_deg": "--angle-deg",
+                 "theta_ratio": "--theta-ratio", "R": "--R", "m": "--m", "v_z0": "--vz0-min/max",
+                 "speeds": "--vz0-min/max"}
+
+
 def _cmd_export(a) -> int:
     require_n = a.n >= 1 and (a.n >= 2 or a.vz0_min == a.vz0_max)
     if not require_n:
@@ -295,10 +310,13 @@ def _cmd_export(a) -> int:
         speeds = np.geomspace(a.vz0_min, a.vz0_max, a.n)
     else:
         speeds = np.linspace(a.vz0_min, a.vz0_max, a.n)
-    df = table.export_curve(a.out, material, a.R, a.m, speeds, theta_ratio=a.theta_ratio,
-                            extrapolate=a.extrapolate,
-                            allow_large_contact=a.allow_large_contact,
-                            angle_deg=a.angle_deg, mu=a.mu)
+    try:
+        df = table.export_curve(a.out, material, a.R, a.m, speeds, theta_ratio=a.theta_ratio,
+                                extrapolate=a.extrapolate,
+                                allow_large_contact=a.allow_large_contact,
+                                angle_deg=a.angle_deg, mu=a.mu)
+    except ValueError as exc:  # name the options as typed, not the API's arguments
+        raise as_flags(exc, _EXPORT_FLAGS) from None
     summary = {"out": a.out, "model": material.model, "rows": len(df),
                **({"psi": float(df.psi.iloc[0]), "angle_deg": a.angle_deg, "mu": a.mu}
                   if "psi" in df.columns else {}),

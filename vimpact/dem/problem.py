@@ -341,6 +341,7 @@ def problem_from_toml(text: str, source: str = "<string>", *, base: Path | None 
 def load_problem(path, temperature: float | None = None) -> DemProblem:
     """Read a DEM set-up TOML file (module doc); ``temperature`` (K) overrides its
     ``temperature_K``."""
+    from vimpact.model.toml_input import read_text
     path = Path(path)
-    return problem_from_toml(path.read_text(encoding="utf-8"), str(path), base=path.parent,
+    return problem_from_toml(read_text(path, "DEM set-up"), str(path), base=path.parent,
                              temperature=temperature)

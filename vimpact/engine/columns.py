@@ -50,6 +50,7 @@ from vimpact.model.material import MODELS
 from vimpact.model.scene import (
     DEFAULT_THETA_RATIO,
     MAX_DASHPOT_TIME,
+    SEED_FRICTION_ALLOWED,
     TANGENTIAL_EFFECTS,
     TANGENTIAL_MEMORY,
     Scene,
@@ -282,6 +283,10 @@ class SceneColumns:
             ratio = arrays.get("theta_ratio", np.full(n, DEFAULT_THETA_RATIO))
             Theta = check_column("theta_ratio", ratio, "positive", reasons) * m * R**2
         model = _model(arrays.get("model"), G_arm, num["eta0_Pa_s"], n, reasons)
+        seeded = ((codes["tangential_memory"] == TANGENTIAL_MEMORY.index("seed"))
+                  & np.isfinite(num["mu"]))
+        for i in np.flatnonzero(seeded & is_none(reasons)):
+            reasons[i] = message("mu", float(num["mu"][i]), SEED_FRICTION_ALLOWED)
         cols = dict(nu=num["nu"], G_inf=num["G_inf_Pa"], eta0=num["eta0_Pa_s"], G_arm=G_arm,
                     tau_arm=tau_arm, R=R, m=m, v_z0=num["v_z0_m_s"], v_x0=num["v_x0_m_s"],
                     omega0=num["omega0_rad_s"], Theta=Theta, mu=num["mu"],

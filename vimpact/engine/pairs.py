@@ -17,7 +17,7 @@ import pandas as pd
 from vimpact.engine.simulate import simulate, simulate_batch
 from vimpact.model.pair import Body, PairResult, Wall, end_states, pair_scene
 from vimpact.model.scene import Scene
-from vimpact.model.validation import require
+from vimpact.model.validation import message, require
 
 
 def simulate_pair(body1: Body, other: Body | Wall, numerics=None, **scene_options) -> PairResult:
@@ -54,22 +54,44 @@ def simulate_pair_batch(pairs: Sequence[tuple[Body, Body | Wall]], numerics=None
     pandas.DataFrame
         one row per pair: ``e_z, beta_x, status, t_contact_s`` and the end
         states ``v_z1, v_x1, omega1, v_z2, v_x2, omega2`` (m/s, rad/s; NaN for a
-        wall) and the impulses on body 1 ``J_z, J_x`` (N s).
+        wall) and the impulses on body 1 ``J_z, J_x`` (N s), and ``error``. A pair
+        that is not a valid ``(body, body or wall)`` approaching along ``z`` gets
+        status ``invalid``, its reason in ``error`` and NaN numbers; the other pairs
+        are unaffected (nothing is raised for a bad pair).
     """
-    scenes = [pair_scene(b1, b2, **scene_options) for b1, b2 in pairs]
-    df = simulate_batch(scenes, numerics)
-    rows = []
-    for (b1, b2), s, e_z, beta_x in zip(pairs, scenes, df["e_z"].to_numpy(),
-                                        df["beta_x"].to_numpy()):
-        end1, end2, J_z, J_x = end_states(b1, b2, s, float(e_z), float(beta_x))
-        end2 = end2 or (np.nan, np.nan, np.nan)
-        rows.append((*end1, *end2, J_z, J_x))
-    ends = pd.DataFrame(rows, columns=["v_z1", "v_x1", "omega1", "v_z2", "v_x2", "omega2",
-                                       "J_z", "J_x"])
-    out = pd.concat([df[["e_z", "beta_x", "status", "t_contact"]].reset_index(drop=True), ends],
-                    axis=1)
-    bad = ~np.isfinite(out["e_z"].to_numpy(dtype=float))
-    out.loc[bad, ["v_z1", "v_x1", "omega1", "v_z2", "v_x2", "omega2", "J_z", "J_x"]] = np.nan
+    pairs = list(pairs)
+    n = len(pairs)
+    scenes: list = [None] * n
+    reasons: list = [None] * n
+    for i, pair in enumerate(pairs):
+        try:
+            b1, b2 = pair
+            require(f"pairs[{i}]", pair, isinstance(b1, Body) and isinstance(b2, (Body, Wall)),
+                    "a (vimpact.Body, vimpact.Body or vimpact.Wall) pair")
+            scenes[i] = pair_scene(b1, b2, **scene_options)
+        except (ValueError, TypeError) as exc:
+            reasons[i] = (f"pairs[{i}]: {exc}" if isinstance(exc, ValueError) else
+                          message(f"pairs[{i}]", pair, "a (vimpact.Body, vimpact.Body or "
+                                                       "vimpact.Wall) pair"))
+    good = [i for i in range(n) if scenes[i] is not None]
+    df = simulate_batch([scenes[i] for i in good], numerics)
+    columns = ["e_z", "beta_x", "status", "t_contact", "v_z1", "v_x1", "omega1", "v_z2", "v_x2",
+               "omega2", "J_z", "J_x", "error"]
+    rows = [dict(e_z=np.nan, beta_x=np.nan, status="invalid", t_contact=np.nan, v_z1=np.nan,
+                 v_x1=np.nan, omega1=np.nan, v_z2=np.nan, v_x2=np.nan, omega2=np.nan,
+                 J_z=np.nan, J_x=np.nan, error=reasons[i]) for i in range(n)]
+    for k, i in enumerate(good):
+        row = df.iloc[k]
+        e_z, beta_x = float(row["e_z"]), float(row["beta_x"])
+        rows[i].update(e_z=e_z, beta_x=beta_x, status=row["status"],
+                       t_contact=float(row["t_contact"]), error=row.get("error"))
+        if math.isfinite(e_z):
+            b1, b2 = pairs[i]
+            end1, end2, J_z, J_x = end_states(b1, b2, scenes[i], e_z, beta_x)
+            end2 = end2 or (np.nan, np.nan, np.nan)
+            rows[i].update(zip(("v_z1", "v_x1", "omega1", "v_z2", "v_x2", "omega2", "J_z",
+                                "J_x"), (*end1, *end2, J_z, J_x)))
+    out = pd.DataFrame(rows, columns=columns)
     return out.rename(columns={"t_contact": "t_contact_s"})
 
 

@@ -61,7 +61,9 @@ class ImpactResult:
     a_max : maximum contact half-width, m
     t_hertz, d_hertz, a_hertz : Hertz contact time (s), indentation (m) and
         radius (m) of the elastic impact with the relaxed modulus
-    energy_ratio : kinetic energy after / before (translation and rotation)
+    energy_ratio : kinetic energy after / before (translation and rotation; with a held
+        spin, ``rotation=False``, the spin's energy is left out and the work of the
+        torque holding it counted as energy put in: docs/physics.md#energy-and-passivity)
     Q1, Q2, nu : dimensionless parameters (Q1 NaN for a general Prony series,
         Q2 NaN unless a standard solid)
     v_z_end, v_x_end, omega_end : end velocities, m/s, m/s, rad/s (v_z > 0 into the half-space)

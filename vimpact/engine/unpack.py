@@ -66,8 +66,15 @@ def unpack(cols: SceneColumns, out: np.ndarray, path_names: np.ndarray, explicit
         spin = np.where(cols.rotation, impulse * cols.m * cols.R / cols.Theta, 0.0)
         v_x_end = cols.v_x0 - impulse
         omega_end = cols.omega0 - spin
-        energy0 = 0.5 * (cols.m * (v_z0**2 + cols.v_x0**2) + cols.Theta * cols.omega0**2)
-        energy1 = 0.5 * (cols.m * (v_z_end**2 + v_x_end**2) + cols.Theta * omega_end**2)
+        # a held spin (rotation off) is a drive, not a store: its energy is left out and
+        # the work of the torque that holds it, R omega0 times the tangential impulse,
+        # is counted as energy put in (docs/physics.md#energy-and-passivity)
+        held = ~cols.rotation
+        spin0 = np.where(held, 0.0, cols.Theta * cols.omega0**2)
+        spin1 = np.where(held, 0.0, cols.Theta * omega_end**2)
+        drive = np.where(held, 2.0 * cols.m * cols.R * cols.omega0 * impulse, 0.0)
+        energy0 = 0.5 * (cols.m * (v_z0**2 + cols.v_x0**2) + spin0 + drive)
+        energy1 = 0.5 * (cols.m * (v_z_end**2 + v_x_end**2) + spin1)
         # passivity of what the contact can exchange: the normal energy and the contact
         # point's effective tangential energy m v_c^2 / (2 mu_t); a spin held fixed
         # (rotation off) is outside it, so its work on the sphere cannot count as a gain
@@ -92,6 +99,7 @@ def unpack(cols: SceneColumns, out: np.ndarray, path_names: np.ndarray, explicit
         # the contact point's tangential speed cannot grow either (|beta_x| <= 1): the
         # normal energy is far larger when v_c0 << v_z0, so the sum above misses it
         gain = ((contact1 > contact0 * (1.0 + PASSIVITY_SLACK))
+                | (np.abs(vz_end) > 1.0 + PASSIVITY_SLACK)
                 | (tangential & (np.abs(vc_end) > 1.0 + PASSIVITY_SLACK)))
         contact_steps = out[:, layout.OUT_T_CONTACT] * steps_per_T
         unresolved = contact_steps < MIN_CONTACT_STEPS
@@ -99,6 +107,8 @@ def unpack(cols: SceneColumns, out: np.ndarray, path_names: np.ndarray, explicit
     incremental = cols.memory == TANGENTIAL_MEMORY.index("incremental")
     status[ok & gain & incremental & ~explicit_euler] = "unstable"
     status[ok & gain & incremental & explicit_euler] = "energy_gain"
+    status[ok & gain & ~incremental] = "not_passive"
+    passive = incremental & ~explicit_euler
     status[ok & (steps_per_T > 0) & unresolved] = "unresolved"
     ok = status == "ok"
     status[ok & (values["a_max"] > HALF_SPACE_LIMIT * cols.R)] = "half_space"
@@ -106,6 +116,8 @@ def unpack(cols: SceneColumns, out: np.ndarray, path_names: np.ndarray, explicit
     status[ok & (cols.tangential == TANGENTIAL_EFFECTS.index("none"))] = "normal_only"
     ok = status == "ok"
     status[ok & (v_c0 == 0.0)] = "vc0_zero"
+    clip_round_off(values, np.isin(status, ("ok", "vc0_zero", "normal_only", "half_space")),
+                   passive)
     guard(values, status, tangential)
     why = np.full(n, None, dtype=object)
     for i in np.flatnonzero(valid & ~ran):  # refused rows only
@@ -125,6 +137,21 @@ def unpack(cols: SceneColumns, out: np.ndarray, path_names: np.ndarray, explicit
         result[name] = np.where(valid, result[name], np.nan)
     result["n_steps"] = np.where(valid, result["n_steps"], 0)
     return {name: result[name] for name in RESULT_FIELDS}
+
+
+def clip_round_off(values: dict[str, np.ndarray], ok: np.ndarray, passive: np.ndarray) -> None:
+    """The physical bounds of a passive impact, kept exactly: in a finished row (``ok``
+    and its finished variants, not ``energy_gain``, ``not_passive``; mask ``ok``) of a
+    passive scene (incremental memory, not explicit Euler) ``e_z``, ``e_x``,
+    ``|beta_x|`` and ``energy_ratio`` are at most 1. Rounding can put them above by
+    up to :data:`PASSIVITY_SLACK` (a larger excess is status ``unstable``); such a
+    value is set to the bound (``beta_x`` keeps its sign)."""
+    rows = ok & passive
+    with np.errstate(invalid="ignore"):
+        for name in ("e_z", "e_x", "energy_ratio"):
+            values[name] = np.where(rows & (values[name] > 1.0), 1.0, values[name])
+        b = values["beta_x"]
+        values["beta_x"] = np.where(rows & (np.abs(b) > 1.0), np.sign(b), b)
 
 
 def guard(values: dict[str, np.ndarray], status: np.ndarray, tangential: np.ndarray) -> None:
@@ -148,11 +175,17 @@ def _explain(status: np.ndarray, error: np.ndarray, contact_steps: np.ndarray,
              relative_gain: np.ndarray) -> None:
     """A reason for every row whose status is not finished and has none yet: no row
     ends without numbers and without saying why."""
-    for i in np.flatnonzero(~np.isin(status, FINISHED) & is_none(error)):
+    explain = ~np.isin(status, FINISHED) | (status == "not_passive")
+    for i in np.flatnonzero(explain & is_none(error)):
         if status[i] == "unresolved":
             error[i] = (f"the contact lasted {contact_steps[i]:.3g} time steps on the element "
                         f"path: at least {MIN_CONTACT_STEPS} are needed to resolve it (more "
                         "steps per t_H, or the continuum path)")
+        elif status[i] == "not_passive":
+            error[i] = (f"the contact energy rose by {relative_gain[i]:.2g} of its start, or "
+                        "|e_z| or |beta_x| exceeds 1: the seed tangential memory is not "
+                        "passive (numbers kept as its rule gives them; the incremental "
+                        "memory is passive)")
         elif status[i] == "unstable":
             error[i] = (f"the contact energy rose by {relative_gain[i]:.2g} of its start, or the "
                         f"contact point's tangential speed by more than {PASSIVITY_SLACK:g} "

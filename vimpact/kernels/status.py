@@ -51,6 +51,9 @@ TABLE: tuple[Status, ...] = (
     Status("energy_gain", None, "finished, but explicit Euler gained energy (more than 1e-6 of "
            "the contact energy), as it does by construction: numbers kept as the thesis's "
            "integrator gives them, not converged (use verlet)", True, False),
+    Status("not_passive", None, "finished, but the seed tangential memory (not passive) gained "
+           "energy or gave |e_z| or |beta_x| above 1 + 1e-6: numbers kept as its rule gives "
+           "them, not physical (the incremental memory is passive)", True, False),
     Status("unresolved", None, "the contact lasted fewer time steps than the element path needs "
            "to resolve it (numerics.MIN_CONTACT_STEPS); outputs NaN (more steps, or the "
            "continuum path)", False, False),

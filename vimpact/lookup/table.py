@@ -992,8 +992,11 @@ class RestitutionTable:
         p = Path(path)
         require("out", str(path), p.suffix.lower() == ".csv", "a file name ending in .csv")
         require("out", str(path), p.parent.is_dir(), "in an existing directory")
+        from vimpact.sweep.store import atomic_file, refuse_symlink
+        refuse_symlink(p, "out")  # before the work
         df = self.restitution_curve(material, R, m, v_z0, **options)
-        df.to_csv(p, index=False, float_format="%.10g")
+        with atomic_file(p, "out", mode="w") as f:  # never through a symbolic link
+            df.to_csv(f, index=False, float_format="%.10g")
         return df
 
 

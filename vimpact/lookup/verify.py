@@ -41,6 +41,9 @@ __all__ = ["KINDS", "held_out_errors", "held_out_points", "interpolation_error",
 #: move the peak by O(h). On the Kelvin-Voigt tables, fresh random points exceeded
 #: the measured max by at most 1e-4 (relative): 1.5 leaves room for that.
 BOUND_FACTOR = 1.5
+#: Random held-out points of :func:`interpolation_error` at most (each is one direct
+#: simulation; ``vimpact table verify --n``).
+MAX_POINTS = 100_000
 #: Kinds of held-out points (see the module text).
 KINDS = ("axis", "centre", "random")
 _OUTPUTS = ("e_z", "beta_x", "e_x")
@@ -293,6 +296,9 @@ def interpolation_error(table, numerics=None, n: int = 200, seed: int = 0, theta
     """
     from vimpact import __version__
 
+    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or not 0 <= n <= MAX_POINTS:
+        raise InputError(f"n = {n!r} is not allowed: must be an integer from 0 to {MAX_POINTS} "
+                         "(random held-out points, each one direct simulation)")
     numerics = numerics_of(table) if numerics is None else numerics
     err = held_out_errors(table, numerics, n, seed, theta_ratio, method, kinds, simulate)
     axes = [a for a in ("Q1", "Q2", "nu") if a in err.columns]

@@ -22,6 +22,11 @@ from vimpact.model.validation import (
 )
 
 TANGENTIAL_MEMORY = ("incremental", "seed")
+#: What a friction coefficient may be with the seed memory: the seed memory sets every
+#: element to the total contact-point displacement, which slip cannot change, so
+#: Coulomb friction needs the incremental memory.
+SEED_FRICTION_ALLOWED = ("inf (full stick) with the seed tangential memory: Coulomb friction "
+                         "needs the incremental memory")
 
 #: What a scene asks of the tangential problem: ``auto`` (stick whenever
 #: ``v_c0 != 0``), ``stick`` (full stick, docs/physics.md#full-stick) or ``none``
@@ -120,6 +125,8 @@ class Scene:
         flag("rotation", self.rotation)
         flag("allow_large_contact", self.allow_large_contact)
         object.__setattr__(self, "mu", friction_coefficient("mu", self.mu))
+        require("mu", self.mu, self.tangential_memory != "seed" or math.isinf(self.mu),
+                SEED_FRICTION_ALLOWED)
         mat = self.material
         with np.errstate(all="ignore"):
             hz = hertz_scales(mat.G_inf, mat.nu, self.R, self.m, self.v_z0)

@@ -169,14 +169,24 @@ class TomlSource:
         return value
 
 
-def read_toml(path: Path, what: str) -> tuple[str, dict]:
-    """Text and parsed content of the TOML file ``path`` (``what`` names it in errors)."""
+def read_text(path: Path, what: str) -> str:
+    """The UTF-8 text of the file ``path``; ``ValueError`` naming the file and ``what``
+    it should be when it is missing, unreadable or not UTF-8 text."""
     try:
-        text = path.read_text(encoding="utf-8")
+        return Path(path).read_text(encoding="utf-8")
     except FileNotFoundError:
         raise ValueError(f"{path}: {what} not found") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise ValueError(f"{path}: cannot read the {what}: {exc}") from None
+    except UnicodeDecodeError as exc:
+        raise ValueError(f"{path}: cannot read the {what}: not UTF-8 text (byte "
+                         f"{exc.object[exc.start:exc.start + 1]!r} at position {exc.start})") \
+            from None
+    except OSError as exc:
+        raise ValueError(f"{path}: cannot read the {what}: {exc.strerror or exc}") from None
+
+
+def read_toml(path: Path, what: str) -> tuple[str, dict]:
+    """Text and parsed content of the TOML file ``path`` (``what`` names it in errors)."""
+    text = read_text(path, what)
     return text, parse_toml(TomlSource(path), text)
 
 

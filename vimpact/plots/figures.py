@@ -53,10 +53,17 @@ def _as_table(table, name: str) -> RestitutionTable:
         raise ValueError(f"figure {name} needs a restitution table: make it with "
                          f"`vimpact sweep {fig.spec}` and pass it (--table TABLE, or table=)")
     if isinstance(table, RestitutionTable):
-        return table
-    if isinstance(table, pd.DataFrame):
-        return RestitutionTable(table)
-    return RestitutionTable.open(table)
+        opened = table
+    elif isinstance(table, pd.DataFrame):
+        opened = RestitutionTable(table)
+    else:
+        opened = RestitutionTable.open(table)
+    if "psi" in opened.data.columns:  # the thesis's chapter 5 is full stick
+        shown = str(table) if isinstance(table, (str, Path)) else "the given table"
+        raise ValueError(f"table = {shown!r} is not allowed: figure {name} draws full-stick "
+                         "restitution and this table has friction (a psi column); give a "
+                         f"full-stick table, made by `vimpact sweep {FIGURES[name].spec}`")
+    return opened
 
 
 def _need_model(table: RestitutionTable, name: str, model: str) -> None:

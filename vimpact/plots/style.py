@@ -8,6 +8,8 @@ from __future__ import annotations
 import contextlib
 from pathlib import Path
 
+from vimpact.sweep.store import atomic_file, refuse_symlink
+
 __all__ = ["FORMATS", "STYLE", "check_out", "drawing"]
 
 #: Output formats, chosen by the extension of ``out``.
@@ -41,6 +43,7 @@ def check_out(out) -> Path:
     if not path.parent.is_dir():
         raise ValueError(f"out = {str(out)!r} is not allowed: directory "
                          f"{str(path.parent)!r} does not exist")
+    refuse_symlink(path, "out")
     return path
 
 
@@ -57,5 +60,6 @@ def drawing(out, nrows=1, ncols=1, figsize=(6.4, 4.4), **subplots):
         FigureCanvasAgg(fig)
         axes = fig.subplots(nrows, ncols, squeeze=True, **subplots)
         yield fig, axes
-        fig.savefig(path)
+        with atomic_file(path, "out") as f:  # never through a symbolic link
+            fig.savefig(f, format=path.suffix[1:].lower())
     fig.clear()

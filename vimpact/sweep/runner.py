@@ -47,6 +47,7 @@ import dataclasses
 import json
 import math
 import os
+import socket
 import sys
 from collections.abc import Callable
 from pathlib import Path
@@ -254,17 +255,8 @@ class RefinedSweepSpec(SweepSpec):
 
 
 def _write_json_atomic(path: Path, value: dict) -> None:
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    try:
-        with open(tmp, "w") as f:
-            json.dump(value, f)
-            f.flush()
-            os.fsync(f.fileno())
-        os.replace(tmp, path)
-    finally:
-        if tmp.exists():
-            tmp.unlink()
-    store.fsync_dir(path.parent)
+    with store.atomic_file(path, str(path), mode="w") as f:  # never through a symlink
+        json.dump(value, f)
 
 
 def _read_grid_cache(path: Path, spec: SweepSpec):
@@ -449,8 +441,8 @@ def run_sweep(spec_path, out=None, resume: bool = False,
     layout = spec.table_layout
     if workers is not None and scheduler is not None:
         raise ValueError("give --workers or --scheduler, not both")
-    if workers is not None and workers < 1:
-        raise ValueError(f"--workers = {workers} is not allowed: must be an integer >= 1")
+    if workers is not None:
+        check_workers(workers)
     if shard is not None:
         index, count = shard
         if not (isinstance(index, int) and isinstance(count, int) and 0 <= index < count):
@@ -460,12 +452,19 @@ def run_sweep(spec_path, out=None, resume: bool = False,
             raise ValueError("give --shard or --combine, not both")
     store.check_output(out, layout, out_name)
     parts = store.parts_dir(out, layout)
-    if shard is not None:  # shards run side by side (SLURM array): no output lock
-        return _run(spec, spec_path, out, parts, True, progress, workers, scheduler, shard,
-                    False, chunk_order, timings)
-    with store.OutputLock(out):
-        return _run(spec, spec_path, out, parts, resume, progress, workers, scheduler, None,
-                    combine, chunk_order, timings)
+    if scheduler is not None and not combine:  # before anything is written
+        scheduler = connect_scheduler(scheduler)
+    try:
+        if shard is not None:  # shards run side by side (SLURM array): a shared lock
+            with store.OutputLock(out, shared=True):
+                return _run(spec, spec_path, out, parts, True, progress, workers, scheduler,
+                            shard, False, chunk_order, timings)
+        with store.OutputLock(out):
+            return _run(spec, spec_path, out, parts, resume, progress, workers, scheduler, None,
+                        combine, chunk_order, timings)
+    finally:
+        if scheduler is not None and not isinstance(scheduler, str):
+            scheduler.close()
 
 
 def _run(spec, spec_path, out, parts, resume, progress, workers, scheduler, shard, combine,
@@ -568,6 +567,61 @@ def warm_kernels(spec: SweepSpec, rows_per_chunk: int = 2, chunks: int = 4) -> N
                 pass
 
 
+#: Local Dask workers per usable core at most (``--workers``): a worker is one process
+#: with one numba thread, so more than a few per core only adds memory and switching.
+WORKERS_PER_CORE = 4
+#: Memory one local Dask worker process needs at least (Python, Dask, numba, pyarrow and
+#: a chunk), bytes: ``--workers`` is bounded by the available memory over this.
+WORKER_MEMORY_BYTES = 400 * 2**20
+
+
+def _usable_cores() -> int:
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:  # not on Linux
+        return os.cpu_count() or 1
+
+
+def _available_memory() -> int | None:
+    """Bytes of memory available for new processes (Linux ``MemAvailable``), or None."""
+    try:
+        with open("/proc/meminfo") as f:
+            for line in f:
+                if line.startswith("MemAvailable:"):
+                    return int(line.split()[1]) * 1024
+    except (OSError, ValueError, IndexError):
+        pass
+    try:
+        return os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
+    except (ValueError, OSError, AttributeError):
+        return None
+
+
+def max_local_workers() -> tuple[int, str]:
+    """The most local Dask workers this machine takes (``--workers``) and why:
+    :data:`WORKERS_PER_CORE` per usable core, and no more than the available memory
+    holds at :data:`WORKER_MEMORY_BYTES` each (at least 1)."""
+    cores = _usable_cores()
+    limit, why = WORKERS_PER_CORE * cores, f"{WORKERS_PER_CORE} per core, {cores} cores"
+    memory = _available_memory()
+    if memory is not None:
+        fit = max(1, memory // WORKER_MEMORY_BYTES)
+        why += (f"; {memory / 2**30:.1f} GiB available memory at about "
+                f"{WORKER_MEMORY_BYTES / 2**30:.2g} GiB per worker")
+        limit = min(limit, int(fit))
+    return limit, why
+
+
+def check_workers(workers) -> int:
+    """``--workers`` as an int in ``[1, max_local_workers()]``, or :class:`InputError`
+    before anything starts."""
+    limit, why = max_local_workers()
+    if isinstance(workers, bool) or not isinstance(workers, int) or not 1 <= workers <= limit:
+        raise InputError(f"--workers = {workers!r} is not allowed: must be an integer from 1 "
+                         f"to {limit} on this machine ({why})")
+    return workers
+
+
 def local_cluster(workers: int):
     """A ``dask.distributed.LocalCluster`` of ``workers`` processes with one thread each
     and ``NUMBA_NUM_THREADS=1`` in their environment (set by the nanny before the worker
@@ -575,6 +629,88 @@ def local_cluster(workers: int):
     from distributed import LocalCluster
     return LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
                         env={"NUMBA_NUM_THREADS": "1"}, dashboard_address=None)
+
+
+#: Seconds a ``--scheduler`` address has to accept a connection and answer the Dask
+#: handshake (an ``identity`` request) before the sweep is refused.
+SCHEDULER_TIMEOUT_S = 5.0
+
+
+def _scheduler_error(address, why: str) -> InputError:
+    return InputError(f"--scheduler = {address!r} is not allowed: {why}")
+
+
+def _probe_scheduler(address: str, timeout: float) -> None:
+    """Refuse ``address`` unless a Dask scheduler answers its handshake within
+    ``timeout`` seconds: a refused port, an unknown host, a service that is not Dask
+    (that sends something else, or nothing) each give one :class:`InputError`."""
+    import asyncio
+    import concurrent.futures
+
+    from distributed.comm import connect
+    from distributed.comm.addressing import parse_address, parse_host_port
+
+    try:
+        scheme, location = parse_address(address)
+        host, port = parse_host_port(location) if scheme in ("tcp", "tls") else (None, None)
+    except (ValueError, TypeError) as exc:
+        raise _scheduler_error(address, f"must be a Dask scheduler address such as "
+                                        f"tcp://host:8786 ({exc})") from None
+    if host is not None and not (isinstance(port, int) and 0 < port < 65536):
+        raise _scheduler_error(address, f"port {port} is not a TCP port (1 to 65535)")
+    if host is not None:  # a plain TCP connection first: a clear, quick answer
+        try:
+            socket.create_connection((host, port), timeout=timeout).close()
+        except socket.gaierror as exc:
+            raise _scheduler_error(address, f"unknown host {host!r} ({exc.strerror})") from None
+        except (OSError, OverflowError) as exc:
+            why = ("nothing answered" if isinstance(exc, TimeoutError)
+                   else getattr(exc, "strerror", None) or str(exc))
+            raise _scheduler_error(address, f"cannot connect to {host}:{port} ({why}; waited "
+                                            f"at most {timeout:g} s)") from None
+
+    if scheme != "tcp":  # the handshake below is plain TCP; other schemes: Client's timeout
+        return
+
+    async def identity():
+        comm = await asyncio.wait_for(connect(address, timeout=timeout), timeout)
+        try:
+            await asyncio.wait_for(comm.write({"op": "identity", "reply": True}), timeout)
+            return await asyncio.wait_for(comm.read(), timeout)
+        finally:
+            comm.abort()
+
+    with concurrent.futures.ThreadPoolExecutor(1) as pool:  # its own event loop
+        try:
+            reply = pool.submit(asyncio.run, identity()).result()
+        except (Exception, MemoryError) as exc:  # noqa: BLE001 - any answer but Dask's
+            reply = {"error": "no answer" if isinstance(exc, TimeoutError) else
+                     f"an answer that is not Dask's ({type(exc).__name__})"}
+    if not (isinstance(reply, dict) and reply.get("type") == "Scheduler"):
+        got = reply.get("error", "another server's answer") if isinstance(reply, dict) \
+            else "another server's answer"
+        raise _scheduler_error(address, f"no Dask scheduler there: its handshake gave {got} "
+                                        f"within {timeout:g} s")
+
+
+def connect_scheduler(address, timeout: float = SCHEDULER_TIMEOUT_S):
+    """A ``distributed.Client`` of the Dask scheduler at ``address``, or
+    :class:`InputError` (one line naming ``--scheduler`` and the address) within about
+    ``timeout`` seconds when none answers there; nothing is written before."""
+    if not isinstance(address, str) or not address.strip():
+        raise _scheduler_error(address, "must be a Dask scheduler address such as "
+                                        "tcp://host:8786")
+    try:
+        from distributed import Client
+    except ImportError:
+        raise ValueError("--workers / --scheduler need Dask: pip install 'vimpact[dask]'") \
+            from None
+    _probe_scheduler(address, timeout)
+    try:
+        return Client(address, timeout=timeout)
+    except (OSError, TimeoutError) as exc:
+        raise _scheduler_error(address, f"the Dask scheduler stopped answering ({exc})") \
+            from None
 
 
 def _run_dask(spec, todo, parts, bar, done, workers, scheduler) -> None:
@@ -590,7 +726,7 @@ def _run_dask(spec, todo, parts, bar, done, workers, scheduler) -> None:
         cluster = local_cluster(workers)
         client = Client(cluster)
     else:
-        client = Client(scheduler)
+        client = scheduler if not isinstance(scheduler, str) else connect_scheduler(scheduler)
     try:
         slots = 4 * max(1, sum(client.nthreads().values()))
         pending = iter(todo)
@@ -612,7 +748,7 @@ def _run_dask(spec, todo, parts, bar, done, workers, scheduler) -> None:
             cluster.close()
 
 
-__all__ = ["GRID_CACHE", "RefinedSweepSpec", "SweepInterrupted", "chunk_summary",
-           "compute_chunk", "explain_paths", "guard_nan", "local_cluster",
-           "measure_interpolation_error", "refined_spec", "run_chunk", "run_sweep",
-           "warm_kernels"]
+__all__ = ["GRID_CACHE", "RefinedSweepSpec", "SweepInterrupted", "check_workers",
+           "chunk_summary", "compute_chunk", "connect_scheduler", "explain_paths", "guard_nan",
+           "local_cluster", "max_local_workers", "measure_interpolation_error", "refined_spec",
+           "run_chunk", "run_sweep", "warm_kernels"]

@@ -20,7 +20,8 @@ parameters)::
     nu = [0.0, 0.1, 0.2, 0.3, 0.4, 0.5]
 
 Top-level keys: ``model`` (required), ``description``, ``seed``,
-``chunk_size`` (default 64), ``output`` (default: the spec's name with
+``chunk_size`` (default 64; at most :data:`MAX_CHUNK_SIZE` rows, and at most
+:data:`MAX_CHUNKS` chunks per sweep), ``output`` (default: the spec's name with
 ``.parquet`` beside it), ``layout``, ``tangential_memory``, ``tangential``,
 ``rotation``, ``numerics`` (a table, or a preset name as a string) and exactly
 one of ``[random]`` or ``[grid]``. Unknown keys and bad values are errors
@@ -108,7 +109,9 @@ included: in full stick they are the impulse ratio, the rebound angle, 0 and 0),
 then ``path``, ``status``, ``error``.
 
 Output paths: ``output`` in the spec is relative to the spec file's
-directory; ``out=`` / ``--out`` is relative to the current directory. The
+directory and stays inside it (no ``..``, not absolute: a spec someone sends
+cannot make the sweep write elsewhere); ``out=`` / ``--out`` is relative to the
+current directory. The
 table layout and the runners are described in :mod:`vimpact.sweep.store` and
 :mod:`vimpact.sweep.runner`.
 
@@ -168,6 +171,12 @@ SWEEP_STATUSES = {s.name: s.message for s in STATUS_TABLE}
 DEFAULT_CHUNK_SIZE = 64
 #: Rows of one sweep at most (a grid axis has at most as many points).
 MAX_ROWS = 10**12
+#: Chunks (part files) of one sweep at most: the runners list the chunks to do and the
+#: parts directory holds one file each; more rows need a larger ``chunk_size``.
+MAX_CHUNKS = 10**6
+#: Rows of one chunk at most: a chunk is held in memory (its inputs, outputs and the
+#: kernels' arrays, about a kilobyte a row).
+MAX_CHUNK_SIZE = 10**6
 #: Table layouts: one Parquet file, or a partitioned dataset (a directory).
 LAYOUTS = ("auto", "file", "dataset")
 #: ``layout = "auto"`` writes one file up to this many rows, a dataset above.
@@ -618,7 +627,11 @@ def load_spec(path) -> SweepSpec:
     output = data.get("output", path.with_suffix(".parquet").name)
     if not isinstance(output, str) or not output.strip():
         raise spec.bad("output", output, "a path (relative to the spec's directory)")
-    output = (path.parent / output) if not Path(output).is_absolute() else Path(output)
+    if Path(output).is_absolute() or ".." in Path(output).parts:
+        raise spec.bad("output", output, "a relative path inside the spec's directory "
+                       "(no '..', not absolute): a spec writes only beside itself; give "
+                       "--out to write elsewhere")
+    output = path.parent / output
     numerics = parse_numerics(spec, data.get("numerics", {}))
     layout = spec.choice(data, "layout", LAYOUTS, "auto")
 
@@ -641,6 +654,20 @@ def load_spec(path) -> SweepSpec:
         draws, arms = {}, ()
     if mode == "random":
         grid_tolerance = grid_mu = None
+    if chunk_size > MAX_CHUNK_SIZE:
+        raise spec.bad("chunk_size", chunk_size, f"at most {MAX_CHUNK_SIZE} rows (a chunk is "
+                       "held in memory)")
+    if -(-rows // chunk_size) > MAX_CHUNKS:
+        raise spec.bad("chunk_size", chunk_size,
+                       f"at least {-(-rows // MAX_CHUNKS)} for {rows} rows: at most "
+                       f"{MAX_CHUNKS} chunks (part files) per sweep")
+    finite_mu = "mu" in draws and any(math.isfinite(x) for x in draws["mu"].values)
+    if header.tangential_memory == "seed" and ("psi" in axes or finite_mu):
+        key = "grid.psi" if "psi" in axes else "random.mu"
+        raise spec.error(key, "is not allowed with tangential_memory = \"seed\": the seed "
+                         "memory sets every element to the total contact-point displacement, "
+                         "which slip cannot change, so friction needs tangential_memory = "
+                         "\"incremental\"")
     return SweepSpec(path=path, text=text, model=model, mode=mode, seed=seed,
                      chunk_size=chunk_size, output=output, numerics=numerics,
                      tangential_memory=header.tangential_memory,

@@ -44,9 +44,12 @@ Metadata: the Parquet key-value metadata ``vimpact.<key>``; one codec
 
 from __future__ import annotations
 
+import contextlib
+import errno
 import hashlib
 import json
 import os
+import shutil
 import socket
 import sys
 from pathlib import Path
@@ -528,6 +531,53 @@ def fsync_dir(path: Path) -> None:
         os.close(fd)
 
 
+def refuse_symlink(path, name: str = "--out", value=None) -> None:
+    """:class:`InputError` if ``path`` is a symbolic link: a file vimpact creates or
+    replaces is never reached through one (its target would be overwritten). The
+    message names ``name = value`` (default: ``path``), as the user gave it."""
+    if os.path.islink(path):
+        it = "it is" if value is None else f"{path} is"
+        raise InputError(f"{name} = {str(path if value is None else value)!r} is not allowed: "
+                         f"{it} a symbolic link (to {os.readlink(path)!r}); vimpact does not "
+                         "write through one: give a regular file's path or a new name")
+
+
+def _temporary(path: Path) -> Path:
+    return path.with_name(f".{path.name}.{socket.gethostname()}.{os.getpid()}.tmp")
+
+
+@contextlib.contextmanager
+def atomic_file(path, name: str = "--out", mode: str = "wb"):
+    """Yield a file object whose content replaces ``path`` atomically on success.
+
+    The content goes to a new temporary file in ``path``'s directory, created with
+    ``O_CREAT | O_EXCL | O_NOFOLLOW`` (never an existing file, never through a
+    symbolic link); it is fsynced and renamed onto ``path`` (``os.replace``), then
+    the directory is fsynced. ``path`` itself must not be a symbolic link
+    (:func:`refuse_symlink`, ``name`` is how the user gave it). On an error the
+    temporary file is removed and an earlier ``path`` stays as it was."""
+    path = Path(path)
+    refuse_symlink(path, name)
+    tmp = _temporary(path)
+    flags = os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_NOFOLLOW", 0) \
+        | getattr(os, "O_CLOEXEC", 0)
+    try:
+        fd = os.open(tmp, flags, 0o644)
+    except FileExistsError:  # a temporary of a write cut short (this pid, reused)
+        os.unlink(tmp)
+        fd = os.open(tmp, flags, 0o644)
+    try:
+        with open(fd, mode) as f:  # the builtin on the descriptor (tests fill the disk here)
+            yield f
+            f.flush()
+            os.fsync(f.fileno())
+        os.replace(tmp, path)
+    finally:
+        if os.path.lexists(tmp):
+            tmp.unlink()
+    fsync_dir(path.parent)
+
+
 def write_atomic(table, path: Path, *, schema_only: bool = False, more=(),
                  content_sha256: str | None = None) -> None:
     """Write the ``pyarrow`` ``table`` (or only its schema) to ``path``: a temporary
@@ -560,9 +610,8 @@ def write_atomic(table, path: Path, *, schema_only: bool = False, more=(),
     if any(k.startswith(META_PREFIX.encode()) if isinstance(k, bytes) else
            str(k).startswith(META_PREFIX) for k in (table.schema.metadata or {})):
         table = _with_metadata_hash(table)
-    tmp = path.with_name(f".{path.name}.{socket.gethostname()}.{os.getpid()}.tmp")
     try:
-        with open(tmp, "wb") as f:
+        with atomic_file(path, str(path)) as f:
             if schema_only:
                 pq.write_metadata(table.schema, f)
             elif more:
@@ -572,16 +621,9 @@ def write_atomic(table, path: Path, *, schema_only: bool = False, more=(),
                         writer.write_table(other.replace_schema_metadata(table.schema.metadata))
             else:
                 pq.write_table(table, f, write_page_checksum=True)
-            f.flush()
-            os.fsync(f.fileno())
-        os.replace(tmp, path)
     except OSError as exc:
         raise OSError(exc.errno, f"{exc.strerror or _first_line(exc)} while writing "
                       f"{path}") from exc
-    finally:
-        if tmp.exists():
-            tmp.unlink()
-    fsync_dir(path.parent)
 
 
 def remove_temporaries(directory: Path, name: str = "") -> None:
@@ -690,9 +732,16 @@ def write_part(spec, table, parts: Path, chunk: int, summary_: dict) -> Path:
     try:
         write_atomic(table.replace_schema_metadata(encode_metadata(meta)), path)
     except OSError as exc:
-        raise OSError(exc.errno, f"{exc.strerror}; the finished chunks are kept in {parts}: "
-                      "make room and continue with --resume") from exc
+        raise _kept(exc, parts) from exc
     return path
+
+
+def _kept(exc: OSError, parts: Path) -> OSError:
+    """The error of a failed write, saying that the finished parts are kept; "make
+    room" only when the disk (or a quota) is full."""
+    full = exc.errno in (errno.ENOSPC, errno.EDQUOT)
+    return OSError(exc.errno, f"{exc.strerror or _first_line(exc)}; the finished chunks are "
+                   f"kept in {parts}: {'make room and ' if full else ''}continue with --resume")
 
 
 def is_complete(spec, out: Path) -> bool:
@@ -773,11 +822,11 @@ def combine(spec, parts: Path, out: Path, explain_paths) -> None:
     first = read(0).replace_schema_metadata(meta)
     rest = (read(c) for c in range(1, spec.n_chunks))
     out.parent.mkdir(parents=True, exist_ok=True)
+    check_room(out, parts, sum(found[c].stat().st_size for c in range(spec.n_chunks)))
     try:
         write_atomic(first, out, more=rest, content_sha256=digest)
     except OSError as exc:
-        raise OSError(exc.errno, f"{exc.strerror}; the finished chunks are kept in {parts}: "
-                      "make room and continue with --resume") from exc
+        raise _kept(exc, parts) from exc
     _verify_written(out, parts)
     for chunk in range(spec.n_chunks):
         found[chunk].unlink()
@@ -788,6 +837,25 @@ def combine(spec, parts: Path, out: Path, explain_paths) -> None:
         print(f"vimpact sweep: {parts} is kept: it holds files that are not finished parts "
               f"({', '.join(sorted(p.name for p in parts.iterdir()))})", file=sys.stderr)
     fsync_dir(parts.parent)
+
+
+#: Free disk kept beyond the parts' size when a file-layout table is combined, bytes.
+COMBINE_MARGIN_BYTES = 2**20
+
+
+def check_room(out: Path, parts: Path, parts_bytes: int) -> None:
+    """Refuse to combine a file-layout table when its folder lacks the room: the table
+    (about the size of its parts) is written while the parts still exist, and they are
+    removed only after it is verified, so the end of a sweep needs about twice the
+    table's size. ``OSError`` (``ENOSPC``) saying how much, before anything is written."""
+    need = parts_bytes + COMBINE_MARGIN_BYTES
+    free = shutil.disk_usage(out.parent).free
+    if free < need:
+        raise OSError(errno.ENOSPC, f"not enough free disk to combine {out}: it needs about "
+                      f"{need / 2**20:.1f} MiB in {out.parent} (the size of its parts, which "
+                      f"are removed only after the table is verified), {free / 2**20:.1f} MiB "
+                      f"are free; the finished chunks are kept in {parts}: make room and "
+                      "continue with --resume")
 
 
 def _verify_written(out: Path, parts: Path) -> None:
@@ -807,6 +875,8 @@ def check_output(out: Path, layout: str, name: str = "--out") -> None:
     without write permission. ``name``: how the user gave the output (``--out``, or
     the spec's ``output`` key), for the message."""
     out = Path(out)
+    for path in (out, out.with_name(out.name + ".parts"), out.with_name(out.name + ".lock")):
+        refuse_symlink(path, name, out)
     if out.suffix != ".parquet":
         raise ValueError(f"{name} = {str(out)!r} is not allowed: the table's name must end "
                          "in .parquet")
@@ -825,53 +895,89 @@ def check_output(out: Path, layout: str, name: str = "--out") -> None:
 
 
 class OutputLock:
-    """An exclusive lock on ``OUT.lock`` (``fcntl.flock``, released by the kernel when the
-    process dies, even by kill -9): a second sweep into the same output is refused.
-    A lock file left by a killed sweep does not block (nobody holds its lock); a
-    lock taken on a file its holder removed meanwhile is taken again on the new one."""
+    """A lock on ``OUT.lock`` (``fcntl.flock``, released by the kernel when the process
+    dies, even by kill -9).
 
-    def __init__(self, out: Path):
+    A plain run, ``--resume`` and ``--combine`` take it exclusively: a second sweep
+    into the same output is refused. Shards (``shared=True``) take it shared: any
+    number of shards run side by side, but not beside a plain run (either one that
+    comes second is refused). A lock file left by a killed sweep does not block
+    (nobody holds its lock); a lock taken on a file its holder removed meanwhile is
+    taken again on the new one. The lock file is opened with ``O_NOFOLLOW`` (a
+    symbolic link there is refused, never followed)."""
+
+    #: Seconds a shard waits for a shared lock that another shard briefly holds
+    #: exclusively (while it removes the lock file on its way out).
+    SHARED_WAIT_S = 2.0
+
+    def __init__(self, out: Path, shared: bool = False):
         self.path = Path(out).with_name(Path(out).name + ".lock")
+        self.shared = shared
         self.fd: int | None = None
+
+    def _open(self) -> int:
+        refuse_symlink(self.path, "lock file")
+        try:
+            return os.open(self.path, os.O_RDWR | os.O_CREAT | getattr(os, "O_NOFOLLOW", 0)
+                           | getattr(os, "O_CLOEXEC", 0), 0o644)
+        except OSError as exc:
+            if exc.errno == errno.ELOOP:  # made a symlink between the check and the open
+                refuse_symlink(self.path, "lock file")
+            raise
 
     def __enter__(self) -> OutputLock:
         import fcntl
+        import time
         self.path.parent.mkdir(parents=True, exist_ok=True)
-        fd = os.open(self.path, os.O_RDWR | os.O_CREAT, 0o644)
-        try:
-            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except OSError:
+        fd = self._open()
+        mode = fcntl.LOCK_SH if self.shared else fcntl.LOCK_EX
+        deadline = time.monotonic() + (self.SHARED_WAIT_S if self.shared else 0.0)
+        while True:
             try:
-                holder = os.read(fd, 200).decode(errors="replace").strip() or "unknown"
-            finally:
-                os.close(fd)
-            raise ValueError(f"another sweep is writing {self.path.with_suffix('')} "
-                             f"({holder}); wait for it, or stop it first") from None
+                fcntl.flock(fd, mode | fcntl.LOCK_NB)
+                break
+            except OSError:
+                if time.monotonic() < deadline:
+                    time.sleep(0.05)
+                    continue
+                try:
+                    holder = os.read(fd, 200).decode(errors="replace").strip() or \
+                        "shards (vimpact sweep --shard) are writing its parts"
+                finally:
+                    os.close(fd)
+                raise ValueError(f"another sweep is writing {self.path.with_suffix('')} "
+                                 f"({holder}); wait for it, or stop it first") from None
         try:
-            same = os.fstat(fd).st_ino == os.stat(self.path).st_ino
+            same = os.fstat(fd).st_ino == os.stat(self.path, follow_symlinks=False).st_ino
         except FileNotFoundError:
             same = False
         if not same:  # the holder removed the file between our open and flock: try again
             os.close(fd)
             return self.__enter__()
-        os.ftruncate(fd, 0)
-        os.write(fd, f"pid {os.getpid()} on {socket.gethostname()}".encode())
+        if not self.shared:  # shards leave it empty: several hold it
+            os.ftruncate(fd, 0)
+            os.write(fd, f"pid {os.getpid()} on {socket.gethostname()}".encode())
         self.fd = fd
         return self
 
     def __exit__(self, *exc) -> None:
-        if self.fd is not None:
-            try:
-                self.path.unlink()
-            except FileNotFoundError:
-                pass
+        import fcntl
+        if self.fd is None:
+            return
+        try:
+            if self.shared:  # the last shard out removes the file; the others leave it
+                fcntl.flock(self.fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            self.path.unlink()
+        except (FileNotFoundError, BlockingIOError):
+            pass
+        finally:
             os.close(self.fd)
             self.fd = None
 
 
 __all__ = ["COMMON_METADATA", "CONTENT_HASH_KEY", "CONTENT_HASH_VERSION", "CORRUPT_DIR",
            "ContentHash", "INT_KEYS", "JSON_KEYS", "METADATA_HASH_KEY", "META_PREFIX",
-           "OutputLock", "check_output", "metadata_hash",
+           "OutputLock", "atomic_file", "check_output", "metadata_hash", "refuse_symlink",
            "combine", "content_hash", "decode_metadata", "decode_value", "encode_metadata",
            "encode_value", "existing_parts", "fsync_dir", "is_complete", "move_aside",
            "part_path", "parts_dir", "read_metadata", "remove_temporaries", "rows_in_footer",
