@@ -285,8 +285,8 @@ class SceneColumns:
         model = _model(arrays.get("model"), G_arm, num["eta0_Pa_s"], n, reasons)
         seeded = ((codes["tangential_memory"] == TANGENTIAL_MEMORY.index("seed"))
                   & np.isfinite(num["mu"]))
-        for i in np.flatnonzero(seeded & is_none(reasons)):
-            reasons[i] = message("mu", float(num["mu"][i]), SEED_FRICTION_ALLOWED)
+        for row in np.flatnonzero(seeded & is_none(reasons)):
+            reasons[row] = message("mu", float(num["mu"][row]), SEED_FRICTION_ALLOWED)
         cols = dict(nu=num["nu"], G_inf=num["G_inf_Pa"], eta0=num["eta0_Pa_s"], G_arm=G_arm,
                     tau_arm=tau_arm, R=R, m=m, v_z0=num["v_z0_m_s"], v_x0=num["v_x0_m_s"],
                     omega0=num["omega0_rad_s"], Theta=Theta, mu=num["mu"],
