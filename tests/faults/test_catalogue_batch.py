@@ -24,7 +24,8 @@ import pytest
 
 import vimpact as v
 from vimpact.cli.main import main
-from vimpact.model.pair import Body, Wall, simulate_pair_batch
+from vimpact.engine.pairs import simulate_pair_batch
+from vimpact.model.pair import Body, Wall
 from vimpact.model.validation import InputError
 
 #: The doctest scene of docs/physics.md (continuum full stick; compiled by the docs tests).
