@@ -33,6 +33,7 @@ BENCHMARKS: dict[str, str] = {
     "paths": "vimpact.bench.paths",
     "overhead": "vimpact.bench.overhead",
     "imports": "vimpact.bench.imports",
+    "threads": "vimpact.bench.threads",
     "friction": "benchmarks.friction",
     "sweep_backends": "benchmarks.sweep_backends",
     "lookup": "benchmarks.lookup",
