@@ -11,17 +11,12 @@ their own ``run`` and ``plot``.
 from __future__ import annotations
 
 import argparse
-import importlib.util
 import json
-import subprocess
-import sys
-import tempfile
 from pathlib import Path
-from types import ModuleType
 
 from vimpact.bench.machine import (  # noqa: F401  (re-exported for the scripts)
-    figure, load_average, machine_info, machine_line, median_time, progress, save_figure,
-    time_samples, use_agg)
+    figure, load_average, machine_info, machine_line, median_time, module_at_commit, progress,
+    save_figure, time_samples, use_agg)
 
 RESULTS = Path(__file__).parent / "results"
 
@@ -65,26 +60,3 @@ def bench_main(doc: str, run, plot, stem: str, png_stem: str | None = None,
     (args.out / f"{stem}{sfx}.json").write_text(json.dumps(data, indent=1, allow_nan=False))
     plot(data, args.out / f"{png_stem or stem}{sfx}.png")
     return data
-
-
-def module_at_commit(commit: str, path: str) -> ModuleType | None:
-    """The repository's module ``path`` (e.g. ``vimpact/kernels/elements.py``) as of
-    ``commit``, for a benchmark that times a kernel before and after a change; ``None``
-    without git (not a source checkout). The source is written under the temporary
-    folder with a stable name, so that numba's cache beside it survives the run."""
-    try:
-        src = subprocess.run(["git", "show", f"{commit}:{path}"], cwd=RESULTS.parent.parent,
-                             capture_output=True, text=True, check=True).stdout
-    except (OSError, subprocess.CalledProcessError):
-        return None
-    folder = Path(tempfile.gettempdir()) / "vimpact_bench_before"
-    folder.mkdir(exist_ok=True)
-    name = f"{Path(path).stem}_{commit[:10]}"
-    file = folder / f"{name}.py"
-    if not file.exists() or file.read_text() != src:
-        file.write_text(src)
-    spec = importlib.util.spec_from_file_location(name, file)
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[name] = module  # numba's cache finds the module again by name
-    spec.loader.exec_module(module)
-    return module

@@ -34,11 +34,13 @@ BENCHMARKS: dict[str, str] = {
     "overhead": "vimpact.bench.overhead",
     "imports": "vimpact.bench.imports",
     "threads": "vimpact.bench.threads",
-    "friction": "benchmarks.friction",
-    "sweep_backends": "benchmarks.sweep_backends",
+    "cold_start": "vimpact.bench.cold_start",
+    "specialization": "vimpact.bench.specialization",
+    "friction": "vimpact.bench.friction",
+    "sweep_backends": "vimpact.bench.sweep_backends",
     "lookup": "benchmarks.lookup",
     "continuum_maxwell": "benchmarks.continuum_maxwell",
-    "element_orders": "benchmarks.element_orders",
+    "element_orders": "vimpact.bench.element_orders",
 }
 
 
