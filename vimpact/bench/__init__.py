@@ -38,7 +38,7 @@ BENCHMARKS: dict[str, str] = {
     "specialization": "vimpact.bench.specialization",
     "friction": "vimpact.bench.friction",
     "sweep_backends": "vimpact.bench.sweep_backends",
-    "lookup": "benchmarks.lookup",
+    "lookup": "vimpact.bench.lookup",
     "continuum_maxwell": "benchmarks.continuum_maxwell",
     "element_orders": "vimpact.bench.element_orders",
 }
