@@ -11,13 +11,8 @@ their own ``run`` and ``plot``.
 from __future__ import annotations
 
 import argparse
-import importlib.util
 import json
-import subprocess
-import sys
-import tempfile
 from pathlib import Path
-from types import ModuleType
 
 from vimpact.bench.machine import (  # noqa: F401  (re-exported for the scripts)
     figure,
@@ -25,6 +20,7 @@ from vimpact.bench.machine import (  # noqa: F401  (re-exported for the scripts)
     machine_info,
     machine_line,
     median_time,
+    module_at_commit,
     progress,
     save_figure,
     time_samples,
@@ -73,49 +69,3 @@ def bench_main(doc: str, run, plot, stem: str, png_stem: str | None = None,
     (args.out / f"{stem}{sfx}.json").write_text(json.dumps(data, indent=1, allow_nan=False))
     plot(data, args.out / f"{png_stem or stem}{sfx}.png")
     return data
-
-
-def module_at_commit(commit: str, path: str) -> ModuleType | None:
-    """The repository's module ``path`` (e.g. ``vimpact/kernels/elements.py``) as of
-    ``commit``, for a benchmark that times a kernel before and after a change; ``None``
-    without git (not a source checkout). The source is written under the temporary
-    folder with a stable name, so that numba's cache beside it survives the run."""
-    try:
-        src = subprocess.run(["git", "show", f"{commit}:{path}"], cwd=RESULTS.parent.parent,
-                             capture_output=True, text=True, check=True).stdout
-    except (OSError, subprocess.CalledProcessError):
-        return None
-    folder = Path(tempfile.gettempdir()) / "vimpact_bench_before"
-    folder.mkdir(exist_ok=True)
-    name = f"{Path(path).stem}_{commit[:10]}"
-    file = folder / f"{name}.py"
-    if not file.exists() or file.read_text() != src:
-        file.write_text(src)
-    spec = importlib.util.spec_from_file_location(name, file)
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[name] = module  # numba's cache finds the module again by name
-    lent = _lend_moved_names()
-    try:
-        spec.loader.exec_module(module)
-    finally:
-        for home, attr in lent:
-            delattr(home, attr)
-    return module
-
-
-#: Names an earlier commit's kernel imports from a module they have since left:
-#: ``{old module: {name: module that defines it now}}``.
-MOVED_NAMES = {"vimpact.kernels.layout": {"_record": "vimpact.kernels.record"}}
-
-
-def _lend_moved_names() -> list[tuple[ModuleType, str]]:
-    """Put each moved name back on its old module while an old kernel is imported
-    (the modules themselves keep no alias); return what was lent."""
-    lent = []
-    for old, names in MOVED_NAMES.items():
-        home = importlib.import_module(old)
-        for attr, new in names.items():
-            if not hasattr(home, attr):
-                setattr(home, attr, getattr(importlib.import_module(new), attr))
-                lent.append((home, attr))
-    return lent

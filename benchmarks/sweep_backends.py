@@ -1,166 +1,21 @@
-"""Sweep backends side by side, and a 1e6-row sweep: wall time against kernel time.
+"""Full-size run of the ``sweep_backends`` benchmark: writes
+``benchmarks/results/sweep_backends.json`` (``python -m benchmarks.sweep_backends
+[--part backends|large|both] [--rows N] [--quick]``; a part not run keeps its earlier entry).
 
-Run: ``python -m benchmarks.sweep_backends [--part backends|large|both] [--rows N]
-[--quick]``.
-
-- ``backends``: the same random oblique Kelvin-Voigt sweep (``fast`` numerics)
-  in-process on 2 numba threads and on a Dask ``LocalCluster`` of 2 worker
-  processes x 1 thread, one run each, side by side (after a warm-up of both;
-  the cluster's start-up is reported apart). Compare the ratio, not the seconds:
-  the machine is shared and noisy. The two tables must be identical.
-- ``large``: one 1e6-row random oblique sweep (``fast`` numerics, in-process):
-  wall time, kernel time alone (seconds inside the numba kernels, from
-  ``simulate_batch(timings=...)``), their ratio (target <= 1.2), rows/s, Python
-  overhead per row, and the peak resident memory of this process and its
-  children (``resource.getrusage``).
-
-Writes ``benchmarks/results/sweep_backends.json`` (a part not run keeps its
-earlier entry).
+The code is :mod:`vimpact.bench.sweep_backends` (also ``vimpact bench sweep_backends``);
+its names are re-exported here.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
-import os
-import platform
-import resource
-import tempfile
-import time
 from pathlib import Path
 
+from vimpact.bench.sweep_backends import *  # noqa: F401,F403
+from vimpact.bench.sweep_backends import backends, large, machine
+
 RESULTS = Path(__file__).parent / "results"
-TITLE = "Sweeps: in-process against a Dask LocalCluster, and a large sweep's wall over kernel time"
-
-SPEC = """
-description = "benchmark: random oblique Kelvin-Voigt impacts"
-model = "kelvin_voigt"
-seed = 2026
-chunk_size = {chunk}
-[numerics]
-preset = "fast"
-[random]
-rows = {rows}
-E_Pa = [1e7, 1e10]
-eta_Pa_s = [1e1, 1e5]
-R_m = [0.01, 0.1]
-m_kg = [1e-3, 0.1]
-v_z0_m_s = [0.1, 10]
-v_x0_m_s = [-5, 5]
-omega0_rad_s = [-100, 100]
-nu = [0.0, 0.5]
-"""
-
-
-def machine() -> dict:
-    return {"platform": platform.platform(), "python": platform.python_version(),
-            "cpus": os.cpu_count(), "load_average_1min": os.getloadavg()[0],
-            "date_utc": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime())}
-
-
-def _spec(tmp: Path, name: str, rows: int, chunk: int) -> Path:
-    path = tmp / f"{name}.toml"
-    path.write_text(SPEC.format(rows=rows, chunk=chunk))
-    return path
-
-
-def backends(rows: int, chunk: int) -> dict:
-    import numba
-    from distributed import Client
-
-    from vimpact.sweep import run_sweep
-    from vimpact.sweep.runner import local_cluster
-
-    numba.set_num_threads(min(2, numba.config.NUMBA_NUM_THREADS))
-    with tempfile.TemporaryDirectory() as tmp:
-        tmp = Path(tmp)
-        warm, spec = _spec(tmp, "warm", 8, 2), _spec(tmp, "sweep", rows, chunk)
-        t0 = time.perf_counter()
-        cluster = local_cluster(2)
-        client = Client(cluster)
-        start_s = time.perf_counter() - t0
-        try:
-            address = cluster.scheduler_address
-            run_sweep(warm, out=tmp / "w1.parquet", progress=False)
-            run_sweep(warm, out=tmp / "w2.parquet", progress=False, scheduler=address)
-            t0 = time.perf_counter()
-            a = run_sweep(spec, out=tmp / "inprocess.parquet", progress=False)
-            t_in = time.perf_counter() - t0
-            t0 = time.perf_counter()
-            b = run_sweep(spec, out=tmp / "dask.parquet", progress=False, scheduler=address)
-            t_dask = time.perf_counter() - t0
-            identical = a.read_bytes() == b.read_bytes()
-        finally:
-            client.close()
-            cluster.close()
-    return {"rows": rows, "chunk_size": chunk, "numerics": "fast",
-            "in_process_2_threads_s": t_in, "dask_2_workers_x_1_thread_s": t_dask,
-            "dask_over_in_process": t_dask / t_in, "cluster_start_s": start_s,
-            "rows_per_s": {"in_process": rows / t_in, "dask": rows / t_dask},
-            "tables_identical": identical}
-
-
-def large(rows: int, chunk: int) -> dict:
-    from vimpact.sweep import run_sweep, summary
-
-    with tempfile.TemporaryDirectory() as tmp:
-        tmp = Path(tmp)
-        spec = _spec(tmp, "large", rows, chunk)
-        timings: dict = {}
-        t0 = time.perf_counter()
-        out = run_sweep(spec, out=tmp / "large.parquet", timings=timings)
-        wall = time.perf_counter() - t0
-        counts = summary(out)
-        size = sum(p.stat().st_size for p in ([out] if out.is_file() else out.iterdir()))
-    self_kb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
-    children_kb = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss
-    kernel = timings.get("kernel_s", float("nan"))
-    return {"rows": rows, "chunk_size": chunk, "numerics": "fast", "wall_s": wall,
-            "kernel_s": kernel, "simulate_batch_s": timings.get("total_s"),
-            "wall_over_kernel": wall / kernel, "rows_per_s": rows / wall,
-            "overhead_us_per_row": 1e6 * (wall - kernel) / rows,
-            "peak_rss_mb": {"self": self_kb / 1024, "children": children_kb / 1024},
-            "table_bytes": size, "statuses": counts}
-
-
-def run(quick: bool) -> dict:
-    """Both parts (``quick``: 200 rows side by side, a 2000-row large sweep;
-    full: 2000 rows side by side, a 1e6-row large sweep)."""
-    return {"machine": machine(),
-            "backends": backends(200 if quick else 2000, 20 if quick else 100),
-            "large": large(2000 if quick else 1_000_000, 500 if quick else 10_000)}
-
-
-def plot(data: dict, path) -> None:
-    """Rows per second of each backend, and the large sweep's wall and kernel time."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    from vimpact.bench.machine import save_figure
-
-    fig, axes = plt.subplots(1, 2, figsize=(10, 4))
-    b, big = data["backends"], data["large"]
-    axes[0].bar(["in-process\n2 threads", "Dask\n2 workers x 1"],
-                [b["rows_per_s"]["in_process"], b["rows_per_s"]["dask"]], color=["C0", "C1"])
-    axes[0].set(ylabel="rows / s", title=f"same sweep, {b['rows']} rows ({b['numerics']})")
-    axes[1].bar(["wall", "kernel"], [big["wall_s"], big["kernel_s"]], color=["C2", "C3"])
-    axes[1].set(ylabel="s", title=f"{big['rows']:.0e}-row sweep: wall / kernel = "
-                f"{big['wall_over_kernel']:.2f}")
-    save_figure(fig, path)
-
-
-def figures(data: dict) -> dict:
-    """Dask over in-process time, the large sweep's wall over kernel time, its
-    rows/s and Python overhead per row."""
-    from vimpact.bench.machine import figure
-
-    b, big = data["backends"], data["large"]
-    return {"dask_over_in_process": figure(b["dask_over_in_process"], "-"),
-            "large_wall_over_kernel": figure(big["wall_over_kernel"], "-"),
-            "large_rows_per_s": figure(big["rows_per_s"], "1/s", better="higher"),
-            "large_overhead_us_per_row": figure(big["overhead_us_per_row"], "us/row")}
 
 
 def main(argv=None) -> dict:

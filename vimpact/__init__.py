@@ -18,6 +18,10 @@ from __future__ import annotations
 import importlib
 from importlib.metadata import PackageNotFoundError, version
 
+from vimpact.kernels.threads import configure as _configure_threads
+
+_configure_threads()  # before numba starts its threads (vimpact.kernels.threads)
+
 try:
     __version__ = version("vimpact")
 except PackageNotFoundError:  # running from a source tree

@@ -2,6 +2,8 @@
 
 import json
 
+import pytest
+
 
 def test_sweep_speedup_quick(tmp_path):
     from benchmarks import sweep_speedup
@@ -14,10 +16,15 @@ def test_sweep_speedup_quick(tmp_path):
     json.dumps(data)
 
 
+@pytest.mark.slow
 def test_paths_quick(tmp_path):
     """Each path runs; the specialized kernels give the general kernel's normal
     results exactly (same arithmetic, branches folded); the continuum path is
-    the more accurate one at its setting."""
+    the more accurate one at its setting.
+
+    Slow: on a cold cache it compiles four element kernels (110 s of CPU,
+    ``-p tests.compile_profile``), among them the general kernel with arms and
+    a dashpot (full stick, incremental), which no other default test runs."""
     from vimpact.bench import paths
 
     data = paths.run(quick=True)

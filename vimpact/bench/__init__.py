@@ -33,11 +33,14 @@ BENCHMARKS: dict[str, str] = {
     "paths": "vimpact.bench.paths",
     "overhead": "vimpact.bench.overhead",
     "imports": "vimpact.bench.imports",
-    "friction": "benchmarks.friction",
-    "sweep_backends": "benchmarks.sweep_backends",
-    "lookup": "benchmarks.lookup",
+    "threads": "vimpact.bench.threads",
+    "cold_start": "vimpact.bench.cold_start",
+    "specialization": "vimpact.bench.specialization",
+    "friction": "vimpact.bench.friction",
+    "sweep_backends": "vimpact.bench.sweep_backends",
+    "lookup": "vimpact.bench.lookup",
     "continuum_maxwell": "benchmarks.continuum_maxwell",
-    "element_orders": "benchmarks.element_orders",
+    "element_orders": "vimpact.bench.element_orders",
 }
 
 

@@ -14,14 +14,18 @@ Every result file is a JSON object with
 
 from __future__ import annotations
 
+import importlib.util
 import json
 import math
 import os
 import platform
+import subprocess
 import sys
+import tempfile
 import time
 from collections.abc import Callable, Sequence
 from pathlib import Path
+from types import ModuleType
 
 import numpy as np
 
@@ -228,3 +232,53 @@ def run_and_write(name: str, module, quick: bool, out: Path, json_name: str | No
     print(figures_table(data["figures"]))
     print(f"wrote {json_path} and {png_path} ({time.perf_counter() - start:.0f} s)")
     return data, json_path, png_path
+
+
+def module_at_commit(commit: str, path: str) -> ModuleType | None:
+    """The repository's module ``path`` (e.g. ``vimpact/kernels/elements.py``) as of
+    ``commit``, for a benchmark that times a kernel before and after a change; ``None``
+    without git or outside a source checkout (an installed package). The source is
+    written under the temporary folder with a stable name, so that numba's cache
+    beside it survives the run."""
+    checkout = Path(__file__).resolve().parents[2]
+    if not (checkout / "pyproject.toml").exists():  # installed: no repository at hand
+        return None
+    try:
+        src = subprocess.run(["git", "show", f"{commit}:{path}"], cwd=checkout,
+                             capture_output=True, text=True, check=True).stdout
+    except (OSError, subprocess.CalledProcessError):
+        return None
+    folder = Path(tempfile.gettempdir()) / "vimpact_bench_before"
+    folder.mkdir(exist_ok=True)
+    name = f"{Path(path).stem}_{commit[:10]}"
+    file = folder / f"{name}.py"
+    if not file.exists() or file.read_text() != src:
+        file.write_text(src)
+    spec = importlib.util.spec_from_file_location(name, file)
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[name] = module  # numba's cache finds the module again by name
+    lent = _lend_moved_names()
+    try:
+        spec.loader.exec_module(module)
+    finally:
+        for home, attr in lent:
+            delattr(home, attr)
+    return module
+
+
+#: Names an earlier commit's kernel imports from a module they have since left:
+#: ``{old module: {name: module that defines it now}}``.
+MOVED_NAMES = {"vimpact.kernels.layout": {"_record": "vimpact.kernels.record"}}
+
+
+def _lend_moved_names() -> list[tuple[ModuleType, str]]:
+    """Put each moved name back on its old module while an old kernel is imported
+    (the modules themselves keep no alias); return what was lent."""
+    lent = []
+    for old, names in MOVED_NAMES.items():
+        home = importlib.import_module(old)
+        for attr, new in names.items():
+            if not hasattr(home, attr):
+                setattr(home, attr, getattr(importlib.import_module(new), attr))
+                lent.append((home, attr))
+    return lent

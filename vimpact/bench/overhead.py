@@ -21,6 +21,12 @@ call that compiles or loads the kernels; median over the repeats. Also the
 Kelvin-Voigt normal-only throughput, rows / ``total_s``. Targets:
 overhead <= 5 microseconds per row, throughput >= 50,000 rows/s on 2 threads.
 
+One impact (:func:`one_impact`, issue 24: at most 100 us of Python outside
+the kernel): the CPU time of one ``vimpact.simulate(scene)`` call on one
+thread, minus the kernel's (wall) time, for an oblique and a normal-only
+Kelvin-Voigt scene, and the same call as of the commit before issue 24 side
+by side (from a source checkout, which has that code in git).
+
 Rows: ``nu`` uniform in [0, 0.5], ``R`` log-uniform in [1 mm, 10 cm], steel
 density (``m = 7800 kg/m^3 * 4/3 pi R^3``), ``v_z0`` log-uniform in [0.1,
 10] m/s, the modulus chosen for ``a_H / R`` log-uniform in [0.003, 0.03]
@@ -37,7 +43,15 @@ from pathlib import Path
 import numba
 import numpy as np
 
-from .machine import figure, load_average, machine_info, progress, save_figure, use_agg
+from .machine import (
+    figure,
+    load_average,
+    machine_info,
+    module_at_commit,
+    progress,
+    save_figure,
+    use_agg,
+)
 
 TITLE = "Python overhead per row outside the kernels (columnar simulate_batch) and KV rows/s"
 
@@ -116,6 +130,88 @@ def _measure(columns: dict, numerics, repeats: int) -> dict:
     }
 
 
+#: the commit before issue 24 (simulate() overhead): its ``simulate`` is timed
+#: side by side with the current one where the source is at hand (a checkout)
+BEFORE_COMMIT = "54d8eb1"
+#: issue 24: Python CPU time outside the kernel of one ``simulate()`` call, us
+TARGET_ONE_IMPACT_US = 100.0
+
+
+def _cpu_us(fn, calls: int, repeats: int) -> tuple[float, list[float]]:
+    """Smallest over ``repeats`` of the CPU time per call of ``fn()`` over ``calls``
+    calls, us (CPU time: robust against other processes on the machine), and all."""
+    fn()
+    samples = []
+    for _ in range(repeats):
+        t0 = time.process_time()
+        for _ in range(calls):
+            fn()
+        samples.append((time.process_time() - t0) / calls * 1e6)
+    return min(samples), samples
+
+
+def _before_simulate():
+    """``simulate`` as of :data:`BEFORE_COMMIT` (with that commit's ``unpack``), or
+    ``None`` outside a source checkout."""
+    old_unpack = module_at_commit(BEFORE_COMMIT, "vimpact/engine/unpack.py")
+    old = module_at_commit(BEFORE_COMMIT, "vimpact/engine/simulate.py")
+    if old is None or old_unpack is None:
+        return None
+    old.unpack = old_unpack.unpack
+    return old.simulate
+
+
+def one_impact(quick: bool = False) -> dict:
+    """CPU time of one ``simulate()`` call on 1 numba thread, the kernel's share
+    (``run_columns`` timings: wall time inside the kernel) and the Python stages
+    around it, for the README's oblique Kelvin-Voigt scene (full-stick continuum
+    path) and a normal-only one (Kelvin-Voigt continuum path); with the
+    :data:`BEFORE_COMMIT` code side by side where available."""
+    import vimpact as v
+    from vimpact.engine.columns import SceneColumns
+    from vimpact.engine.routing import route
+    from vimpact.engine.simulate import run_columns
+
+    calls, repeats = (200, 3) if quick else (1000, 5)
+    before = _before_simulate()
+    mat = v.Material.kelvin_voigt(nu=0.5, E=5e10, eta=1e5)
+    scenes = {"oblique (README)": v.Scene(mat, R=0.2, m=10.0, v_z0=10.0, v_x0=5.0),
+              "normal only": v.Scene(mat, R=0.2, m=10.0, v_z0=10.0, tangential="none")}
+    numerics = v.Numerics()
+    all_threads = numba.get_num_threads()
+    numba.set_num_threads(1)
+    out = {"before_commit": BEFORE_COMMIT if before else None, "calls": calls,
+           "repeats": repeats, "scenes": {}}
+    try:
+        for name, scene in scenes.items():
+            cols = SceneColumns.from_scenes([scene])
+            run_columns(cols, numerics)  # load the kernel
+            kernel = []
+            for _ in range(repeats):
+                t: dict = {}
+                for _ in range(calls):
+                    run_columns(cols, numerics, timings=t)
+                kernel.append(t["kernel_s"] / calls * 1e6)
+            kernel_us = min(kernel)
+            rec = {"path": v.simulate(scene).path, "kernel_us": kernel_us}
+            rec["simulate_us"], rec["simulate_us_samples"] = _cpu_us(
+                lambda: v.simulate(scene), calls, repeats)
+            rec["from_scenes_us"], _ = _cpu_us(lambda: SceneColumns.from_scenes([scene]),
+                                               calls, repeats)
+            rec["route_us"], _ = _cpu_us(lambda: route(cols, numerics), calls, repeats)
+            rec["outside_kernel_us"] = rec["simulate_us"] - kernel_us
+            if before is not None:
+                rec["before_simulate_us"], rec["before_simulate_us_samples"] = _cpu_us(
+                    lambda: before(scene), calls, repeats)
+                rec["before_outside_kernel_us"] = rec["before_simulate_us"] - kernel_us
+                rec["before_over_now"] = rec["before_simulate_us"] / rec["simulate_us"]
+            out["scenes"][name] = rec
+    finally:
+        numba.set_num_threads(all_threads)
+    out["target_outside_kernel_us"] = TARGET_ONE_IMPACT_US
+    return out
+
+
 def run(quick: bool = False) -> dict:
     """Measure both paths; returns the JSON-ready record (``continuum``,
     ``elements``: see :func:`_measure`; ``targets`` and whether they are met)."""
@@ -140,6 +236,8 @@ def run(quick: bool = False) -> dict:
         el = _measure(el_cols, fast, cfg["element_repeats"])
     finally:
         numba.set_num_threads(all_threads)
+    progress("overhead: one simulate() call", start)
+    single = one_impact(quick)
     return {
         "machine": machine_info(),
         "load_average": {"before": load_before, "after": load_average()},
@@ -148,6 +246,7 @@ def run(quick: bool = False) -> dict:
                    "element_numerics": "fast"},
         "continuum": kv,
         "elements": el,
+        "one_impact": single,
         "targets": {
             "overhead_us_per_row_max": TARGET_OVERHEAD_US_PER_ROW,
             "kv_rows_per_second_min": TARGET_KV_ROWS_PER_SECOND,
@@ -170,6 +269,12 @@ def figures(data: dict) -> dict:
             d["median_overhead_us_per_row"], "us/row", samples=d["overhead_us_per_row"])
         out[f"{key}_kernel_us_per_row"] = figure(
             d["median_kernel_us_per_row"], "us/row", samples=d["kernel_s"])
+    for name, rec in data.get("one_impact", {}).get("scenes", {}).items():
+        key = "one_impact_" + name.split(" ")[0]
+        out[f"{key}_simulate_cpu_us"] = figure(rec["simulate_us"], "us",
+                                               samples=rec["simulate_us_samples"])
+        if "before_over_now" in rec:
+            out[f"{key}_before_over_now"] = figure(rec["before_over_now"], "-", better="higher")
     kv = data["continuum"]
     out["continuum_rows_per_second"] = figure(kv["median_rows_per_second"], "rows/s",
                                               better="higher", samples=kv["rows_per_second"])
@@ -186,6 +291,15 @@ def report(data: dict) -> str:
                      f"{d['median_kernel_us_per_row']:>15.2f}"
                      f"{d['median_overhead_us_per_row']:>17.2f}"
                      f"{d['median_rows_per_second']:>11.4g}")
+    one = data.get("one_impact", {})
+    for name, rec in one.get("scenes", {}).items():
+        line = (f"one simulate(), {name} [{rec['path']}]: {rec['simulate_us']:.0f} us CPU, "
+                f"kernel {rec['kernel_us']:.0f} us, outside it {rec['outside_kernel_us']:.0f} us "
+                f"(from_scenes {rec['from_scenes_us']:.0f}, route {rec['route_us']:.0f})")
+        if "before_over_now" in rec:
+            line += (f"; at {one['before_commit']}: {rec['before_simulate_us']:.0f} us "
+                     f"({rec['before_over_now']:.2f}x now)")
+        lines.append(line)
     t = data["targets"]
     lines.append(f"targets ({data['threads']} threads): overhead <= "
                  f"{t['overhead_us_per_row_max']:g} us/row: continuum "

@@ -36,9 +36,13 @@ class HalfSpaceError(InputError):
     """The contact grew beyond the half-space limit ``a_max > 0.2 R``."""
 
 
+#: ``Numerics()`` made and validated once (it is frozen), not on every call
+_DEFAULT_NUMERICS = Numerics()
+
+
 def _numerics(numerics) -> Numerics:
     if numerics is None:
-        return Numerics()
+        return _DEFAULT_NUMERICS
     if isinstance(numerics, str):
         return Numerics.preset(numerics)
     require("numerics", numerics, isinstance(numerics, Numerics),
@@ -72,7 +76,7 @@ def run_columns(cols: SceneColumns, numerics: Numerics, n_rec: int = 0, rec_ever
         path, idx = queue.pop(0)
         arrays = None
         if path.spec is not None:
-            arrays = element_arrays(cols.take(idx), numerics, path.spec)
+            arrays = element_arrays(_rows(cols, idx), numerics, path.spec)
             per_t_H = HERTZ_TIME_FACTOR / arrays["h"]
             costly = (per_t_H > MAX_STEPS_PER_T_H) | (arrays["n_elem"] > MAX_ELEMENTS_IN_ROW)
             for j in np.flatnonzero(costly):
@@ -98,11 +102,18 @@ def run_columns(cols: SceneColumns, numerics: Numerics, n_rec: int = 0, rec_ever
             idx = idx[order]
             if arrays is not None:
                 arrays = {key: value[order] for key, value in arrays.items()}
-        sub = cols.take(idx)
+        sub = _rows(cols, idx)
         sub_out = np.zeros((len(idx), layout.N_OUT))
         sub_rec = np.zeros((len(idx), n_rec, layout.N_REC))
         t0 = time.perf_counter()
-        run_path(path, sub, numerics, sub_rec, rec_every, sub_out, arrays)
+        if 0 < len(idx) < threads:  # a thread per row at most: waking idle ones only costs
+            numba.set_num_threads(len(idx))
+            try:
+                run_path(path, sub, numerics, sub_rec, rec_every, sub_out, arrays)
+            finally:
+                numba.set_num_threads(threads)
+        else:
+            run_path(path, sub, numerics, sub_rec, rec_every, sub_out, arrays)
         kernel_s += time.perf_counter() - t0
         out[idx] = sub_out
         if n_rec:
@@ -119,6 +130,15 @@ def run_columns(cols: SceneColumns, numerics: Numerics, n_rec: int = 0, rec_ever
         timings["kernel_s"] = timings.get("kernel_s", 0.0) + kernel_s
     written = out[:, layout.OUT_N_REC].astype(np.int64)
     return unpack(cols, out, path_names, explicit_euler, steps_per_T, refused), rec, written
+
+
+def _rows(cols: SceneColumns, idx: np.ndarray) -> SceneColumns:
+    """``cols.take(idx)``, or ``cols`` itself if ``idx`` is all its rows in order
+    (one path for the whole batch, as for a single impact: no copy)."""
+    if len(idx) == len(cols) and (len(idx) == 0 or (idx[0] == 0 and idx[-1] == len(idx) - 1
+                                                    and bool(np.all(np.diff(idx) == 1)))):
+        return cols
+    return cols.take(idx)
 
 
 def simulate_batch(scenes, numerics: Numerics | str | None = None, *,

@@ -2,6 +2,7 @@
 
 - :mod:`~vimpact.kernels.jit`: the one decorator factory with every numba option
 - :mod:`~vimpact.kernels.status`: the status table: names, kernel codes, meanings (no numba)
+- :mod:`~vimpact.kernels.threads`: how numba's threads wait (set before they start)
 - :mod:`~vimpact.kernels.layout`: integrator and status codes, output and record columns (no numba)
 - :mod:`~vimpact.kernels.record`: the trajectory record writer
 - :mod:`~vimpact.kernels.arms`: exact Maxwell-arm updates

@@ -4,7 +4,9 @@ All kernels are compiled through :func:`jit`, so that caching and the error
 model are the same everywhere: ``cache=True`` (a fresh clone compiles once,
 later runs load from ``__pycache__``) and ``error_model="numpy"`` (division by
 zero gives inf/NaN like NumPy instead of raising, which the kernels check
-explicitly). No ``fastmath``: the kernels rely on NaN checks.
+explicitly). No ``fastmath``: the kernels rely on NaN checks. How numba's
+threads wait between launches is set in :mod:`vimpact.kernels.threads`
+before numba starts them.
 """
 
 from __future__ import annotations
