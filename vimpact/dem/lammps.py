@@ -471,16 +471,6 @@ def round_trip_files(problem: DemProblem, speeds, steps_per_contact: int = STEPS
 
 
 if __name__ == "__main__":  # python -m vimpact.dem.lammps SETUP.toml [STEPS_PER_CONTACT]
-    from vimpact.dem.problem import load_problem
+    from vimpact.dem.report import round_trip_main
 
-    why = lammps_available()
-    if why:
-        sys.exit(f"cannot run LAMMPS: {why}")
-    prob = load_problem(sys.argv[1])
-    steps = int(sys.argv[2]) if len(sys.argv) > 2 else STEPS_PER_CONTACT
-    sp = np.geomspace(prob.speeds.min(), prob.speeds.max(), 5)
-    print(f"{'contact':12s} {'level':>5s} {'v [m/s]':>8s} {'predicted e':>12s} {'LAMMPS e':>12s} "
-          f"{'diff':>10s}")
-    for r in round_trip_files(prob, sp, steps):
-        print(f"{r['contact']:12s} {r['level']:5d} {r['v']:8.3g} {r['predicted']:12.8f} "
-              f"{r['e']:12.8f} {r['e'] - r['predicted']:10.2e}")
+    round_trip_main("LAMMPS", lammps_available, round_trip_files, STEPS_PER_CONTACT)

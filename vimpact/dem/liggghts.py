@@ -225,17 +225,6 @@ def round_trip(problem: DemProblem, speeds, steps_per_contact: int = STEPS_PER_C
 
 
 if __name__ == "__main__":  # python -m vimpact.dem.liggghts SETUP.toml [STEPS_PER_CONTACT]
-    import sys
+    from vimpact.dem.report import round_trip_main
 
-    from vimpact.dem.problem import load_problem
-
-    why = liggghts_available()
-    if why:
-        sys.exit(f"cannot run LIGGGHTS: {why}")
-    prob = load_problem(sys.argv[1])
-    steps = int(sys.argv[2]) if len(sys.argv) > 2 else STEPS_PER_CONTACT
-    sp = np.geomspace(prob.speeds.min(), prob.speeds.max(), 5)
-    print(f"{'contact':12s} {'v [m/s]':>8s} {'predicted e':>12s} {'LIGGGHTS e':>12s} {'diff':>10s}")
-    for r in round_trip(prob, sp, steps):
-        print(f"{r['contact']:12s} {r['v']:8.3g} {r['predicted']:12.8f} {r['e']:12.8f} "
-              f"{r['e'] - r['predicted']:10.2e}")
+    round_trip_main("LIGGGHTS", liggghts_available, round_trip, STEPS_PER_CONTACT)

@@ -119,3 +119,26 @@ def markdown(code: str, problem: DemProblem, targets: dict[str, Targets],
                      "the DEM code's Coulomb limit (exported mu) takes over at grazing angles")
     lines += ["", f"![vimpact vs {code}]({png})", ""]
     return "\n".join(lines)
+
+
+def round_trip_main(code: str, available, round_trip, steps_per_contact: int) -> None:
+    """``python -m vimpact.dem.CODE SETUP.toml [STEPS_PER_CONTACT]``: run the DEM code
+    on the exported files at five speeds over the set-up's range and print the
+    restitution it gives next to the report's prediction (one row per collision;
+    ``round_trip(problem, speeds, steps)`` returns rows with ``contact``, ``v``
+    (m/s), ``predicted``, ``e`` and optionally ``level``)."""
+    import sys
+
+    from vimpact.dem.problem import load_problem
+
+    why = available()
+    if why:
+        sys.exit(f"cannot run {code}: {why}")
+    prob = load_problem(sys.argv[1])
+    steps = int(sys.argv[2]) if len(sys.argv) > 2 else steps_per_contact
+    speeds = np.geomspace(prob.speeds.min(), prob.speeds.max(), 5)
+    print(f"{'contact':12s} {'level':>5s} {'v [m/s]':>8s} {'predicted e':>12s} "
+          f"{code + ' e':>12s} {'diff':>10s}")
+    for r in round_trip(prob, speeds, steps):
+        print(f"{r['contact']:12s} {r.get('level', 0):5d} {r['v']:8.3g} {r['predicted']:12.8f} "
+              f"{r['e']:12.8f} {r['e'] - r['predicted']:10.2e}")
