@@ -253,7 +253,7 @@ def _rk_mask(phase, n, tang, mask):
     return 4 + (2 if tang else 0)
 
 
-@jit(inline="always")
+@jit()
 def _filter_weights(z):
     """Weights of the exact filter updates (module docstring) for ``z = Delta/tau``.
 
@@ -292,13 +292,13 @@ def _filter_weights(z):
             24.0 * p3 - 72.0 * p4)
 
 
-@jit(inline="always")
+@jit()
 def _arm(x0, ez, w0, wr, wj, dt, p0, pr, j):
     """The quadratic-drive filter update ``exp(-z) X_0 + Delta (w_0 P_0 + w_r P_r) + w_J J``."""
     return ez * x0 + dt * (w0 * p0 + wr * pr) + wj * j
 
 
-@jit(inline="always")
+@jit()
 def _arm3(x0, ez, c0, c1, cr, cj, dt, p0, dp0, pr, j):
     """The cubic-drive filter update ``exp(-z) X_0 + Delta (c_0 P_0 + c_1 Delta P'_0
     + c_r P_r) + c_J J``."""
@@ -480,6 +480,17 @@ def _rhs(phase, y0, x, K, r, advance, tau0, g, itau, n, kappa, mu_t, tang, rc, h
         x[ou + n + 1] = -mu_t * Fx
         K[r, ou + n + 1] = 0.0
     return Fz, Fx
+
+
+@jit()
+def _rhs_once(phase, y0, x, K, r, tau0, g, itau, n, kappa, mu_t, tang, rc, hs, nh, ah, e_val,
+              kh):
+    """:func:`_rhs` at a state that holds its arm quantities (no advance), as a
+    called function for the few evaluations outside the steps (one inlined copy
+    of the right-hand side, in :func:`_step`, is what the run time needs; every
+    further copy costs compile time)."""
+    return _rhs(phase, y0, x, K, r, False, tau0, g, itau, n, kappa, mu_t, tang, rc, hs, nh, ah,
+                e_val, kh)
 
 
 @jit(inline="always")
@@ -764,8 +775,8 @@ def maxwell_stick_impact(tau0, g, tau, kappa, mu_t, tangential, rtol, max_steps,
     y[1] = 1.0
     if tang:
         y[3 + 3 * n + 1] = 1.0
-    Fz, Fx = _rhs(phase, y, y, K, 0, False, tau0, ga, itau, n, kappa, mu_t, tang, rc, hs, nh, ah,
-                  e_val, kh)
+    Fz, Fx = _rhs_once(phase, y, y, K, 0, tau0, ga, itau, n, kappa, mu_t, tang, rc, hs, nh, ah,
+                       e_val, kh)
     h = 0.05 * min(1.0, s_scale)
     sig = 0.0
     err_old = 1e-4
@@ -907,8 +918,8 @@ def maxwell_stick_impact(tau0, g, tau, kappa, mu_t, tangential, rtol, max_steps,
             atol[3] = rtol * (s_scale * s_scale)
             if tau0 > 0.0:
                 atol[0] = rtol * min(s_max, (v_scale / (1.25 * tau0)) ** (1.0 / 3.0))
-            Fz, Fx = _rhs(phase, y, y, K, 0, False, tau0, ga, itau, n, kappa, mu_t, tang, rc, hs,
-                          nh, ah, e_val, kh)
+            Fz, Fx = _rhs_once(phase, y, y, K, 0, tau0, ga, itau, n, kappa, mu_t, tang, rc, hs,
+                               nh, ah, e_val, kh)
             # restart small: the right-hand side is not smooth in the edge state
             # at the turning point, and there the error estimate of a long step
             # misses most of its error (measured: 10-20x the error otherwise)
@@ -955,8 +966,8 @@ def maxwell_stick_impact(tau0, g, tau, kappa, mu_t, tangential, rtol, max_steps,
 def _rec_state(rec, i_rec, phase, y, K, tau0, g, itau, n, kappa, mu_t, tang, rc, hs, nh, ah,
                e_val, kh):
     """Record the current state (forces recomputed at it)."""
-    Fz, Fx = _rhs(phase, y, y, K, 6, False, tau0, g, itau, n, kappa, mu_t, tang, rc, hs, nh, ah,
-                  e_val, kh)
+    Fz, Fx = _rhs_once(phase, y, y, K, 6, tau0, g, itau, n, kappa, mu_t, tang, rc, hs, nh, ah,
+                       e_val, kh)
     if phase == 0:
         u = y[0] * y[0]
         vc = y[3 + 3 * n + 1] if tang else 0.0
