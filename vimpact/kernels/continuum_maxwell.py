@@ -315,7 +315,8 @@ def _rhs(phase, y0, x, K, r, advance, tau0, g, itau, n, kappa, mu_t, tang, rc, h
     holds them already. Their entries of ``K[r]`` are 0. Unloading reads the
     loading history (``rc``, ``hs``, ``nh``, ``ah``) at the edge; ``e_val``
     receives the decay factors there and, at ``n``, the force density at the
-    edge (zero up to the integration error).
+    edge (zero up to the integration error); ``e_val[n + 1:]`` (``4 n`` more) keeps
+    each arm's step weights between its strain and strain-rate updates.
     """
     s = x[0]
     v = x[1]
@@ -424,6 +425,11 @@ def _rhs(phase, y0, x, K, r, advance, tau0, g, itau, n, kappa, mu_t, tang, rc, h
     for i in range(n):
         if advance:
             ez, w0, wr, wj, c0, c1, cr, cj = _filter_weights(dt * itau[i])
+            w = n + 1 + 4 * i  # the step's weights, kept for the strain rate below
+            e_val[w] = ez
+            e_val[w + 1] = w0
+            e_val[w + 2] = wr
+            e_val[w + 3] = wj
             x[4 + i] = _arm3(y0[4 + i], ez, c0, c1, cr, cj, dt, y0[1], y0[ou + n], v, du)
             if tang:
                 x[o + 2 + i] = _arm3(y0[o + 2 + i], ez, c0, c1, cr, cj, dt, y0[o + 1],
@@ -431,8 +437,8 @@ def _rhs(phase, y0, x, K, r, advance, tau0, g, itau, n, kappa, mu_t, tang, rc, h
         d = x[4 + i]
         # arm quantities of the edge element at its entry (loading history)
         ez, w0, wr, wj, c0, c1, cr, cj = _filter_weights(dte * itau[i])
-        de = _arm3(ah[k, i], ez, c0, c1, cr, cj, dte, vk, rc[k, 0, la], ve, due)
         dk = ah[k, i]
+        de = _arm3(dk, ez, c0, c1, cr, cj, dte, vk, rc[k, 0, la], ve, due)
         se = _arm3(ah[k, n + i], ez, c0, c1, cr, cj, dte, -dk * rate_k,
                    -(vk - dk * itau[i]) * rate_k - dk * accel_k, -de * rate_e,
                    _dense(rc, k, th, 3 + 2 * n + i) - rc[k, 0, 3 + 2 * n + i])
@@ -461,8 +467,9 @@ def _rhs(phase, y0, x, K, r, advance, tau0, g, itau, n, kappa, mu_t, tang, rc, h
     # for a fast arm and carry the stage values' inconsistency (first order)
     for i in range(n):
         if advance:
-            ez, w0, wr, wj, c0, c1, cr, cj = _filter_weights(dt * itau[i])
-            x[ou + i] = _arm(y0[ou + i], ez, w0, wr, wj, dt, y0[ou + n], -Fz, v - y0[1])
+            w = n + 1 + 4 * i
+            x[ou + i] = _arm(y0[ou + i], e_val[w], e_val[w + 1], e_val[w + 2], e_val[w + 3], dt,
+                             y0[ou + n], -Fz, v - y0[1])
         ft += g[i] * x[ou + i]
         K[r, ou + i] = 0.0
     x[ou + n] = -Fz
@@ -761,7 +768,7 @@ def maxwell_stick_impact(tau0, g, tau, kappa, mu_t, tangential, rtol, max_steps,
     K = np.zeros((7, mm))
     Ks = np.zeros((7, mm))
     ys = np.zeros(mm)
-    e_val = np.zeros(n + 1)
+    e_val = np.zeros(5 * n + 1)  # decay factors, edge force density, step weights
     kh = np.zeros(1, dtype=np.int64)  # the history step of the last edge
     cap = 64
     rc = np.zeros((cap, 5, m_l))
