@@ -39,34 +39,31 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
+from benchmarks.continuum_maxwell import (  # noqa: E402
+    BEFORE_COMMIT,
+    THETA_RATIO,
+    _kappa,
+    kernel_before,
+)
 from benchmarks.machine import (  # noqa: E402
     bench_main,
     figure,
     load_average,
     machine_info,
-    module_at_commit,
     save_figure,
     use_agg,
 )
+from vimpact.model.hertz import Q1_PER_TAU  # noqa: E402
 
-#: the explicit-arm continuum kernel (routing sent arms faster than 1e-3 T to elements)
-BEFORE_COMMIT = "54d8eb1"
-KERNEL_PATH = "vimpact/kernels/continuum_maxwell.py"
 TARGET = 1e-8
 RTOLS = [1e-6, 3e-7, 1e-7, 3e-8, 1e-8, 3e-9, 1e-9, 1e-10]
 NU = 0.5
-THETA_RATIO = 0.4
-Q1_PER_TAU = (15.0 / 32.0) ** 0.5
 T_UNIT = 1e-4  # s, the time unit of the 20-arm spectrum
 
 SCENES = [
     ("standard_solid_q2_1e-3", 0.0, [1000.0], [1e-3 * 0.01 / Q1_PER_TAU]),
     ("prony20", 0.0, [1000.0 / 20] * 20, list(np.logspace(-9, 6, 20) / T_UNIT)),
 ]
-
-
-def _kappa(nu):
-    return 2.0 * (1.0 - nu) / (2.0 - nu)
 
 
 def _batch_args(rows, tau0, g, tau):
@@ -124,10 +121,7 @@ def run(quick: bool) -> dict:
     repeats = 3 if quick else 5
     rtols = RTOLS[:4] if quick else RTOLS
     max_steps = 2_000_000
-    before = None
-    if not quick:
-        module = module_at_commit(BEFORE_COMMIT, KERNEL_PATH)
-        before = None if module is None else module.maxwell_stick_batch
+    before = None if quick else kernel_before()  # the explicit-arm kernel
     scenes = []
     try:
         for name, tau0, g, tau in SCENES:
