@@ -217,6 +217,10 @@ class SceneColumns:
             codes["memory"][i] = TANGENTIAL_MEMORY.index(s.tangential_memory)
             codes["model"][i] = MODELS.index(mat.model)
             rotation[i], large[i] = s.rotation, s.allow_large_contact
+            if s.adhesion > 0.0:  # not a batch effect: never run it as if without adhesion
+                reasons[i] = (f"scenes[{i}]: adhesion = {s.adhesion!r} J/m^2 is simulated one "
+                              "scene at a time (vimpact.simulate); the batch path has no "
+                              "adhesion")
         cols = dict(G_arm=G_arm, tau_arm=tau_arm, rotation=rotation, allow_large_contact=large,
                     reasons=reasons, **get, **codes)
         _neutralize(cols)

@@ -30,6 +30,8 @@ from vimpact.model.scene import TANGENTIAL_MEMORY, Scene
 CONTINUUM = "continuum"
 CONTINUUM_STICK = "continuum_stick"
 ELEMENTS = "elements"
+#: the adhesive normal-impact kernel (vimpact.kernels.adhesion), one scene at a time
+ADHESION = "adhesion"
 
 #: Below this incidence psi = 2 (1 - nu) / (mu (2 - nu)) |v_c0| / v_z0 a finite mu is
 #: full stick to rounding: friction moves beta_x by at most about psi (measured on a
@@ -68,6 +70,8 @@ class KernelPath:
         """Short label, e.g. ``elements[verlet,tangential:incremental,dashpot]``."""
         if self.kind == CONTINUUM_STICK:
             return "continuum[stick]"
+        if self.kind == ADHESION:
+            return "adhesion[verlet,normal]"
         if self.spec is None:
             return "continuum[kelvin_voigt,normal]"
         sp = self.spec
@@ -166,7 +170,14 @@ def handover_reason(status: int) -> str:
 
 
 def choose_path(scene: Scene, numerics: Numerics) -> Path:
-    """The kernel :func:`route` picks for ``scene``, with the reasons in words."""
+    """The kernel :func:`route` picks for ``scene``, with the reasons in words
+    (an adhesive scene: the adhesive kernel, which :func:`vimpact.simulate` runs)."""
+    if scene.adhesion > 0.0:
+        return Path(ADHESION, None, (
+            f"work of adhesion {scene.adhesion:g} J/m^2: adhesive normal impact on the MDR "
+            "element row with the rule of Hess (docs/physics.md#adhesion), "
+            f"{numerics.steps} steps per t_H and {numerics.elements} elements per a_H "
+            "(refined for a glassy modulus and a strong adhesion), verlet",))
     cols = SceneColumns.from_scenes([scene])
     routes = route(cols, numerics)
     path = routes.paths[routes.group[0]]

@@ -206,6 +206,22 @@ def simulate(scene: Scene, numerics: Numerics | str | None = None, *,
     if not isinstance(scene, Scene):
         raise InputError(message("scene", scene, "a vimpact.Scene"))
     numerics = _numerics(numerics)
+    if scene.adhesion > 0.0:  # its own kernel, normal only (docs/physics.md#adhesion)
+        res = _adhesive(scene, numerics, trajectory)
+    else:
+        res = _simulate(scene, numerics, trajectory)
+    if res.status == "tolerance_unreachable":
+        raise InputError(res.error)
+    if res.status == "half_space" and not scene.allow_large_contact:
+        raise HalfSpaceError(
+            f"a_max = {res.a_max:.4g} m is not allowed: must be <= 0.2 R = "
+            f"{HALF_SPACE_LIMIT * scene.R:.4g} m (R = {scene.R:.4g} m; half-space model; "
+            "allow_large_contact=True or --allow-large-contact accepts it)")
+    return res
+
+
+def _simulate(scene: Scene, numerics: Numerics, trajectory: bool) -> ImpactResult:
+    """One non-adhesive impact on the batch path (:func:`simulate` checks its status)."""
     cols = SceneColumns.from_scenes([scene])
     n_rec, rec_every = 0, 1
     if trajectory:
@@ -223,15 +239,16 @@ def simulate(scene: Scene, numerics: Numerics | str | None = None, *,
     traj = None
     if trajectory:
         traj = _trajectory(scene, rec[0, :written[0]])
-    res = ImpactResult(trajectory=traj, **row)
-    if res.status == "tolerance_unreachable":
-        raise InputError(res.error)
-    if res.status == "half_space" and not scene.allow_large_contact:
-        raise HalfSpaceError(
-            f"a_max = {res.a_max:.4g} m is not allowed: must be <= 0.2 R = "
-            f"{HALF_SPACE_LIMIT * scene.R:.4g} m (R = {scene.R:.4g} m; half-space model; "
-            "allow_large_contact=True or --allow-large-contact accepts it)")
-    return res
+    return ImpactResult(trajectory=traj, **row)
+
+
+def _adhesive(scene: Scene, numerics: Numerics, trajectory: bool) -> ImpactResult:
+    """One adhesive impact (:mod:`vimpact.engine.adhesion`; no trajectory yet)."""
+    from vimpact.engine.adhesion import impact_result
+
+    require("trajectory", trajectory, not trajectory, "False for an adhesive scene "
+            "(adhesion > 0): its kernel records no trajectory yet")
+    return impact_result(scene, numerics)
 
 
 def explain(scene: Scene, numerics: Numerics | str | None = None) -> str:

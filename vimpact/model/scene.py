@@ -89,6 +89,10 @@ class Scene:
     mu : Coulomb friction coefficient, dimensionless, >= 0 (default ``inf``:
         full stick, docs/physics.md#full-stick; finite: every element obeys
         ``|f_t| <= mu f_n``, section 12)
+    adhesion : work of adhesion ``dgamma`` of the sphere-half-space pair, J/m^2,
+        >= 0 (default 0: no adhesion, the impact exactly as without this field).
+        ``> 0``: the adhesive normal impact of docs/physics.md#adhesion
+        (JKR through the MDR with the rule of Hess; normal impact only)
     """
 
     material: Material
@@ -103,6 +107,7 @@ class Scene:
     tangential: str = "auto"
     rotation: bool = True
     mu: float = math.inf
+    adhesion: float = 0.0
     hertz: HertzScales = field(init=False, repr=False, compare=False)
 
     def __post_init__(self):
@@ -125,6 +130,12 @@ class Scene:
         flag("rotation", self.rotation)
         flag("allow_large_contact", self.allow_large_contact)
         object.__setattr__(self, "mu", friction_coefficient("mu", self.mu))
+        object.__setattr__(self, "adhesion", finite("adhesion", self.adhesion))
+        require("adhesion", self.adhesion, self.adhesion >= 0.0,
+                ">= 0 (work of adhesion, J/m^2; 0: no adhesion)")
+        require("adhesion", self.adhesion, self.adhesion == 0.0 or self.tangential == "none"
+                or self.v_c0 == 0.0, "0 for an oblique impact (v_c0 != 0 with tangential "
+                "'auto' or 'stick'): the adhesive impact is normal only (tangential='none')")
         require("mu", self.mu, self.tangential_memory != "seed" or math.isinf(self.mu),
                 SEED_FRICTION_ALLOWED)
         mat = self.material
