@@ -76,6 +76,12 @@ def add_parser(sub) -> argparse.ArgumentParser:
     g.add_argument("--mu", type=float, default=None, metavar="MU",
                    help="Coulomb friction coefficient, dimensionless, >= 0 (default: inf, "
                         "full stick)")
+    g.add_argument("--adhesion", type=float, default=None, metavar="J_M2",
+                   help="work of adhesion, J/m^2, >= 0 (default 0: none); the adhesive impact "
+                        "is normal only (--tangential none or no tangential speed)")
+    g.add_argument("--sticking-velocity", action="store_true",
+                   help="also find the impact speed below which the sphere sticks (bisection "
+                        "on --vz0 to 1e-3 relative; needs --adhesion)")
     g.add_argument("--tangential-memory", choices=TANGENTIAL_MEMORY, default=None,
                    help="tangential element rule: incremental (default, passive) or seed "
                         "(thesis eq. 4.16, total displacement)")
@@ -129,7 +135,8 @@ _FLAGS = {"v_z0": "--vz0", "v_x0": "--vx0", "omega0": "--omega0", "theta_ratio":
           "R": "--R", "m": "--m", "Theta": "--Theta", "mu": "--mu", "nu": "--nu", "Q1": "--Q1",
           "Q2": "--Q2", "E": "--E", "G": "--G", "eta": "--eta", "G1": "--G1", "G2": "--G2",
           "steps": "--steps", "elements": "--elements", "rtol": "--rtol",
-          "tolerance": "--tolerance", "integrator": "--integrator"}
+          "tolerance": "--tolerance", "integrator": "--integrator", "adhesion": "--adhesion",
+          "rtol_sticking": "--sticking-velocity"}
 #: Options that set a scene's Hertz scales (named when those leave the float range).
 _SCALE_OPTIONS = ("E", "G", "G1", "G2", "eta", "prony", "R", "m", "Theta", "vz0", "theta_ratio")
 
@@ -177,7 +184,10 @@ def _scene_from_args(a) -> Scene:
         if a.Theta is not None:
             raise InputError("--Theta cannot be combined with --Q1: the dimensionless scene "
                              "takes --theta-ratio")
-        return Scene.from_dimensionless(a.Q1, a.nu, a.Q2, theta_ratio=ratio, **effects)
+        scene = Scene.from_dimensionless(a.Q1, a.nu, a.Q2, theta_ratio=ratio, **effects)
+        if a.adhesion is not None:
+            scene = dataclasses.replace(scene, adhesion=a.adhesion)
+        return scene
     if a.Q2 is not None:
         raise missing("Q1", "--Q2 is part of the dimensionless input --Q1 --Q2 --nu")
     if a.temperature is not None and a.material is None:
@@ -191,6 +201,8 @@ def _scene_from_args(a) -> Scene:
     theta = a.Theta
     if theta is None and a.theta_ratio is not None:
         theta = positive("theta_ratio", a.theta_ratio) * a.m * a.R**2
+    if a.adhesion is not None:
+        effects["adhesion"] = a.adhesion
     return Scene(material, R=a.R, m=a.m, v_z0=a.vz0, v_x0=a.vx0, omega0=a.omega0, Theta=theta,
                  allow_large_contact=a.allow_large_contact, **effects)
 
@@ -226,6 +238,7 @@ def _scene_file(a) -> tuple[Scene, Numerics | None]:
              + tuple(_EFFECTS) if getattr(a, n) is not None]
     given += [f"--{n.replace('_', '-')}" for n, default in
               (("vx0", 0.0), ("omega0", 0.0), ("theta_ratio", None), ("mu", None),
+               ("adhesion", None),
                ("no_rotation", False))
               if getattr(a, n) != default]
     if given:
@@ -300,6 +313,10 @@ def run(a) -> int:
     from vimpact.engine.routing import choose_path
     from vimpact.engine.simulate import simulate
 
+    if a.sticking_velocity and scene.adhesion <= 0.0:
+        raise InputError("--sticking-velocity needs a work of adhesion > 0 (--adhesion J_M2, "
+                         "or adhesion_J_m2 in the scene file): without adhesion the sphere "
+                         "never sticks")
     path = choose_path(scene, numerics)
     if a.explain and not a.json:
         print(path.explain())
@@ -317,14 +334,39 @@ def run(a) -> int:
                 res.trajectory.to_csv(f, index=False)
             else:
                 res.trajectory.to_parquet(f, index=False)
+    extra = _adhesion_outputs(scene, numerics, a.sticking_velocity)
     if a.json:
         d = res.to_json_dict()
         if a.explain:
             d["explain"] = list(path.reasons)
+        if extra:
+            d["adhesion"] = extra
         print(json.dumps(d))
     else:
         print(_summary(scene, res))
+        for key, value in extra.items():
+            print(f"  {key:<21} {value:.6g}" if isinstance(value, float) else
+                  f"  {key:<21} {value}")
     return 0
+
+
+def _adhesion_outputs(scene: Scene, numerics: Numerics, sticking: bool) -> dict:
+    """The adhesive impact's own outputs (empty without adhesion), SI units in the names."""
+    if scene.adhesion <= 0.0:
+        return {}
+    from vimpact.engine.adhesion import STICKING_RTOL, simulate_adhesive, sticking_velocity
+
+    adh = simulate_adhesive(scene, numerics)
+    out: dict = {"adhesion_J_m2": scene.adhesion, "stuck": adh.stuck,
+                 "F_tensile_max_N": adh.F_tensile_max, "u_min_m": adh.u_min,
+                 "adhesion_number": adh.adhesion_number}
+    if sticking:
+        try:
+            out["sticking_velocity_m_s"] = sticking_velocity(scene, numerics)
+        except InputError as exc:
+            raise InputError(f"--sticking-velocity: {exc}") from None
+        out["sticking_velocity_rtol"] = STICKING_RTOL
+    return out
 
 
 def _summary(scene: Scene, res) -> str:

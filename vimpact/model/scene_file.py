@@ -29,6 +29,7 @@ with backspin)::
     omega0_rad_s = -40.0            # spin about y, rad/s (default 0)
     theta_ratio = 0.4               # Theta / (m R^2) (default 0.4, a solid sphere)
     mu = 0.3                        # Coulomb friction coefficient (default inf: full stick)
+    # adhesion_J_m2 = 0.05          # work of adhesion (default 0; normal impacts only)
 
 Top-level keys: ``model`` (required), ``description``, ``tangential_memory``,
 ``tangential``, ``rotation``, ``allow_large_contact``, ``numerics`` (a table,
@@ -39,6 +40,8 @@ or a preset name as a string) and ``scene`` (required).
 - all models: ``nu``, ``R_m``, ``m_kg``, ``v_z0_m_s`` (required),
   ``v_x0_m_s`` (default 0), ``omega0_rad_s`` (default 0), ``theta_ratio``
   (default 0.4)
+- adhesion, all models: ``adhesion_J_m2`` (work of adhesion, J/m^2, >= 0, default
+  0; a scene file only, docs/physics.md#adhesion; the impact must be normal)
 - friction, all models: ``mu`` (Coulomb friction coefficient, static =
   kinetic, a number >= 0; ``inf`` (TOML) or ``"inf"`` is full stick, the
   default) and ``angle_deg`` (impact angle from the normal, degrees, in
@@ -75,6 +78,7 @@ Python API::
 
 from __future__ import annotations
 
+import dataclasses
 from pathlib import Path
 
 from vimpact.model.material_file import inline_material
@@ -96,6 +100,9 @@ from vimpact.model.toml_input import (
     scene_from_values,
 )
 
+#: ``[scene]`` key of the work of adhesion, J/m^2 (default 0; docs/physics.md#adhesion).
+ADHESION_KEY = "adhesion_J_m2"
+
 #: Top-level keys of a scene file.
 TOP_KEYS = ("model", "description", "tangential_memory", "tangential", "rotation",
             "allow_large_contact", "numerics", "scene")
@@ -115,6 +122,7 @@ _CHECKS = {
     "E_Pa": _POSITIVE, "G_Pa": _POSITIVE, "G1_Pa": _POSITIVE, "G2_Pa": _POSITIVE,
     "eta_Pa_s": _NON_NEGATIVE, "tau_s": _POSITIVE,
     "R_m": _POSITIVE, "m_kg": _POSITIVE, "v_z0_m_s": _POSITIVE, "theta_ratio": _POSITIVE,
+    "adhesion_J_m2": _NON_NEGATIVE,
 }
 
 
@@ -162,7 +170,12 @@ def _scene(spec: TomlSource, text: str, data: dict,
     if "scene" not in data:
         raise spec.error("scene", "missing: a [scene] table with the physical values ("
                          + ", ".join(allowed_scene_keys(header.model)) + ")")
-    values, arms = _scene_table(spec, header.model, data["scene"])
+    table = data["scene"]
+    adhesion = 0.0  # a scene-file key only (docs/physics.md#adhesion; sweeps have no adhesion)
+    if isinstance(table, dict) and ADHESION_KEY in table:
+        table = dict(table)
+        adhesion = _number(spec, f"scene.{ADHESION_KEY}", table.pop(ADHESION_KEY), ADHESION_KEY)
+    values, arms = _scene_table(spec, header.model, table)
 
     # The same key names, defaults and construction as a sweep row
     # (vimpact.model.toml_input), so the two formats cannot drift apart.
@@ -171,6 +184,8 @@ def _scene(spec: TomlSource, text: str, data: dict,
                                   tangential_memory=header.tangential_memory,
                                   tangential=header.tangential, rotation=header.rotation,
                                   allow_large_contact=allow_large)
+        if adhesion:
+            scene = dataclasses.replace(scene, adhesion=adhesion)
     except ScaleError as exc:  # name the keys of this file that set the scales
         keys = [k for name in exc.names for k in _SCALE_KEYS.get(name, (name,))
                 if k in values or name not in _SCALE_KEYS]
