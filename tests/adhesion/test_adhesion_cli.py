@@ -67,3 +67,9 @@ adhesion_J_m2 = 0.5
     with pytest.raises(ValueError, match="adhesion_J_m2"):
         scene_from_toml(text.replace("0.5\n", "-0.5\n").replace("nu = -0.5", "nu = 0.5"))
     assert scene_from_toml(text.replace("adhesion_J_m2 = 0.5\n", ""))[0].adhesion == 0.0
+
+
+def test_adhesion_figure(tmp_path, capsys):
+    out = tmp_path / "fig_adhesion.png"
+    assert main(["plot", "fig_adhesion", "--out", str(out)]) == 0
+    assert out.stat().st_size > 10_000

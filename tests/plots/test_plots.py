@@ -46,9 +46,11 @@ FRICTION = ("fig_mbf", "fig_beta_psi", "fig_chung_ooi")
 #: e_z(v) of the example polymer at five temperatures (45 impacts on the element path):
 #: drawn in tests/plots/test_temperature_figure.py (slow)
 TEMPERATURE = ("fig_temperature",)
+#: e_z(v) and sticking velocities of the adhesive example: drawn in tests/adhesion
+ADHESION = ("fig_adhesion",)
 
 
-@pytest.mark.parametrize("name", [n for n in FIGURE_NAMES if n not in FRICTION + TEMPERATURE])
+@pytest.mark.parametrize("name", [n for n in FIGURE_NAMES if n not in FRICTION + TEMPERATURE + ADHESION])
 def test_every_figure_renders_png(name, tables, tmp_path):
     out = tmp_path / f"{name}.png"
     path = plot_figure(name, out, table=tables.get(name))
@@ -100,7 +102,7 @@ def test_figure_errors(tables, tmp_path):
 
 def test_figure_names():
     assert set(FIGURE_NAMES) == {"fig3_2", "fig4_2", "fig4_4", "fig5_1", "fig5_2", "fig5_3",
-                                 "fig5_4", "fig5_5", *FRICTION, *TEMPERATURE}
+                                 "fig5_4", "fig5_5", *FRICTION, *TEMPERATURE, *ADHESION}
     assert figure_name("5.2") == figure_name("Fig 5.2") == figure_name("fig5_2") == "fig5_2"
     assert all(FIGURES[n].spec for n in FIGURE_NAMES if n.startswith("fig5"))
 

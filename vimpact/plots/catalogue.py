@@ -27,6 +27,8 @@ CATALOGUE: dict[str, tuple[str, str | None]] = {
     "fig_temperature": ("e_z over the impact speed at several temperatures, the example "
                         "polymer sweeps/materials/synthetic_rubber.toml (run from the "
                         "repository root)", None),
+    "fig_adhesion": ("adhesion: e_z over the impact speed with the sticking velocity, elastic "
+                     "and Kelvin-Voigt half-space", None),
 }
 
 #: Names accepted by :func:`vimpact.plots.figures.plot_figure` (also ``"5.2"``,

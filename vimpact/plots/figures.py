@@ -454,6 +454,7 @@ _DRAW: dict[str, Callable] = {
     "fig_mbf": _friction("fig_mbf"), "fig_beta_psi": _friction("fig_beta_psi"),
     "fig_chung_ooi": _friction("fig_chung_ooi"),
     "fig_temperature": _lazy("vimpact.plots.temperature", "fig_temperature"),
+    "fig_adhesion": _lazy("vimpact.plots.adhesion", "fig_adhesion"),
 }
 if set(_DRAW) != set(CATALOGUE):  # the catalogue (titles, specs) and the drawings agree
     raise ImportError(f"figures without a drawing or a catalogue entry: "
