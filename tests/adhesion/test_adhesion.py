@@ -20,6 +20,7 @@ from scipy.integrate import quad
 
 import vimpact as v
 from vimpact.engine.adhesion import (
+    adhesion_for_number,
     adhesion_number,
     jkr_quasi_static,
     simulate_adhesive,
@@ -195,3 +196,42 @@ def test_sticking_velocity_input_errors():
     with pytest.raises(ValueError, match="rtol"):
         sticking_velocity(scene(0.02), rtol=0.0)
     assert sticking_velocity(dataclasses.replace(scene(0.02), adhesion=0.0)) == 0.0
+
+
+def test_elastic_sticking_velocity_closed_form_and_collapse():
+    """Elastic: e_z depends on lam alone, and the sticking velocity is
+    v_s = C (dgamma^5 R^4 / (E*^2 m^3))^(1/6) with C from the JKR work in JKR units
+    (a scipy quadrature here): lam_s = (1 / (2 w0))^(3/10), C = sqrt(16/15) (2 pi / lam_s^2)^(5/6)."""
+    w0 = -quad(lambda s: (1.25 * s**3 - 15.0 / 8.0 * s**1.5) * (2.0 * s - 0.5 * s**-0.5),
+               4.0 ** (-2.0 / 3.0), 1.0)[0]
+    lam_s = (1.0 / (2.0 * w0)) ** 0.3
+    C = math.sqrt(16.0 / 15.0) * (2.0 * math.pi / lam_s**2) ** (5.0 / 6.0)
+    assert C == pytest.approx(3.766, abs=1e-3)
+    other = v.Scene(v.Material.elastic(nu=0.3, E=7e7), R=0.05, m=0.3, v_z0=0.1, adhesion=2.0,
+                    tangential="none")
+    for s in (scene(0.02), other):
+        scale = (s.adhesion**5 * s.R**4 / (s.E_star**2 * s.m**3)) ** (1.0 / 6.0)
+        assert sticking_velocity(s, rtol=1e-3) == pytest.approx(C * scale, rel=3e-3)
+    # same lam, different physics: the same e_z to rounding
+    for lam in (0.3, 1.0):
+        a = scene(0.05)
+        b = dataclasses.replace(other, v_z0=0.7)
+        a = dataclasses.replace(a, adhesion=adhesion_for_number(a, lam))
+        b = dataclasses.replace(b, adhesion=adhesion_for_number(b, lam))
+        assert adhesion_number(a) == pytest.approx(lam, rel=1e-12)
+        assert simulate_adhesive(a).e_z == pytest.approx(simulate_adhesive(b).e_z, abs=1e-12)
+
+
+def test_kelvin_voigt_collapses_on_lam_and_q1():
+    """Kelvin-Voigt: e_z depends on (lam, Q1) only (measured on two physical scenes)."""
+    q1, lam = 0.05, 0.8
+    a = v.Scene.from_dimensionless(q1, 0.5, tangential="none")
+    mat_b = v.Material.kelvin_voigt(nu=0.2, G=4e6, eta=1.0)
+    b = v.Scene(mat_b, R=0.003, m=2e-4, v_z0=0.4, tangential="none")
+    b = dataclasses.replace(b, material=v.Material.kelvin_voigt(
+        nu=0.2, G=4e6, eta=1.0 * q1 / b.Q1))
+    assert b.Q1 == pytest.approx(q1, rel=1e-12)
+    a = dataclasses.replace(a, adhesion=adhesion_for_number(a, lam), allow_large_contact=True)
+    b = dataclasses.replace(b, adhesion=adhesion_for_number(b, lam), allow_large_contact=True)
+    ra, rb = simulate_adhesive(a), simulate_adhesive(b)
+    assert ra.e_z == pytest.approx(rb.e_z, abs=1e-9) and 0.0 < ra.e_z < 1.0

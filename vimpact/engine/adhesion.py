@@ -92,6 +92,14 @@ def adhesion_number(scene: Scene) -> float:
     return math.sqrt(2.0 * math.pi * float(hz.a_H) * scene.adhesion / scene.E_star) / float(hz.d)
 
 
+def adhesion_for_number(scene: Scene, lam: float) -> float:
+    """The work of adhesion (J/m^2) that gives ``scene`` the adhesion number ``lam``
+    (the inverse of :func:`adhesion_number`): ``dgamma = lam^2 d^2 E* / (2 pi a_H)``."""
+    lam = positive("lam", lam)
+    hz = scene.hertz
+    return lam**2 * float(hz.d) ** 2 * scene.E_star / (2.0 * math.pi * float(hz.a_H))
+
+
 def _inputs(scene: Scene, numerics: Numerics, widen: float) -> dict:
     cols = SceneColumns.from_scenes([dataclasses.replace(scene, adhesion=0.0)])
     num = numerics.with_(row_width=numerics.row_width * widen)
