@@ -80,6 +80,24 @@ _OTHER = ("Theta_kg_m2", "theta_ratio", "rotation", "model")
 MODEL_ELASTIC, MODEL_KELVIN_VOIGT, MODEL_STANDARD_SOLID, MODEL_PRONY = range(4)
 
 
+class _once:  # noqa: N801 - used as a decorator, like property
+    """A derived column computed on first access and then kept in the instance
+    (``functools.cached_property`` without its lock, which costs more than the
+    one-row arithmetic it saves)."""
+
+    def __init__(self, fn):
+        self.fn, self.__doc__ = fn, fn.__doc__
+
+    def __set_name__(self, owner, name: str) -> None:
+        self.name = name
+
+    def __get__(self, obj, owner=None):
+        if obj is None:
+            return self
+        value = obj.__dict__[self.name] = self.fn(obj)
+        return value
+
+
 @dataclass
 class SceneColumns:
     """A batch of scenes as arrays (SI units), validated, with derived Hertz scales.
@@ -128,43 +146,45 @@ class SceneColumns:
         return self.nu.shape[0]
 
     # ---- derived, vectorized (docs/physics.md#method-of-dimensionality-reduction,
-    # docs/physics.md#energy-and-passivity, docs/physics.md#dimensionless-parameters) ------
+    # docs/physics.md#energy-and-passivity, docs/physics.md#dimensionless-parameters);
+    # the ones routing, packing and unpacking all read are computed once per batch
+    # (:data:`_DERIVED`; :meth:`check_scales` forgets them when it rewrites rows) ----
     @property
     def valid(self) -> np.ndarray:
         """Rows without a reason to refuse them (valid scenes), bool."""
         return is_none(self.reasons)
 
-    @property
+    @_once
     def v_c0(self) -> np.ndarray:
         """Initial contact-point velocity ``v_x0 + R omega0``, m/s."""
         return self.v_x0 + self.R * self.omega0
 
-    @property
+    @_once
     def theta_ratio(self) -> np.ndarray:
         """``Theta / (m R^2)``, dimensionless."""
         return self.Theta / (self.m * self.R**2)
 
-    @property
+    @_once
     def contact_mass_factor(self) -> np.ndarray:
         """``1 + m R^2 / Theta`` (1 without rotation), dimensionless."""
         return np.where(self.rotation, 1.0 + 1.0 / self.theta_ratio, 1.0)
 
-    @property
+    @_once
     def kappa(self) -> np.ndarray:
         """``c_t / c_n = 2 (1 - nu) / (2 - nu)``, dimensionless."""
         return 2.0 * (1.0 - self.nu) / (2.0 - self.nu)
 
-    @property
+    @_once
     def computes_tangential(self) -> np.ndarray:
         """The tangential problem is solved: asked for and ``v_c0 != 0``."""
         return (self.tangential != TANGENTIAL_EFFECTS.index("none")) & (self.v_c0 != 0.0)
 
-    @property
+    @_once
     def has_arms(self) -> np.ndarray:
         """Rows with at least one Maxwell arm, bool."""
         return np.any(self.G_arm > 0.0, axis=1)
 
-    @property
+    @_once
     def dashpot_time(self) -> np.ndarray:
         """``eta0 / G_inf``, s."""
         return self.eta0 / self.G_inf
@@ -220,9 +240,9 @@ class SceneColumns:
         cols = dict(G_arm=G_arm, tau_arm=tau_arm, rotation=rotation, allow_large_contact=large,
                     reasons=reasons, **get, **codes)
         _neutralize(cols)
-        out = cls(**cols)
-        out.check_scales()
-        return out
+        # no check_scales: a Scene checked the same ranges when it was made
+        # (ScaleError), and a row that is not a Scene is already marked
+        return cls(**cols)
 
     @classmethod
     def from_columns(cls, data) -> SceneColumns:
@@ -333,11 +353,16 @@ class SceneColumns:
             fields = {k: getattr(self, k) for k in _FIELDS}
             _neutralize(fields)
             self.__post_init__()
+            for name in _DERIVED:  # computed from the rows before they were neutralized
+                self.__dict__.pop(name, None)
 
 
 _FIELDS = ("nu", "G_inf", "eta0", "G_arm", "tau_arm", "R", "m", "v_z0", "v_x0", "omega0",
            "Theta", "mu", "tangential", "memory", "model", "rotation", "allow_large_contact",
            "reasons")
+#: derived columns computed once per batch (:class:`_once`)
+_DERIVED = ("v_c0", "theta_ratio", "contact_mass_factor", "kappa", "computes_tangential",
+            "has_arms", "dashpot_time")
 #: harmless values written into invalid rows, so that no arithmetic on them warns
 _NEUTRAL = {"nu": 0.5, "G_inf": 1.0, "eta0": 0.0, "R": 1.0, "m": 1.0, "v_z0": 1.0, "v_x0": 0.0,
             "omega0": 0.0, "Theta": 0.4, "mu": math.inf}

@@ -19,7 +19,7 @@ from vimpact.engine.columns import SceneColumns, scene_columns
 from vimpact.engine.pack import element_arrays, interleave, run_path
 from vimpact.engine.result import RESULT_FIELDS, ImpactResult
 from vimpact.engine.routing import CONTINUUM_STICK, choose_path, route
-from vimpact.engine.unpack import unpack
+from vimpact.engine.unpack import unpack, unpack_row
 from vimpact.kernels import layout
 from vimpact.model.hertz import HERTZ_TIME_FACTOR
 from vimpact.model.numerics import MAX_ELEMENTS_IN_ROW, MAX_STEPS_PER_T_H, Numerics
@@ -59,6 +59,17 @@ def run_columns(cols: SceneColumns, numerics: Numerics, n_rec: int = 0, rec_ever
     Rows the full-stick continuum kernel hands back (its assumptions broke, or
     its step limit) run again on the element kernel their effects call for.
     """
+    out, rec, path_names, explicit_euler, steps_per_T, refused = _run(
+        cols, numerics, n_rec, rec_every, timings)
+    written = out[:, layout.OUT_N_REC].astype(np.int64)
+    return unpack(cols, out, path_names, explicit_euler, steps_per_T, refused), rec, written
+
+
+def _run(cols: SceneColumns, numerics: Numerics, n_rec: int, rec_every: int,
+         timings: dict | None) -> tuple[np.ndarray, ...]:
+    """Route, pack and run: the kernel rows ``out``, the trajectory buffer, and per
+    row the path name, explicit Euler, steps per ``T`` and refusal that
+    :func:`~vimpact.engine.unpack.unpack` takes (:func:`run_columns`)."""
     import numba
 
     n = len(cols)
@@ -128,14 +139,13 @@ def run_columns(cols: SceneColumns, numerics: Numerics, n_rec: int = 0, rec_ever
                 queue.extend((p, rows[again.group == k]) for k, p in enumerate(again.paths))
     if timings is not None:
         timings["kernel_s"] = timings.get("kernel_s", 0.0) + kernel_s
-    written = out[:, layout.OUT_N_REC].astype(np.int64)
-    return unpack(cols, out, path_names, explicit_euler, steps_per_T, refused), rec, written
+    return out, rec, path_names, explicit_euler, steps_per_T, refused
 
 
 def _rows(cols: SceneColumns, idx: np.ndarray) -> SceneColumns:
     """``cols.take(idx)``, or ``cols`` itself if ``idx`` is all its rows in order
     (one path for the whole batch, as for a single impact: no copy)."""
-    if len(idx) == len(cols) and (len(idx) == 0 or (idx[0] == 0 and idx[-1] == len(idx) - 1
+    if len(idx) == len(cols) and (len(idx) <= 1 or (idx[0] == 0 and idx[-1] == len(idx) - 1
                                                     and bool(np.all(np.diff(idx) == 1)))):
         return cols
     return cols.take(idx)
@@ -218,11 +228,13 @@ def simulate(scene: Scene, numerics: Numerics | str | None = None, *,
             rec_every = max(1, int(per_t_H) // TRAJECTORY_ROWS_PER_T_H)
             n_rec = int(a["max_steps"][0] // rec_every) + 2
         n_rec = min(n_rec, MAX_TRAJECTORY_ROWS)
-    result, rec, written = run_columns(cols, numerics, n_rec, rec_every)
-    row = {name: (v[0].item() if hasattr(v[0], "item") else v[0]) for name, v in result.items()}
+    out, rec, path_names, explicit_euler, steps_per_T, refused = _run(
+        cols, numerics, n_rec, rec_every, None)
+    row = unpack_row(cols, out[0], path_names[0], bool(explicit_euler[0]),
+                     float(steps_per_T[0]), refused[0])
     traj = None
     if trajectory:
-        traj = _trajectory(scene, rec[0, :written[0]])
+        traj = _trajectory(scene, rec[0, :int(out[0, layout.OUT_N_REC])])
     res = ImpactResult(trajectory=traj, **row)
     if res.status == "tolerance_unreachable":
         raise InputError(res.error)
