@@ -1,6 +1,6 @@
 """Run impacts: scenes in, results out.
 
-Data flow (DESIGN.md): scenes (``Scene`` objects or input columns) ->
+Data flow: scenes (``Scene`` objects or input columns) ->
 :class:`~vimpact.engine.columns.SceneColumns` (validated, vectorized) ->
 routing by masks (:func:`~vimpact.engine.routing.route`) -> kernel arrays per
 path (:mod:`~vimpact.engine.pack`) -> one parallel kernel call per path ->
@@ -104,10 +104,11 @@ def _run(cols: SceneColumns, numerics: Numerics, n_rec: int, rec_every: int,
                 costly[:] = True
             explicit_euler[idx] = path.spec.integrator == layout.EULER
             steps_per_T[idx] = 1.0 / arrays["h"]
-            idx = idx[~costly]
-            arrays = {key: value[~costly] for key, value in arrays.items()}
-            if len(idx) == 0:
-                continue
+            if costly.any():
+                idx = idx[~costly]
+                arrays = {key: value[~costly] for key, value in arrays.items()}
+                if len(idx) == 0:
+                    continue
         if n_rec == 0 and len(idx) > threads:
             order = interleave(len(idx), threads)
             idx = idx[order]

@@ -88,7 +88,7 @@ class Scene:
         ``omega`` keeps ``omega0`` (``Theta`` is then not used)
     mu : Coulomb friction coefficient, dimensionless, >= 0 (default ``inf``:
         full stick, docs/physics.md#full-stick; finite: every element obeys
-        ``|f_t| <= mu f_n``, section 12)
+        ``|f_t| <= mu f_n``, docs/physics.md#coulomb-friction)
     """
 
     material: Material
