@@ -64,7 +64,7 @@ def judge(old: dict, new: dict) -> dict:
     """One figure's comparison: ``ratio`` (new / old), ``noise`` (relative),
     ``threshold`` and the ``verdict``."""
     kind = new["kind"]
-    spreads = [f.get("spread") if f.get("spread") is not None else UNKNOWN_SPREAD[kind]
+    spreads = [float(f["spread"]) if f.get("spread") is not None else UNKNOWN_SPREAD[kind]
                for f in (old, new)]
     noise = math.sqrt(spreads[0] ** 2 + spreads[1] ** 2)
     threshold = max(2.0 * noise, NOISE_FLOOR[kind])

@@ -36,6 +36,7 @@ from __future__ import annotations
 
 import math
 import time
+from typing import Any
 
 import numpy as np
 
@@ -191,7 +192,7 @@ def tolerance_check(tolerances) -> dict:
                      for q1, nu, q2, _ in CHECK_SCENES],
             "friction": [v.Scene.from_dimensionless(q1, nu, q2, mu=mu)
                          for q1, nu, q2, mu in CHECK_SCENES]}
-    out = {}
+    out: dict[str, dict] = {}
     for name, scenes in sets.items():
         out[name] = {}
         for tol in tolerances:
@@ -217,7 +218,8 @@ def run(quick: bool) -> dict:
     sweep = np.arange(190.0, 210.01, 2.0 if quick else 0.5)
     sweep_steps = 2400 if quick else 4800
     before = None if quick else old_kernel()
-    data = {"machine": machine_info(), "before_commit": BEFORE if before else None,
+    data: dict[str, Any] = {"machine": machine_info(),
+                            "before_commit": BEFORE if before else None,
             "steps": steps.tolist(), "fine_steps": fine_steps, "elements": elems.tolist(),
             "fine_elements": fine_elems, "joint_steps": joint.tolist(),
             "joint_elements": (joint / 6.0).tolist(), "sweep_elements": sweep.tolist(),
@@ -229,16 +231,16 @@ def run(quick: bool) -> dict:
         kernels = {"after": element_kernel}
         if before is not None and len(g) > 0:
             kernels["before"] = before
-        case = {"continuum_e_z": ez_ref, "continuum_e_x": ex_ref}
+        case: dict[str, Any] = {"continuum_e_z": ez_ref, "continuum_e_x": ex_ref}
         for label, k in kernels.items():
             t0 = time.perf_counter()
-            r = {}
+            r: dict[str, Any] = {}
 
             def errors(out):
                 return (np.abs(-out[:, OUT_VZ_END] - ez_ref).tolist(),
                         np.abs(np.abs(out[:, OUT_VC_END]) - ex_ref).tolist())
 
-            ladders = {
+            ladders: dict[str, dict[str, Any]] = {
                 "time": dict(h=HERTZ_TIME / steps / TANGENTIAL_FACTOR, dxi=1.0 / fine_elems),
                 "space": dict(h=HERTZ_TIME / fine_steps / TANGENTIAL_FACTOR, dxi=1.0 / elems),
                 "joint": dict(h=HERTZ_TIME / joint / TANGENTIAL_FACTOR, dxi=6.0 / joint),
@@ -325,12 +327,13 @@ def error_model_points(quick: bool) -> dict:
     q_fit = -np.polyfit(np.log(E), np.log(err[-1, :]), 1)[0]
     SS, EE = np.meshgrid(np.asarray(S, float), np.asarray(E, float), indexing="ij")
     p, q = 1.0, 2.0
-    best = None
+    best: tuple[float, float, float] | None = None
     for a in np.logspace(-5, 2, 1400):
         b = max(0.0, float(((err - a / SS**p) * EE**q).max()))
         worst = float(((a / SS**p + b / EE**q) / err).max())
         if best is None or worst < best[2]:
             best = (float(a), b, worst)
+    assert best is not None  # the loop above ran
     presets = {}
     for name in (("fast", "default") if quick else ("fast", "default", "precise")):
         df = v.simulate_batch(scenes, v.Numerics.preset(name).with_(continuum=False))

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import math
 import time
+from typing import Any
 
 import numba
 import numpy as np
@@ -31,7 +32,7 @@ TITLE = "Coulomb friction: friction kernel against stick kernel, beta_x error vs
 def interleaved_medians(fns: dict, repeats: int) -> dict:
     """Median wall time of each ``fns`` entry, timed in turn within every
     repeat (so a busy machine slows all of them alike), s."""
-    times = {k: [] for k in fns}
+    times: dict[str, list[float]] = {k: [] for k in fns}
     for _ in range(repeats):
         for k, fn in fns.items():
             t0 = time.perf_counter()
@@ -50,7 +51,7 @@ def run(quick: bool) -> dict:
     repeats = 5 if quick else 9
     threads = numba.get_num_threads()
     numba.set_num_threads(1)  # one thread: the ratio, not the parallel speed-up
-    data = {"machine": machine_info(), "steps": steps, "elements": elements, "rows": rows,
+    data: dict[str, Any] = {"machine": machine_info(), "steps": steps, "elements": elements, "rows": rows,
             "threads_used": 1, "cost": {}, "ladder": {}}
     h = HERTZ_TIME / steps / TANGENTIAL_FACTOR
     for name, (tau0, g, tau) in MATERIALS.items():

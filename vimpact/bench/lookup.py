@@ -29,6 +29,7 @@ import math
 import time
 import tomllib
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -74,7 +75,7 @@ def measure_grid(name: str, spec_path: Path, n_random: int) -> tuple[dict, objec
     t0 = time.perf_counter()
     table = grid_table(model, axes, numerics)
     t_nodes = time.perf_counter() - t0
-    out = {"spec": str(spec_path.relative_to(ROOT)), "model": model,
+    out: dict[str, Any] = {"spec": str(spec_path.relative_to(ROOT)), "model": model,
            "nodes": {a: len(v) for a, v in axes.items()}, "rows": len(table),
            "failed_nodes": int((table.data["status"] != "ok").sum()),
            "tolerance": tolerance, "numerics_preset": preset, "node_simulation_s": t_nodes}
@@ -168,7 +169,8 @@ def run(quick: bool) -> dict:
     import numba
 
     numba.set_num_threads(1)  # one core
-    data = {"benchmark": "lookup", "machine": machine_info(), "load_before": load_average(),
+    data: dict[str, Any] = {"benchmark": "lookup", "machine": machine_info(),
+                            "load_before": load_average(),
             "grids": {}, "timing": {}}
     for name, path in SHIPPED.items():
         if path.is_file():

@@ -53,7 +53,7 @@ def machine_info() -> dict:
     return {
         "cpu": cpu,
         "cores": os.cpu_count(),
-        "numba_threads": numba.config.NUMBA_NUM_THREADS,
+        "numba_threads": max_threads(),
         "python": platform.python_version(),
         "numpy": np.__version__,
         "numba": numba.__version__,
@@ -68,6 +68,28 @@ def machine_line(info: dict) -> str:
             f"{info.get('numba_threads')} numba threads; python {info.get('python')}, "
             f"numpy {info.get('numpy')}, numba {info.get('numba')}, "
             f"vimpact {info.get('vimpact')}")
+
+
+def max_threads() -> int:
+    """Threads numba may use at most (``NUMBA_NUM_THREADS``, read from the
+    environment when numba is imported; :func:`numba.set_num_threads` takes up to it).
+    """
+    import numba
+
+    return int(vars(numba.config)["NUMBA_NUM_THREADS"])  # set at run time: no stub has it
+
+
+def element_spec(scene, numerics):
+    """The element kernel (:class:`vimpact.kernels.elements.KernelSpec`) that runs
+    ``scene`` with ``numerics``; ``ValueError`` if a continuum kernel runs it (a
+    benchmark of the element kernels passes ``Numerics(continuum=False)``)."""
+    from vimpact.engine.routing import choose_path
+
+    path = choose_path(scene, numerics)
+    if path.spec is None:
+        raise ValueError(f"numerics = {numerics!r} is not allowed here: the scene runs on "
+                         f"{path.name}, must be an element kernel (continuum=False)")
+    return path.spec
 
 
 def load_average() -> list[float]:
@@ -255,6 +277,8 @@ def module_at_commit(commit: str, path: str) -> ModuleType | None:
     if not file.exists() or file.read_text() != src:
         file.write_text(src)
     spec = importlib.util.spec_from_file_location(name, file)
+    if spec is None or spec.loader is None:
+        return None
     module = importlib.util.module_from_spec(spec)
     sys.modules[name] = module  # numba's cache finds the module again by name
     lent = _lend_moved_names()

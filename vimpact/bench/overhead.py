@@ -41,6 +41,7 @@ from __future__ import annotations
 import math
 import time
 from pathlib import Path
+from typing import Any
 
 import numba
 import numpy as np
@@ -49,6 +50,7 @@ from .machine import (
     figure,
     load_average,
     machine_info,
+    max_threads,
     package_at_commit,
     progress,
     save_figure,
@@ -105,13 +107,16 @@ def _measure(columns: dict, numerics, repeats: int) -> dict:
     import vimpact as v
 
     rows = len(columns["nu"])
-    total, kernel = [], []
+    total: list[float] = []
+    kernel: list[float] = []
     frame = None
     for _ in range(repeats):
         t: dict = {}
         frame = v.simulate_batch(columns, numerics, timings=t)
         total.append(t["total_s"])
         kernel.append(t["kernel_s"])
+    if frame is None:
+        raise ValueError(f"repeats = {repeats!r} is not allowed: must be >= 1")
     over = [(a - b) / rows * 1e6 for a, b in zip(total, kernel)]
     rate = [rows / a for a in total]
     statuses = frame["status"].value_counts().to_dict()
@@ -228,7 +233,7 @@ def one_impact(quick: bool = False) -> dict:
     numerics = {"friction (elements, fast)": v.Numerics.preset("fast")}
     all_threads = numba.get_num_threads()
     numba.set_num_threads(1)
-    out = {"before_commit": BEFORE_COMMIT if before else None, "calls": calls,
+    out: dict[str, Any] = {"before_commit": BEFORE_COMMIT if before else None, "calls": calls,
            "repeats": repeats, "scenes": {}}
     try:
         for name, scene in scenes.items():
@@ -282,7 +287,7 @@ def run(quick: bool = False) -> dict:
     import vimpact as v
 
     cfg = CONFIGS["quick" if quick else "full"]
-    all_threads = numba.config.NUMBA_NUM_THREADS
+    all_threads = max_threads()
     threads = min(THREADS, all_threads)
     load_before = load_average()
     start = time.perf_counter()

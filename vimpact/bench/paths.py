@@ -16,6 +16,8 @@ Kernel time only (inputs packed once, median of repeats, one numba thread).
 
 from __future__ import annotations
 
+from typing import Any
+
 import numba
 import numpy as np
 
@@ -28,7 +30,15 @@ from vimpact.kernels import elements as kernel
 from vimpact.kernels import layout
 from vimpact.reference.closed_forms import kelvin_voigt_continuum
 
-from .machine import figure, machine_info, ratio_spread, save_figure, time_samples, use_agg
+from .machine import (
+    element_spec,
+    figure,
+    machine_info,
+    ratio_spread,
+    save_figure,
+    time_samples,
+    use_agg,
+)
 
 TITLE = "cost per impact of each kernel path vs the general element kernel"
 
@@ -58,7 +68,7 @@ def _kv_normal(quick: bool) -> dict:
                                               {"steps": 8000, "elements": 1600}))
     settings = {"continuum rtol=1e-7": (v.Numerics(rtol=1e-7), _continuum_call, repeat),
                 f"elements {elements.steps}/{elements.elements}": (elements, _element_call, 1)}
-    out = {}
+    out: dict[str, dict[str, Any]] = {}
     for name, (numerics, make, k) in settings.items():
         call, result = make(scenes * k, numerics)
         call()  # compile / load
@@ -67,8 +77,8 @@ def _kv_normal(quick: bool) -> dict:
         out[name] = {"path": choose_path(scenes[0], numerics).name,
                      "max_e_z_error": float(np.max(np.abs(e_z - exact))),
                      "us_per_impact": t, "us_per_impact_samples": samples}
-    a, b = out.values()
-    return {"settings": out, "speedup": b["us_per_impact"] / a["us_per_impact"]}
+    a, b = (x["us_per_impact"] for x in out.values())
+    return {"settings": out, "speedup": b / a}
 
 
 def _continuum_call(scenes, numerics: v.Numerics):
@@ -81,7 +91,7 @@ def _continuum_call(scenes, numerics: v.Numerics):
 def _element_call(scenes, numerics: v.Numerics, spec=None):
     """The element kernel ``spec`` (default: the scenes' own) on inputs packed
     for the scenes' own kernel: a call and the output rows."""
-    own = choose_path(scenes[0], numerics).spec
+    own = element_spec(scenes[0], numerics)
     a = element_arrays(SceneColumns.from_scenes(scenes), numerics, own)
     n = len(scenes)
     out = np.zeros((n, layout.N_OUT))
@@ -109,7 +119,7 @@ def _specialization(quick: bool) -> dict:
     for name, scenes in cases.items():
         special, special_out = _element_call(scenes, numerics)
         general, general_out = _element_call(
-            scenes, numerics, general_spec(choose_path(scenes[0], numerics).spec))
+            scenes, numerics, general_spec(element_spec(scenes[0], numerics)))
         special()
         general()
         diff = float(np.max(np.abs(special_out()[:, layout.OUT_VZ_END]

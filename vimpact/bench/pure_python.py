@@ -37,7 +37,9 @@ from __future__ import annotations
 import math
 
 from vimpact import Numerics, Scene
-from vimpact.engine.routing import choose_path, refinement
+from vimpact.engine.routing import refinement
+
+from .machine import element_spec
 
 
 def _arm_coefficients(tau: float, dt: float) -> tuple[float, float, float]:
@@ -66,7 +68,7 @@ def kernel_refinement(scene: Scene, steps: int, elements: int, row_width: float 
     """The element kernel's ``(time_factor, element_factor)`` for ``scene``
     (:func:`vimpact.engine.routing.refinement`), dimensionless, >= 1."""
     numerics = Numerics(steps=steps, elements=elements, row_width=row_width, continuum=False)
-    return refinement(scene, numerics, choose_path(scene, numerics).spec)
+    return refinement(scene, numerics, element_spec(scene, numerics))
 
 
 def refined_row(scene: Scene, steps: int, elements: int, row_width: float = 1.05,

@@ -87,6 +87,9 @@ def _case(name: str, rows: int):
     r = route(sc, numerics)
     k = max(range(len(r.paths)), key=lambda j: int((r.group == j).sum()))
     spec = r.paths[k].spec
+    if spec is None:
+        raise ValueError("the columns' largest group runs on a continuum kernel, must be an "
+                         "element kernel (continuum=False)")
     sub = sc.take(np.flatnonzero(r.group == k))
     a = element_arrays(sub, numerics, spec)
     args = (a["tau0"], a["g"], a["tau"], a["n_arms"], a["kappa"], a["mu_t"], a["mu"], a["h"],

@@ -28,6 +28,8 @@ import tempfile
 import time
 from pathlib import Path
 
+from .machine import max_threads
+
 TITLE = "Sweeps: in-process against a Dask LocalCluster, and a large sweep's wall over kernel time"
 
 SPEC = """
@@ -69,9 +71,9 @@ def backends(rows: int, chunk: int) -> dict:
     from vimpact.sweep import run_sweep
     from vimpact.sweep.runner import local_cluster
 
-    numba.set_num_threads(min(2, numba.config.NUMBA_NUM_THREADS))
-    with tempfile.TemporaryDirectory() as tmp:
-        tmp = Path(tmp)
+    numba.set_num_threads(min(2, max_threads()))
+    with tempfile.TemporaryDirectory() as folder:
+        tmp = Path(folder)
         warm, spec = _spec(tmp, "warm", 8, 2), _spec(tmp, "sweep", rows, chunk)
         t0 = time.perf_counter()
         cluster = local_cluster(2)
@@ -101,8 +103,8 @@ def backends(rows: int, chunk: int) -> dict:
 def large(rows: int, chunk: int) -> dict:
     from vimpact.sweep import run_sweep, summary
 
-    with tempfile.TemporaryDirectory() as tmp:
-        tmp = Path(tmp)
+    with tempfile.TemporaryDirectory() as folder:
+        tmp = Path(folder)
         spec = _spec(tmp, "large", rows, chunk)
         timings: dict = {}
         t0 = time.perf_counter()

@@ -46,6 +46,7 @@ from .machine import (
     figure,
     load_average,
     machine_info,
+    max_threads,
     progress,
     ratio_spread,
     save_figure,
@@ -155,7 +156,7 @@ def run(quick: bool = False) -> dict:
     load_before = load_average()
     numerics: v.Numerics = cfg["numerics"]
     scenes = random_scenes(cfg["n_scenes"])
-    all_threads = numba.config.NUMBA_NUM_THREADS
+    all_threads = max_threads()
     thread_counts = [1, 2] if all_threads >= 2 else [1]
 
     # kernel: warm up (compile / load the cache), then 1 and 2 threads alternately

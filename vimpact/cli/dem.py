@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import math
 import os
 
 from vimpact.model.numerics import CONVERGED_PRESETS
@@ -73,9 +74,11 @@ def run(args: argparse.Namespace) -> int:
                                          Numerics.preset(args.preset),
                                          steps_per_contact=args.steps_per_contact,
                                          progress=progress)
-        worst = max(f.res_e_z.max_abs for f in result.fits)
-        classes = {"size_classes": result.problem.size_classes,
-                   "types": len(result.problem.types), "target": args.residual,
+        worst = max((f.res_e_z.max_abs for f in result.fits if f.res_e_z is not None),
+                    default=math.nan)
+        final = result.problem or problem  # the problem refined to meet the residual
+        classes = {"size_classes": final.size_classes,
+                   "types": len(final.types), "target": args.residual,
                    "max_residual_e_z": worst, "met": met, "classes_needed": needed}
     else:
         result = export(problem, args.code, out, Numerics.preset(args.preset),

@@ -167,9 +167,11 @@ def run_show(a: argparse.Namespace) -> int:
         except ValueError as exc:
             raise ValueError(str(exc).replace("temperature (K) =", "--temperature =", 1)) \
                 from None
-        a_T = mat.shift.shift_factor(a.temperature)
+        shift = mat.shift
+        assert shift is not None  # at_temperature refused a material without a shift law
+        a_T = shift.shift_factor(a.temperature)
         lines.append(f"at {a.temperature:g} K: shift factor a_T = {a_T:.4g} "
-                     f"(log10 a_T = {mat.shift.log10_shift(a.temperature):.4g})")
+                     f"(log10 a_T = {shift.log10_shift(a.temperature):.4g})")
         mat = shifted
     lines.append(f"{mat.model}, nu = {mat.nu:g}")
     lines.append(f"  G_inf    {mat.G_inf:.4g} Pa (relaxed)")

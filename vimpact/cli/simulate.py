@@ -8,6 +8,7 @@ import json
 import math
 import os
 from pathlib import Path
+from typing import Any
 
 from vimpact import __version__
 from vimpact.cli.material_args import add_material_arguments, as_flags, material_from_args, missing
@@ -156,7 +157,7 @@ def scene_from_args(a) -> Scene:
 
 
 def _scene_from_args(a) -> Scene:
-    effects = {k: getattr(a, k) if getattr(a, k) is not None else default
+    effects: dict[str, Any] = {k: getattr(a, k) if getattr(a, k) is not None else default
                for k, default in _EFFECTS.items()}
     effects["rotation"] = not a.no_rotation
     if a.mu is not None:
@@ -312,11 +313,13 @@ def run(a) -> int:
 
         out = Path(a.trajectory)
         csv = out.suffix.lower() == ".csv"
+        trajectory = res.trajectory
+        assert trajectory is not None  # simulate(..., trajectory=True) recorded it
         with atomic_file(out, "--trajectory", mode="w" if csv else "wb") as f:
             if csv:
-                res.trajectory.to_csv(f, index=False)
+                trajectory.to_csv(f, index=False)
             else:
-                res.trajectory.to_parquet(f, index=False)
+                trajectory.to_parquet(f, index=False)
     if a.json:
         d = res.to_json_dict()
         if a.explain:

@@ -190,6 +190,7 @@ def fig4_2(out, scene: Scene | None = None, numerics: Numerics | None = None) ->
     scene = scene or thesis_scene()
     res = simulate(scene, numerics, trajectory=True)
     tr = res.trajectory
+    assert tr is not None  # trajectory=True records it
     t = tr["t_s"].to_numpy() / res.t_hertz
     with _drawing(out) as (fig, ax):
         ax.axhline(0.0, color="k", lw=0.8)
@@ -232,6 +233,7 @@ def fig4_4(out, steps=(50, 100, 500), scene: Scene | None = None, elements: int 
             res = simulate(scene, Numerics(integrator="euler", steps=int(n), elements=elements),
                            trajectory=True)
             tr = res.trajectory
+            assert tr is not None  # trajectory=True records it
             ax.plot(tr["u_z_m"] / res.d_hertz, tr["v_z_m_s"] / scene.v_z0,
                     marker=_MARKERS[k % len(_MARKERS)], markevery=max(1, len(tr) // 25),
                     ms=4, lw=1.2, label=f"explicit Euler, {n} steps per $t_H$ "
