@@ -140,8 +140,11 @@ ELEMENT_PATH_CASES = {
 
 
 def mu_for(psi_over_chi: float, nu: float = NU, theta_ratio: float = THETA_RATIO) -> float:
-    """Kernel-unit friction coefficient ``mu v_z0 / |v_c0|`` for ``psi = that x chi``
-    (``psi = kappa / mu``, ``chi = kappa (1 + m R^2 / Theta) / 2``); ``inf`` for 0."""
+    """Return the kernel-unit friction coefficient for an incidence ``psi``.
+
+    Kernel-unit friction coefficient ``mu v_z0 / |v_c0|`` for ``psi = that x chi``
+    (``psi = kappa / mu``, ``chi = kappa (1 + m R^2 / Theta) / 2``); ``inf`` for 0.
+    """
     if psi_over_chi == 0.0:
         return math.inf
     chi = (1.0 - nu) / (2.0 - nu) * (1.0 + 1.0 / theta_ratio)
@@ -149,9 +152,12 @@ def mu_for(psi_over_chi: float, nu: float = NU, theta_ratio: float = THETA_RATIO
 
 
 def envelope(spec, ez_ref, ex_ref, levels, **material) -> dict:
-    """Largest |error| of e_z and e_x over ``ENVELOPE_SHIFTS`` element counts at
+    """Return the error envelope over shifted element counts, and its orders.
+
+    Largest |error| of e_z and e_x over ``ENVELOPE_SHIFTS`` element counts at
     each joint level (``N + k / ENVELOPE_SHIFTS`` elements per a_H, ``6 N`` steps
-    per t_H) and the orders fitted to them; e_x is compared signed (beta_x)."""
+    per t_H) and the orders fitted to them; e_x is compared signed (beta_x).
+    """
     ez_env, ex_env = [], []
     for n in levels:
         counts = n + np.arange(ENVELOPE_SHIFTS) / ENVELOPE_SHIFTS
@@ -165,9 +171,12 @@ def envelope(spec, ez_ref, ex_ref, levels, **material) -> dict:
 
 
 def element_reference(spec, **material) -> tuple[float, float, float]:
-    """``(e_z, beta_x, uncertainty)`` of a fine element run (9600 steps per t_H,
+    """Return the fine element reference of one case and its uncertainty.
+
+    ``(e_z, beta_x, uncertainty)`` of a fine element run (9600 steps per t_H,
     1600 elements per a_H and two spacings 0.02 % and 0.04 % apart: their mean,
-    and the spread of beta_x over the three)."""
+    and the spread of beta_x over the three).
+    """
     out = run_rows(spec, h=HERTZ_TIME / 9600 / TANGENTIAL_FACTOR,
                    dxi=1.0 / (1600.0 + np.array([0.0, 0.37, 0.71])), **material)
     assert (out[:, OUT_STATUS] == STATUS_OK).all()
@@ -182,10 +191,13 @@ CHECK_SCENES = [(0.3, 0.3, None, 0.3), (1.0, 0.5, 1.0, 0.1), (0.05, 0.0, None, 1
 
 
 def tolerance_check(tolerances) -> dict:
-    """``Numerics.for_tolerance(tol)`` with its tolerance check switched off (plain
+    """Check ``Numerics.for_tolerance`` against a finer run.
+
+    ``Numerics.for_tolerance(tol)`` with its tolerance check switched off (plain
     steps and elements) on :data:`CHECK_SCENES` with the seed memory and with
     friction, against an 8x finer run (steps and elements; 4x gives the reference's
-    uncertainty): largest error on e_z and beta_x over the tolerance, per scene."""
+    uncertainty): largest error on e_z and beta_x over the tolerance, per scene.
+    """
     import vimpact as v
 
     sets = {"seed": [v.Scene.from_dimensionless(q1, nu, q2, tangential_memory="seed")
@@ -293,12 +305,15 @@ MODEL_SCENES = [(0.01, 0.0, None), (0.1, 0.5, None), (1.0, 0.25, None), (5.0, 0.
 
 
 def error_model_points(quick: bool) -> dict:
-    """Errors of ``Numerics(continuum=False, steps=S, elements=E)`` against the
+    """Return the errors of the element path on a grid of steps and elements.
+
+    Errors of ``Numerics(continuum=False, steps=S, elements=E)`` against the
     continuum kernel on :data:`MODEL_SCENES`, max over the scenes of
     ``max(|e_z err|, |e_x err|)``, on a grid of (S, E), and the envelope
     ``a / S + b / E^2`` that bounds every point (the form of
     ``vimpact.model.numerics.ERROR_MODEL``); the presets on the element path,
-    measured the same way."""
+    measured the same way.
+    """
     import vimpact as v
     from vimpact.bench.accuracy import continuum_restitution
 
@@ -406,8 +421,11 @@ def plot(data: dict, path) -> None:
 
 
 def figures(data: dict) -> dict:
-    """Fitted observed orders (time-only and joint refinement, e_z and e_x) per case,
-    the element-count sweep's e_x jump, and each preset's max error on elements."""
+    """Return the headline numbers of an element-orders run.
+
+    Fitted observed orders (time-only and joint refinement, e_z and e_x) per case,
+    the element-count sweep's e_x jump, and each preset's max error on elements.
+    """
     from vimpact.bench.machine import figure
 
     out = {}

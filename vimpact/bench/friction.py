@@ -30,8 +30,11 @@ TITLE = "Coulomb friction: friction kernel against stick kernel, beta_x error vs
 
 
 def interleaved_medians(fns: dict, repeats: int) -> dict:
-    """Median wall time of each ``fns`` entry, timed in turn within every
-    repeat (so a busy machine slows all of them alike), s."""
+    """Return the median wall time of each function, timed in turns, s.
+
+    Median wall time of each ``fns`` entry, timed in turn within every
+    repeat (so a busy machine slows all of them alike), s.
+    """
     times: dict[str, list[float]] = {k: [] for k in fns}
     for _ in range(repeats):
         for k, fn in fns.items():
@@ -134,8 +137,11 @@ def plot(data: dict, path) -> None:
 
 
 def figures(data: dict) -> dict:
-    """Time ratio friction / stick kernel per material and case, and the
-    finest beta_x error of the friction ladder."""
+    """Return the headline numbers of a friction run.
+
+    Time ratio friction / stick kernel per material and case, and the
+    finest beta_x error of the friction ladder.
+    """
     out = {}
     for name, cost in data["cost"].items():
         for label, c in cost.items():

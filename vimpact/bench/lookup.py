@@ -44,9 +44,12 @@ N_LOOKUPS = 1_000_000
 
 
 def grid_axes(spec_path: Path) -> tuple[str, dict, float | None, str]:
-    """``(model, axes, tolerance, numerics preset)`` of a grid spec, its axes made as the
+    """Return the model, axes, tolerance and numerics preset of a grid spec.
+
+    ``(model, axes, tolerance, numerics preset)`` of a grid spec, its axes made as the
     sweep makes them (``per_decade``: ``round(log10(stop/start) * per) + 1`` log-spaced
-    values with exact ends; a list as given)."""
+    values with exact ends; a list as given).
+    """
     data = tomllib.loads(spec_path.read_text())
     axes = {}
     for key in ("Q1", "Q2", "nu"):
@@ -107,8 +110,11 @@ VARIANTS = (("cubic_lookup", "cubic", None), ("cubic_numba", "cubic", "numba"),
 
 
 def _open_shipped(path: Path):
-    """A shipped table, its rows validated (the file's integrity is the store's
-    concern and its own tests'; it does not change the lookup time)."""
+    """Open a shipped table.
+
+    Return a shipped table, its rows validated (the file's integrity is the store's
+    concern and its own tests'; it does not change the lookup time).
+    """
     from vimpact.lookup.table import RestitutionTable
 
     return RestitutionTable.open(path, validate=False).validate()
@@ -124,8 +130,11 @@ def _lookup(table, pts: dict, variant: tuple) -> dict:
 
 
 def time_lookups(table, repeats: int, n_points: int = N_LOOKUPS) -> dict:
-    """``n_points`` random in-range lookups per variant (:data:`VARIANTS`), alternated,
-    wall and CPU s; the kernel's first call timed apart."""
+    """Time random in-range lookups per variant.
+
+    ``n_points`` random in-range lookups per variant (:data:`VARIANTS`), alternated,
+    wall and CPU s; the kernel's first call timed apart.
+    """
     rng = np.random.default_rng(1)
     grid = table._lookup_grid()
     pts = {}
@@ -196,8 +205,11 @@ def run(quick: bool) -> dict:
 
 
 def figures(data: dict) -> dict:
-    """Headline numbers: cubic lookup CPU time per 1e6 points (numba kernel and NumPy
-    reference) per shipped table; with the accuracy part, the max errors per grid."""
+    """Return the headline numbers of a lookup run.
+
+    Headline numbers: cubic lookup CPU time per 1e6 points (numba kernel and NumPy
+    reference) per shipped table; with the accuracy part, the max errors per grid.
+    """
     from vimpact.bench.machine import figure
 
     out = {}

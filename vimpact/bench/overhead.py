@@ -102,8 +102,10 @@ def scene_columns(n: int, seed: int = 0, oblique: bool = False) -> dict[str, np.
 
 
 def _measure(columns: dict, numerics, repeats: int) -> dict:
-    """``repeats`` calls of ``simulate_batch(columns, numerics, timings=t)``:
-    per call ``total_s``, ``kernel_s``, overhead per row (us) and rows/s."""
+    """``repeats`` calls of ``simulate_batch(columns, numerics, timings=t)``.
+
+    Per call ``total_s``, ``kernel_s``, overhead per row (us) and rows/s.
+    """
     import vimpact as v
 
     rows = len(columns["nu"])
@@ -146,8 +148,11 @@ TARGET_ONE_IMPACT_US = 100.0
 
 
 def _cpu_us(fn, calls: int) -> float:
-    """CPU time per call of ``fn()`` over ``calls`` calls, us (CPU time: robust
-    against other processes on the machine)."""
+    """Return the CPU time per call of ``fn()``, us.
+
+    CPU time per call of ``fn()`` over ``calls`` calls, us (CPU time: robust
+    against other processes on the machine).
+    """
     t0 = time.process_time()
     for _ in range(calls):
         fn()
@@ -155,9 +160,12 @@ def _cpu_us(fn, calls: int) -> float:
 
 
 def _side_by_side(fns: dict, calls: int, repeats: int) -> dict[str, list[float]]:
-    """CPU time per call (us) of each function of ``fns``, ``repeats`` rounds of
+    """Time functions in turns, CPU time per call in us.
+
+    CPU time per call (us) of each function of ``fns``, ``repeats`` rounds of
     ``calls`` calls each, the functions taking turns within a round (so a change
-    of load hits all alike); after one warm-up call each."""
+    of load hits all alike); after one warm-up call each.
+    """
     for fn in fns.values():
         fn()
     samples: dict[str, list[float]] = {name: [] for name in fns}
@@ -168,11 +176,14 @@ def _side_by_side(fns: dict, calls: int, repeats: int) -> dict[str, list[float]]
 
 
 class _KernelsReplaced:
-    """While active, every kernel the engines call (the two continuum batch kernels
+    """Replace every kernel by a copy of its output row.
+
+    While active, every kernel the engines call (the two continuum batch kernels
     and each element kernel, in the current and the :data:`BEFORE_COMMIT` engine's
     ``pack``) only copies ``row`` into its output: what is left of a
     ``simulate()`` call is the Python around the kernel. With ``row=None`` the
-    real kernel runs once and its one-row output is kept as ``row``."""
+    real kernel runs once and its one-row output is kept as ``row``.
+    """
 
     def __init__(self, packs: list, row: np.ndarray | None = None):
         self.packs, self.row = packs, row
@@ -208,12 +219,15 @@ class _KernelsReplaced:
 
 
 def one_impact(quick: bool = False) -> dict:
-    """CPU time of one ``simulate()`` call on 1 numba thread, the kernel's share
+    """Measure the Python outside the kernel of one ``simulate()`` call.
+
+    CPU time of one ``simulate()`` call on 1 numba thread, the kernel's share
     (``run_columns`` timings: wall time inside the kernel) and the Python outside
     it, for the README's oblique Kelvin-Voigt scene (full-stick continuum path), a
     normal-only one (Kelvin-Voigt continuum path) and an oblique one with friction
     (element path); with the engine as of :data:`BEFORE_COMMIT` side by side where
-    available, whose results must be the same."""
+    available, whose results must be the same.
+    """
     import vimpact as v
     from vimpact.engine import pack
     from vimpact.engine.columns import SceneColumns
@@ -282,8 +296,11 @@ def one_impact(quick: bool = False) -> dict:
 
 
 def run(quick: bool = False) -> dict:
-    """Measure both paths; returns the JSON-ready record (``continuum``,
-    ``elements``: see :func:`_measure`; ``targets`` and whether they are met)."""
+    """Measure both paths and one impact.
+
+    Measure both paths; returns the JSON-ready record (``continuum``,
+    ``elements``: see :func:`_measure`; ``targets`` and whether they are met).
+    """
     import vimpact as v
 
     cfg = CONFIGS["quick" if quick else "full"]
@@ -387,8 +404,11 @@ def report(data: dict) -> str:
 
 
 def plot(data: dict, path: Path) -> None:
-    """Left: time per row split into kernel and Python overhead, per path, with
-    the overhead target; right: Kelvin-Voigt rows/s per repeat with the target."""
+    """Draw the kernel and Python time per row and the throughput to ``path``.
+
+    Left: time per row split into kernel and Python overhead, per path, with
+    the overhead target; right: Kelvin-Voigt rows/s per repeat with the target.
+    """
     use_agg()
     import matplotlib.pyplot as plt
 

@@ -43,11 +43,14 @@ from .machine import (
 TITLE = "cost per impact of each kernel path vs the general element kernel"
 
 def general_spec(spec: kernel.KernelSpec) -> kernel.KernelSpec:
-    """The element kernel with the tangential problem and the arms on (full
+    """Return the general element kernel for ``spec``.
+
+    The element kernel with the tangential problem and the arms on (full
     stick), and the dashpot flag of ``spec``: the dashpot flag also decides
     how an element in contact for part of a step is weighed (only with a
     dashpot is the normal force discontinuous at entry and exit), so it is
-    not only a folded branch and must match the rows."""
+    not only a folded branch and must match the rows.
+    """
     return kernel.KernelSpec(layout.VERLET, True, 0, True, spec.dashpot, False)
 
 
@@ -58,8 +61,11 @@ def _timed(call, repeats: int, per: float) -> tuple[float, list[float]]:
 
 
 def _kv_normal(quick: bool) -> dict:
-    """Kernel time only (inputs packed once): the Python layer around a batch
-    is the same for both paths and would hide the kernels' ratio."""
+    """Kernel time only (inputs packed once).
+
+    The Python layer around a batch is the same for both paths and would hide the kernels'
+    ratio.
+    """
     q1 = np.geomspace(1e-3, 10.0, 4 if quick else 16)
     scenes = [v.Scene.from_dimensionless(q, 0.5, tangential="none") for q in q1]
     repeat = 1 if quick else 64  # the continuum batch is microseconds: amortize the launch
@@ -89,8 +95,11 @@ def _continuum_call(scenes, numerics: v.Numerics):
 
 
 def _element_call(scenes, numerics: v.Numerics, spec=None):
-    """The element kernel ``spec`` (default: the scenes' own) on inputs packed
-    for the scenes' own kernel: a call and the output rows."""
+    """Return a call of an element kernel and its output rows.
+
+    The element kernel ``spec`` (default: the scenes' own) on inputs packed
+    for the scenes' own kernel: a call and the output rows.
+    """
     own = element_spec(scenes[0], numerics)
     a = element_arrays(SceneColumns.from_scenes(scenes), numerics, own)
     n = len(scenes)
@@ -167,8 +176,7 @@ def plot(data: dict, path) -> None:
 
 
 def figures(data: dict) -> dict:
-    """Time per impact of each path, the continuum's speedup at equal accuracy
-    and its e_z error."""
+    """Time per impact of each path, the continuum's speedup at equal accuracy and its e_z error."""
     out = {}
     kv = data["kelvin_voigt_normal_equal_accuracy"]
     spreads = []

@@ -42,9 +42,12 @@ _KERNEL = None
 
 
 def runtime_flags_kernel():
-    """The batch element kernel with the effects as run-time arguments
+    """Return the batch element kernel with its effects as run-time flags.
+
+    The batch element kernel with the effects as run-time arguments
     ``(integrator, tangential, memory, arms, dashpot, friction, ...)`` followed
-    by the arguments of :func:`~vimpact.kernels.elements.element_kernel`'s kernels."""
+    by the arguments of :func:`~vimpact.kernels.elements.element_kernel`'s kernels.
+    """
     global _KERNEL
     if _KERNEL is None:
         from numba import prange
@@ -100,8 +103,11 @@ def _case(name: str, rows: int):
 
 
 def _compile_cpu(case: str, which: str) -> float:
-    """In this process (fresh cache): CPU seconds of the first call of ``which``
-    (``specialized`` or ``runtime``) on ``case``."""
+    """In this process (fresh cache).
+
+    CPU seconds of the first call of ``which`` (``specialized`` or ``runtime``) on
+    ``case``.
+    """
     from vimpact.kernels import layout
     from vimpact.kernels.elements import element_kernel
 
@@ -123,9 +129,11 @@ print(json.dumps({c: _compile_cpu(c, sys.argv[1]) for c in sys.argv[2:]}))
 
 
 def _compile_times() -> dict:
-    """CPU seconds to compile: each case's specialized kernel, and the run-time-flag
-    kernel (its first case pays; the others find it compiled), each in a fresh
-    process with an empty numba cache."""
+    """CPU seconds to compile.
+
+    Each case's specialized kernel, and the run-time-flag kernel (its first case pays; the
+    others find it compiled), each in a fresh process with an empty numba cache.
+    """
     out = {}
     with tempfile.TemporaryDirectory(prefix="vimpact_spec_") as tmp:
         for which in ("specialized", "runtime"):

@@ -124,8 +124,11 @@ def large(rows: int, chunk: int) -> dict:
 
 
 def run(quick: bool) -> dict:
-    """Both parts (``quick``: 200 rows side by side, a 2000-row large sweep;
-    full: 2000 rows side by side, a 1e6-row large sweep)."""
+    """Measure both parts.
+
+    Both parts (``quick``: 200 rows side by side, a 2000-row large sweep;
+    full: 2000 rows side by side, a 1e6-row large sweep).
+    """
     return {"machine": machine(),
             "backends": backends(200 if quick else 2000, 20 if quick else 100),
             "large": large(2000 if quick else 1_000_000, 500 if quick else 10_000)}
@@ -152,8 +155,11 @@ def plot(data: dict, path) -> None:
 
 
 def figures(data: dict) -> dict:
-    """Dask over in-process time, the large sweep's wall over kernel time, its
-    rows/s and Python overhead per row."""
+    """Return the headline numbers of a sweep-backends run.
+
+    Dask over in-process time, the large sweep's wall over kernel time, its
+    rows/s and Python overhead per row.
+    """
     from vimpact.bench.machine import figure
 
     b, big = data["backends"], data["large"]

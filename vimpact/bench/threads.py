@@ -57,9 +57,12 @@ print(json.dumps(probe(int(sys.argv[1]))))
 
 
 def probe(repeats: int) -> dict:
-    """In this process: mean (what a sweep of many launches pays), median and
+    """Time a ``kv_normal_batch`` launch with 1 and with 2 threads.
+
+    In this process: mean (what a sweep of many launches pays), median and
     90th percentile wall time (s) of a ``ROWS``-row ``kv_normal_batch`` launch
-    with 1 and with 2 threads, and the layer numba took."""
+    with 1 and with 2 threads, and the layer numba took.
+    """
     import numba
 
     from vimpact.kernels import layout

@@ -120,8 +120,11 @@ def _number(x):
 
 
 def to_json(result) -> dict:
-    """The fits of an export as plain data: per contact the constants (SI), the residuals
-    (code minus vimpact, dimensionless) and the notes; the files written."""
+    """Return the fits of an export as plain data.
+
+    Per contact the constants (SI), the residuals (code minus vimpact, dimensionless) and
+    the notes; the files written.
+    """
     def res(r):
         return None if r is None else {"max_abs": r.max_abs, "rms": r.rms}
 

@@ -95,7 +95,7 @@ def _shift(a):
 
 
 def run_fit(a: argparse.Namespace) -> int:
-    """Handler of ``vimpact material fit``; returns the exit code."""
+    """Run ``vimpact material fit`` and return the exit code."""
     from vimpact.model.fit import DEFAULT_PER_DECADE, load_measurements
     from vimpact.model.material import Material, shear_modulus
     from vimpact.model.material_file import material_toml
@@ -156,7 +156,7 @@ def _named(data: str, fit, *args, **kwargs):
 
 
 def run_show(a: argparse.Namespace) -> int:
-    """Handler of ``vimpact material show``; returns the exit code."""
+    """Run ``vimpact material show`` and return the exit code."""
     from vimpact.model.material_file import load_material
 
     mat = load_material(a.file)

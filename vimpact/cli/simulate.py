@@ -107,8 +107,11 @@ def add_parser(sub) -> argparse.ArgumentParser:
 
 
 def _count(text: str) -> int:
-    """An integer option; an integral float such as ``1e3`` is read as that integer (its
-    range is checked by :class:`Numerics`, with a message that names the option)."""
+    """Read an integer option.
+
+    Return an integer option; an integral float such as ``1e3`` is read as that integer (its
+    range is checked by :class:`Numerics`, with a message that names the option).
+    """
     try:
         return int(text)
     except ValueError:
@@ -136,12 +139,12 @@ _SCALE_OPTIONS = ("E", "G", "G1", "G2", "eta", "prony", "R", "m", "Theta", "vz0"
 
 
 def _as_flags(exc: ValueError) -> InputError:
-    """The error of a Scene/Material/Numerics parameter, named by its command-line flag."""
+    """Return the error of a Scene/Material/Numerics parameter, named by its command-line flag."""
     return InputError(str(as_flags(exc, _FLAGS)))
 
 
 def scene_from_args(a) -> Scene:
-    """The scene described by parsed ``simulate`` options (errors name the flags)."""
+    """Return the scene described by parsed ``simulate`` options (errors name the flags)."""
     try:
         return _scene_from_args(a)
     except ScaleError as exc:  # no one input is at fault: name the options that set the scales
@@ -197,8 +200,10 @@ def _scene_from_args(a) -> Scene:
 
 
 def _material_file(a):
-    """The material of ``--material FILE`` (at ``--temperature``); material options
-    beside it are refused."""
+    """Return the material of ``--material FILE`` (at ``--temperature``).
+
+    Material options beside it are refused.
+    """
     from vimpact.model.material_file import load_material  # TOML reading: only when asked
 
     given = [f"--{n}" for n in ("model", "E", "G", "eta", "G1", "G2", "prony", "nu")
@@ -243,7 +248,7 @@ def _scene_file(a) -> tuple[Scene, Numerics | None]:
 
 
 def _numerics(a, base: Numerics | None = None) -> Numerics:
-    """The numerics of the options: a preset, a tolerance or the file's, then overrides."""
+    """Return the numerics of the options: a preset, a tolerance or the file's, then overrides."""
     if a.tolerance is not None and a.numerics is not None:
         raise ValueError(f"--tolerance = {a.tolerance:g} cannot be combined with "
                          f"--numerics = {a.numerics}: give one of them")
@@ -269,8 +274,10 @@ def numerics_from_args(a, base: Numerics | None = None) -> Numerics:
 
 
 def _check_output(flag: str, path: str, suffixes: tuple[str, ...]) -> Path:
-    """Refuse an output path before any work: wrong extension, a directory, a
-    missing or unwritable folder."""
+    """Refuse an output path before any work.
+
+    Wrong extension, a directory, a missing or unwritable folder.
+    """
     from vimpact.sweep.store import refuse_symlink  # the one rule for files vimpact writes
 
     out = Path(path)
@@ -289,7 +296,7 @@ def _check_output(flag: str, path: str, suffixes: tuple[str, ...]) -> Path:
 
 
 def run(a) -> int:
-    """Handler of ``vimpact simulate``; returns the exit code."""
+    """Run ``vimpact simulate`` and return the exit code."""
     if a.trajectory:
         _check_output("--trajectory", a.trajectory, (".csv", ".parquet"))
     if a.scene is not None:

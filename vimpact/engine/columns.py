@@ -81,9 +81,12 @@ MODEL_ELASTIC, MODEL_KELVIN_VOIGT, MODEL_STANDARD_SOLID, MODEL_PRONY = range(4)
 
 
 class _once:  # noqa: N801 - used as a decorator, like property
-    """A derived column computed on first access and then kept in the instance
+    """Decorate a derived column: computed on first access, then kept.
+
+    A derived column computed on first access and then kept in the instance
     (``functools.cached_property`` without its lock, which costs more than the
-    one-row arithmetic it saves)."""
+    one-row arithmetic it saves).
+    """
 
     def __init__(self, fn):
         self.fn, self.__doc__ = fn, fn.__doc__
@@ -151,8 +154,11 @@ class SceneColumns:
     # (:data:`_DERIVED`; :meth:`check_scales` forgets them when it rewrites rows) ----
     @_once
     def valid(self) -> np.ndarray:
-        """Rows without a reason to refuse them (valid scenes), bool (kept until
-        :meth:`check_scales` gives a row a reason)."""
+        """Rows without a reason to refuse them, bool.
+
+        Rows without a reason to refuse them (valid scenes), bool (kept until
+        :meth:`check_scales` gives a row a reason).
+        """
         return is_none(self.reasons)
 
     @_once
@@ -206,7 +212,7 @@ class SceneColumns:
         return np.where(self.model == MODEL_STANDARD_SOLID, q2, np.nan)
 
     def take(self, index) -> SceneColumns:
-        """The rows ``index`` (an integer array or a mask) as a new batch."""
+        """Return the rows ``index`` (an integer array or a mask) as a new batch."""
         fields = {k: getattr(self, k)[index] for k in _FIELDS}
         return SceneColumns(**fields)
 
@@ -321,8 +327,10 @@ class SceneColumns:
         return out
 
     def check_scales(self) -> None:
-        """Mark rows whose Hertz scales (or kernel-unit inputs) are not finite numbers:
-        inputs whose arithmetic leaves the float range (e.g. ``v_z0 = 1e200``)."""
+        """Mark rows whose Hertz scales (or kernel-unit inputs) are not finite numbers.
+
+        Inputs whose arithmetic leaves the float range (e.g. ``v_z0 = 1e200``).
+        """
         with np.errstate(all="ignore"):
             tau0 = self.dashpot_time / self.T
             ok = (np.isfinite(self.d) & (self.d > 0) & np.isfinite(self.T) & (self.T > 0)
@@ -378,7 +386,7 @@ _NEUTRAL_ROW = tuple(_NEUTRAL[name] for name in _SCENE_NUMBERS)
 
 
 def _as_array(values) -> np.ndarray:
-    """A column as an array without NumPy's coercion of mixed lists to strings."""
+    """Return a column as an array without NumPy's coercion of mixed lists to strings."""
     if isinstance(values, np.ndarray) or hasattr(values, "dtype"):
         return np.asarray(values)
     if np.ndim(values) == 0 or isinstance(values, (str, bytes)):

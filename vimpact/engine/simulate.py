@@ -53,8 +53,10 @@ def _numerics(numerics) -> Numerics:
 def run_columns(cols: SceneColumns, numerics: Numerics, n_rec: int = 0, rec_every: int = 1,
                 timings: dict | None = None
                 ) -> tuple[dict[str, np.ndarray], np.ndarray, np.ndarray]:
-    """Route, pack, run and unpack a batch: the result columns, the trajectory
-    buffer ``(n, n_rec, N_REC)`` (kernel units) and the rows written in it.
+    """Route, pack, run and unpack a batch.
+
+    The result columns, the trajectory buffer ``(n, n_rec, N_REC)`` (kernel units) and the
+    rows written in it.
 
     Rows the full-stick continuum kernel hands back (its assumptions broke, or
     its step limit) run again on the element kernel their effects call for.
@@ -67,9 +69,12 @@ def run_columns(cols: SceneColumns, numerics: Numerics, n_rec: int = 0, rec_ever
 
 def _run(cols: SceneColumns, numerics: Numerics, n_rec: int, rec_every: int,
          timings: dict | None) -> tuple[np.ndarray, ...]:
-    """Route, pack and run: the kernel rows ``out``, the trajectory buffer, and per
+    """Route, pack and run a batch; return the kernel rows and what unpack takes.
+
+    Route, pack and run: the kernel rows ``out``, the trajectory buffer, and per
     row the path name, explicit Euler, steps per ``T`` and refusal that
-    :func:`~vimpact.engine.unpack.unpack` takes (:func:`run_columns`)."""
+    :func:`~vimpact.engine.unpack.unpack` takes (:func:`run_columns`).
+    """
     import numba
 
     n = len(cols)
@@ -144,8 +149,11 @@ def _run(cols: SceneColumns, numerics: Numerics, n_rec: int, rec_every: int,
 
 
 def _rows(cols: SceneColumns, idx: np.ndarray) -> SceneColumns:
-    """``cols.take(idx)``, or ``cols`` itself if ``idx`` is all its rows in order
-    (one path for the whole batch, as for a single impact: no copy)."""
+    """Return the rows ``idx`` of ``cols``, without a copy when they are all of it.
+
+    ``cols.take(idx)``, or ``cols`` itself if ``idx`` is all its rows in order
+    (one path for the whole batch, as for a single impact: no copy).
+    """
     if len(idx) == len(cols) and (len(idx) <= 1 or (idx[0] == 0 and idx[-1] == len(idx) - 1
                                                     and bool(np.all(np.diff(idx) == 1)))):
         return cols

@@ -265,12 +265,14 @@ def unpack_row(cols: SceneColumns, out: np.ndarray, path_name: str, explicit_eul
 
 
 def clip_round_off(values: dict[str, np.ndarray], ok: np.ndarray, passive: np.ndarray) -> None:
-    """The physical bounds of a passive impact, kept exactly: in a finished row (``ok``
-    and its finished variants, not ``energy_gain``, ``not_passive``; mask ``ok``) of a
-    passive scene (incremental memory, not explicit Euler) ``e_z``, ``e_x``,
-    ``|beta_x|`` and ``energy_ratio`` are at most 1. Rounding can put them above by
-    up to :data:`PASSIVITY_SLACK` (a larger excess is status ``unstable``); such a
-    value is set to the bound (``beta_x`` keeps its sign)."""
+    """Keep the physical bounds of a passive impact exactly.
+
+    In a finished row (``ok`` and its finished variants, not ``energy_gain``,
+    ``not_passive``; mask ``ok``) of a passive scene (incremental memory, not explicit
+    Euler) ``e_z``, ``e_x``, ``|beta_x|`` and ``energy_ratio`` are at most 1. Rounding can
+    put them above by up to :data:`PASSIVITY_SLACK` (a larger excess is status
+    ``unstable``); such a value is set to the bound (``beta_x`` keeps its sign).
+    """
     rows = ok & passive
     with np.errstate(invalid="ignore"):
         for name in ("e_z", "e_x", "energy_ratio"):
@@ -280,9 +282,11 @@ def clip_round_off(values: dict[str, np.ndarray], ok: np.ndarray, passive: np.nd
 
 
 def guard(values: dict[str, np.ndarray], status: np.ndarray, tangential: np.ndarray) -> None:
-    """NaN only with a status that says why: outputs of a row whose status is not
-    finished become NaN; a finished row with an unexplained NaN or inf becomes
-    ``non_finite`` (all outputs NaN)."""
+    """NaN only with a status that says why.
+
+    Outputs of a row whose status is not finished become NaN; a finished row with an
+    unexplained NaN or inf becomes ``non_finite`` (all outputs NaN).
+    """
     finished = member(status, FINISHED)
     bad = np.zeros(status.shape[0], dtype=bool)
     for name, v in values.items():
@@ -297,9 +301,12 @@ def guard(values: dict[str, np.ndarray], status: np.ndarray, tangential: np.ndar
 
 
 def member(values: np.ndarray, names: tuple[str, ...]) -> np.ndarray:
-    """Elementwise ``value in names`` for an object array of strings (``np.isin``
+    """Return elementwise ``value in names`` for an object array of strings.
+
+    Elementwise ``value in names`` for an object array of strings (``np.isin``
     sorts, which costs some 100 us on a one-row batch; a plain pass over a short
-    array costs about 1 us)."""
+    array costs about 1 us).
+    """
     if values.shape[0] <= _SHORT:
         return np.fromiter((x in names for x in values), dtype=bool, count=values.shape[0])
     return np.isin(values, names)
@@ -311,8 +318,10 @@ _SHORT = 256
 
 def _explain(status: np.ndarray, error: np.ndarray, contact_steps: np.ndarray,
              relative_gain: np.ndarray) -> None:
-    """A reason for every row whose status is not finished and has none yet: no row
-    ends without numbers and without saying why."""
+    """Give a reason to every row whose status is not finished and has none yet.
+
+    No row ends without numbers and without saying why.
+    """
     explain = ~member(status, FINISHED) | (status == "not_passive")
     for i in np.flatnonzero(explain & is_none(error)):
         error[i] = _reason(status[i], contact_steps[i], relative_gain[i])

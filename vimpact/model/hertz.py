@@ -47,7 +47,9 @@ class HertzScales(NamedTuple):
 
 
 def hertz_scales(G, nu, R, m, v_z0) -> HertzScales:
-    """Hertz scales for shear modulus ``G`` (Pa), Poisson ratio ``nu`` (-),
+    """Return the Hertz scales of an elastic impact (works on arrays).
+
+    Hertz scales for shear modulus ``G`` (Pa), Poisson ratio ``nu`` (-),
     sphere radius ``R`` (m), mass ``m`` (kg) and impact speed ``v_z0`` (m/s).
 
     Works elementwise on arrays. For a viscoelastic material pass the relaxed

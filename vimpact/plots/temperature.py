@@ -33,8 +33,11 @@ FIGURE_NUMERICS = Numerics.preset("fast")
 
 def restitution_curves(material: Material, temperatures=TEMPERATURES_K, speeds=SPEEDS_M_S,
                        numerics: Numerics = FIGURE_NUMERICS) -> dict[float, np.ndarray]:
-    """``e_z`` at each normal speed (m/s) for each temperature (K) of ``material``
-    (shifted by its shift law), sphere :data:`SPHERE`; temperature -> array."""
+    """Return ``e_z`` over the normal speed at each temperature.
+
+    ``e_z`` at each normal speed (m/s) for each temperature (K) of ``material``
+    (shifted by its shift law), sphere :data:`SPHERE`; temperature -> array.
+    """
     R, m = SPHERE
     out = {}
     for T in temperatures:
@@ -50,9 +53,12 @@ def restitution_curves(material: Material, temperatures=TEMPERATURES_K, speeds=S
 
 
 def fig_temperature(out, material: Material | str | Path | None = None) -> Path:
-    """``e_z`` over the impact speed at :data:`TEMPERATURES_K` for ``material`` (a
+    """Draw ``e_z`` over the impact speed at several temperatures.
+
+    ``e_z`` over the impact speed at :data:`TEMPERATURES_K` for ``material`` (a
     :class:`Material` with a shift law or a material file; default
-    :data:`EXAMPLE_MATERIAL`, read relative to the current directory)."""
+    :data:`EXAMPLE_MATERIAL`, read relative to the current directory).
+    """
     from vimpact.model.material_file import load_material
 
     if material is None:

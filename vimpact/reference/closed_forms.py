@@ -275,8 +275,10 @@ def kelvin_voigt_small_damping_slope() -> float:
 
 
 class _Event:
-    """A terminal event of :func:`scipy.integrate.solve_ivp`: ``fn(t, y)`` crossing zero
-    in ``direction`` (-1: from above) stops the integration."""
+    """A terminal event of :func:`scipy.integrate.solve_ivp`.
+
+    ``fn(t, y)`` crossing zero in ``direction`` (-1: from above) stops the integration.
+    """
 
     terminal = True
 
@@ -332,7 +334,7 @@ def _kv_single(tau_hat: float, rtol: float) -> tuple[float, float, float]:
 
 
 def kelvin_voigt_continuum(q1, rtol: float = 1e-12) -> KelvinVoigtResult:
-    """Normal impact of a rigid sphere on a Kelvin-Voigt half-space, continuum limit.
+    """Solve the normal impact of a rigid sphere on a Kelvin-Voigt half-space, continuum limit.
 
     Kernel units (docs/physics.md#hertz-scales, docs/physics.md#kelvin-voigt-continuum,
     docs/physics.md#dimensionless-parameters): indentation ``u`` in units of

@@ -1,5 +1,7 @@
-"""What accuracy costs in time: error versus wall time per impact for every
-integrator, its Pareto front, the presets, and an error model to pick numerics.
+"""What accuracy costs in time.
+
+Error versus wall time per impact for every integrator, its Pareto front, the presets, and
+an error model to pick numerics.
 
 Run: ``vimpact bench accuracy [--quick] [--out DIR]`` (writes ``DIR/accuracy.json``
 and ``accuracy.png``); the full-size run of the repository is

@@ -1,5 +1,7 @@
-"""The accuracy benchmark's configurations: tolerances, integrators, scenes and the
-(steps, elements) ladders of each integrator."""
+"""The accuracy benchmark's configurations.
+
+Tolerances, integrators, scenes and the (steps, elements) ladders of each integrator.
+"""
 
 from __future__ import annotations
 
@@ -67,7 +69,7 @@ CONFIGS: dict[str, dict[str, Any]] = {
 
 
 def _ladder(cfg, name) -> list[tuple[int, int, str]]:
-    """(steps, elements, "base" or "refined") of one integrator, by steps."""
+    """Return (steps, elements, "base" or "refined") of one integrator, by steps."""
     lad = cfg["ladders"][name]
     base = {(s, e) for s in lad["steps"] for e in lad["elements"] if s * e <= lad["cap"]}
     out = {k: "base" for k in base}

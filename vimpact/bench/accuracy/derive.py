@@ -24,10 +24,13 @@ from .models import (
 
 
 def derive(out: dict, floors: dict, cfg: dict, scenes: list, ref: dict, timer: Timer) -> dict:
-    """The derived numbers of a run (``out["derived"]``): error and time models per
-    integrator, the cheapest setting per tolerance, the explicit-Euler / Verlet time
-    ratio, observed orders, the models' picks run and measured, suggested presets.
-    Adds ``model_seconds_per_impact`` to every setting and preset of ``out``."""
+    """Return the derived numbers of a run (``out["derived"]``).
+
+    Error and time models per integrator, the cheapest setting per tolerance, the
+    explicit-Euler / Verlet time ratio, observed orders, the models' picks run and
+    measured, suggested presets. Adds ``model_seconds_per_impact`` to every setting and
+    preset of ``out``.
+    """
     derived: dict[str, Any] = {}
     models: dict[str, dict[str, Any]] = {}
     for n in INTEGRATORS:

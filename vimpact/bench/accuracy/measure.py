@@ -1,5 +1,8 @@
-"""Measurements of the accuracy benchmark: the continuum reference, each setting's
-errors and time per impact (:class:`Timer`), the continuum path and table 4.1."""
+"""Measurements of the accuracy benchmark.
+
+The continuum reference, each setting's errors and time per impact (:class:`Timer`), the
+continuum path and table 4.1.
+"""
 
 from __future__ import annotations
 
@@ -95,7 +98,8 @@ def raw_restitution(scenes, numerics) -> tuple[np.ndarray, np.ndarray, np.ndarra
     energy at every practical step on weakly damped scenes, and its
     accuracy is what this benchmark measures, so for those rows the kernel's
     own numbers are read here (internal :func:`vimpact.engine.pack.run_path`
-    on the routed rows; the rows are counted as ``unstable_rows``)."""
+    on the routed rows; the rows are counted as ``unstable_rows``).
+    """
     from vimpact.engine.columns import SceneColumns
     from vimpact.engine.pack import run_path
     from vimpact.engine.routing import route
@@ -200,9 +204,11 @@ def continuum_restitution(scenes, rtol: float) -> tuple[np.ndarray, np.ndarray]:
 
 
 def reference(specs, scenes) -> dict:
-    """``e_z`` and ``e_x`` of every scene from the continuum kernel at
-    :data:`REFERENCE_RTOL`; uncertainty per scene ``|ref(1e-12) - ref(1e-10)|``;
-    on the Kelvin-Voigt scenes ``e_z`` is checked against the closed form."""
+    """``e_z`` and ``e_x`` of every scene from the continuum kernel at :data:`REFERENCE_RTOL`.
+
+    Uncertainty per scene ``|ref(1e-12) - ref(1e-10)|``; on the Kelvin-Voigt scenes
+    ``e_z`` is checked against the closed form.
+    """
     t0 = time.perf_counter()
     ez, ex = continuum_restitution(scenes, REFERENCE_RTOL)
     t1 = time.perf_counter()
@@ -244,8 +250,11 @@ def reference(specs, scenes) -> dict:
 
 
 def _errors(ez, ex, finished, ref) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """``|e_z - ref|``, ``|e_x - ref|`` per scene, ``inf`` where a row did not
-    finish (``finished`` false) or gave no finite value; and the rows that count."""
+    """Return the errors of ``e_z`` and ``e_x`` per scene and the rows that count.
+
+    ``|e_z - ref|``, ``|e_x - ref|`` per scene, ``inf`` where a row did not
+    finish (``finished`` false) or gave no finite value; and the rows that count.
+    """
     ok = finished & np.isfinite(ez) & np.isfinite(ex)
     dz = np.where(ok, np.abs(ez - ref["e_z"]), np.inf)
     dx = np.where(ok, np.abs(ex - ref["e_x"]), np.inf)
@@ -285,9 +294,12 @@ def evaluate(scenes, numerics, ref, timer: Timer) -> dict:
 
 
 def for_tolerance_scan(scenes, ref, tol_max: float, tol_min: float, n: int) -> dict:
-    """``Numerics.for_tolerance(tol)`` on the element path at ``n`` tolerances
+    """Measure ``Numerics.for_tolerance`` on the element path at ``n`` tolerances.
+
+    ``Numerics.for_tolerance(tol)`` on the element path at ``n`` tolerances
     log-spaced over ``[tol_min, tol_max]`` (untimed): the largest error over the
-    scenes per tolerance and the worst ``error / tol`` (above 1: missed)."""
+    scenes per tolerance and the worst ``error / tol`` (above 1: missed).
+    """
     rows = []
     for tol in np.geomspace(tol_max, tol_min, n):
         num = v.Numerics.for_tolerance(float(tol)).with_(continuum=False)
@@ -309,7 +321,7 @@ def for_tolerance_scan(scenes, ref, tol_max: float, tol_min: float, n: int) -> d
 
 
 def continuum_ladder(specs, cfg, timer: Timer) -> list[dict]:
-    """The continuum path on the Kelvin-Voigt scenes made normal-only."""
+    """Return the continuum path on the Kelvin-Voigt scenes made normal-only."""
     kv = [s for s in specs if s["model"] == "kelvin_voigt"]
     if not kv:
         return []
@@ -331,8 +343,11 @@ def continuum_ladder(specs, cfg, timer: Timer) -> list[dict]:
 
 
 def table_4_1(steps_list) -> dict:
-    """Elastic normal-only impact on the element path (continuum off), elements
-    500 per a_H (thesis): |e_z - 1| in percent per integrator; thesis 4.1."""
+    """Return the thesis's table 4.1 for every integrator.
+
+    Elastic normal-only impact on the element path (continuum off), elements
+    500 per a_H (thesis): |e_z - 1| in percent per integrator; thesis 4.1.
+    """
     elastic = v.Scene(v.Material.elastic(nu=0.5, E=5e10), R=0.2, m=10.0, v_z0=10.0)
     out = {"scene": "elastic, nu = 0.5 (Q1 = 0), normal only, Numerics(continuum=False, "
                     "elements=500)",

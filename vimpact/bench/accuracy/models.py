@@ -1,6 +1,8 @@
-"""Error and time models of the accuracy benchmark: Pareto fronts, fitted error laws
-``err = a / steps^p + b / elements^q``, their envelope, the time model, observed
-orders and the cheapest setting per tolerance."""
+"""Error and time models of the accuracy benchmark.
+
+Pareto fronts, fitted error laws ``err = a / steps^p + b / elements^q``, their envelope,
+the time model, observed orders and the cheapest setting per tolerance.
+"""
 
 from __future__ import annotations
 
@@ -24,9 +26,12 @@ def _num(x) -> float:
 
 
 def _orders(rows, floors) -> dict:
-    """Observed orders on the base grid along the diagonal (steps = 5
+    """Return the observed orders on the base grid.
+
+    Observed orders on the base grid along the diagonal (steps = 5
     elements), in steps at the largest elements present for every steps
-    value, in elements at the largest steps present for every elements value."""
+    value, in elements at the largest steps present for every elements value.
+    """
     rows = [r for r in rows if r["grid"] == "base"]
     steps = sorted({r["steps"] for r in rows})
     elements = sorted({r["elements"] for r in rows})
@@ -54,7 +59,7 @@ def _orders(rows, floors) -> dict:
 
 
 def _cheapest(rows, tol, key, by="seconds_per_impact") -> dict | str:
-    """The setting with ``row[key] <= tol`` and the least ``row[by]``."""
+    """Return the setting with ``row[key] <= tol`` and the least ``row[by]``."""
     ok = [r for r in rows if r[key] is not None and r[key] <= tol]
     if not ok:
         return "not reached"
@@ -66,8 +71,11 @@ def _cheapest(rows, tol, key, by="seconds_per_impact") -> dict | str:
 
 
 def pareto(times, errors) -> list[int]:
-    """Indices of the non-dominated points (faster and more accurate than all
-    others in one respect), sorted by time; non-finite errors never qualify."""
+    """Return the Pareto front of (time, error) points.
+
+    Indices of the non-dominated points (faster and more accurate than all
+    others in one respect), sorted by time; non-finite errors never qualify.
+    """
     order = sorted((i for i in range(len(times)) if math.isfinite(errors[i])),
                    key=lambda i: (times[i], errors[i]))
     front, best = [], math.inf
@@ -79,8 +87,11 @@ def pareto(times, errors) -> list[int]:
 
 
 def _slope(x, err, floor) -> dict:
-    """Observed order: minus the least-squares slope of log err over log x,
-    on the points with err above 5x the reference's uncertainty ``floor``."""
+    """Return an observed order: minus the slope of log err over log x.
+
+    Observed order: minus the least-squares slope of log err over log x,
+    on the points with err above 5x the reference's uncertainty ``floor``.
+    """
     x, err = np.asarray(x, float), np.asarray(err, float)
     use = np.isfinite(err) & (err > 5.0 * floor)
     local = [_f(-math.log(err[i + 1] / err[i]) / math.log(x[i + 1] / x[i]))
@@ -93,8 +104,11 @@ def _slope(x, err, floor) -> dict:
 
 
 def fit_error_model(steps, elements, err, floor, p0: float) -> dict:
-    """Least squares in logs of ``err = a / steps^p + b / elements^q`` on the
-    points with err above 3x the reference's uncertainty ``floor``."""
+    """Fit the error model ``err = a / steps^p + b / elements^q``.
+
+    Least squares in logs of ``err = a / steps^p + b / elements^q`` on the
+    points with err above 3x the reference's uncertainty ``floor``.
+    """
     from scipy.optimize import least_squares
 
     S, E, y = (np.asarray(a, float) for a in (steps, elements, err))
@@ -135,9 +149,11 @@ def fit_error_model(steps, elements, err, floor, p0: float) -> dict:
 
 
 def fit_envelope(steps, elements, err, floor, p: float, q: float) -> dict:
-    """``err <= a / steps^p + b / elements^q`` at fixed exponents: least squares
-    in logs for ``a``, ``b``, then both scaled up until the model bounds every
-    point above 3x ``floor`` (the form ``Numerics.for_tolerance`` uses)."""
+    """``err <= a / steps^p + b / elements^q`` at fixed exponents.
+
+    Least squares in logs for ``a``, ``b``, then both scaled up until the model bounds
+    every point above 3x ``floor`` (the form ``Numerics.for_tolerance`` uses).
+    """
     from scipy.optimize import least_squares
 
     S, E, y = (np.asarray(a, float) for a in (steps, elements, err))

@@ -12,8 +12,11 @@ COLOURS = {"verlet": "tab:blue", "symplectic_euler": "tab:green", "euler": "tab:
 
 
 def plot(data: dict, path: Path) -> None:
-    """The Pareto fronts (left), convergence and table 4.1 (top right) and the
-    continuum path (bottom right) to ``path``."""
+    """Draw the accuracy benchmark's chart to ``path``.
+
+    The Pareto fronts (left), convergence and table 4.1 (top right) and the
+    continuum path (bottom right) to ``path``.
+    """
     use_agg()
     import matplotlib.pyplot as plt
 

@@ -90,7 +90,7 @@ def _summary(data: dict) -> str:
 
 
 def report(data: dict) -> str:
-    """The long text summary (fronts, cheapest settings, models, presets)."""
+    """Return the long text summary (fronts, cheapest settings, models, presets)."""
     return _summary(data)
 
 
@@ -99,10 +99,13 @@ def _spread_of(row: dict) -> list[float] | None:
 
 
 def figures(data: dict) -> dict:
-    """Headline numbers: per preset (element path and as routed) and
+    """Return the headline numbers of an accuracy run.
+
+    Headline numbers: per preset (element path and as routed) and
     ``for_tolerance`` target (element path) the time per impact and the error;
     per continuum ``rtol`` the time and the ``e_z`` error; the explicit-Euler
-    error of the thesis's table 4.1."""
+    error of the thesis's table 4.1.
+    """
     out = {}
     for pname, p in data.get("presets", {}).items():
         out[f"preset_{pname}_seconds_per_impact"] = figure(
