@@ -166,24 +166,27 @@ def simulate_batch(scenes, numerics: Numerics | str | None = None, *,
 
     Parameters
     ----------
-    scenes : a sequence of :class:`vimpact.Scene`, or scene columns: a
-        ``DataFrame`` or a mapping of equal-length arrays (names and units in
-        :mod:`vimpact.engine.columns`: ``nu``, ``G_inf_Pa``, ``R_m``, ``m_kg``,
-        ``v_z0_m_s`` required; ``eta0_Pa_s``, ``G_arm<i>_Pa``, ``tau_arm<i>_s``,
-        ``v_x0_m_s``, ``omega0_rad_s``, ``Theta_kg_m2`` or ``theta_ratio``,
-        ``tangential``, ``tangential_memory``, ``rotation``, ``mu``, ``model``
-        optional)
-    numerics : discretization (default ``Numerics()``) or a preset name
-    timings : if given, a dict that receives ``kernel_s`` (seconds in the
-        kernels) and ``total_s`` (the whole call)
+    scenes : sequence of Scene, pandas.DataFrame or mapping of array_like
+        The impacts: :class:`vimpact.Scene` objects, or scene columns of equal
+        length (names and units in :mod:`vimpact.engine.columns`: ``nu``,
+        ``G_inf_Pa``, ``R_m``, ``m_kg``, ``v_z0_m_s`` required; ``eta0_Pa_s``,
+        ``G_arm<i>_Pa``, ``tau_arm<i>_s``, ``v_x0_m_s``, ``omega0_rad_s``,
+        ``Theta_kg_m2`` or ``theta_ratio``, ``tangential``, ``tangential_memory``,
+        ``rotation``, ``mu``, ``model`` optional).
+    numerics : Numerics or str, optional
+        Discretization (default ``Numerics()``) or a preset name.
+    timings : dict, optional
+        If given, receives ``kernel_s`` (s in the kernels) and ``total_s`` (s, the
+        whole call).
 
     Returns
     -------
-    One row per scene, in order, with the columns of :class:`vimpact.ImpactResult`
-    (units in :data:`vimpact.UNITS`) and ``error``. A row that fails (bad input:
-    status ``invalid`` with the reason in ``error``; half-space exceeded, time
-    limit, ...) gets its status and NaN outputs; the others are unaffected.
-    Nothing is raised for a bad row.
+    pandas.DataFrame
+        One row per scene, in order, with the columns of :class:`vimpact.ImpactResult`
+        (units in :data:`vimpact.UNITS`) and ``error``. A row that fails (bad input:
+        status ``invalid`` with the reason in ``error``; half-space exceeded, time
+        limit, ...) gets its status and NaN outputs; the others are unaffected.
+        Nothing is raised for a bad row.
     """
     t0 = time.perf_counter()
     numerics = _numerics(numerics)
@@ -204,13 +207,21 @@ def simulate(scene: Scene, numerics: Numerics | str | None = None, *,
 
     Parameters
     ----------
-    scene : the impact
-    numerics : discretization (default ``Numerics()``: about 1e-4 on e_z, e_x)
-        or a preset name (``"fast"``, ``"default"``, ``"precise"``, ``"thesis"``)
-    trajectory : also record the time series (``ImpactResult.trajectory``, a
-        DataFrame with columns ``t_s, u_z_m, v_z_m_s, v_x_m_s, omega_rad_s,
-        F_z_N, F_x_N, a_m, slip_width_m``; about 500 rows per Hertz time on the element
-        path, one row per accepted step on the continuum path)
+    scene : Scene
+        The impact.
+    numerics : Numerics or str, optional
+        Discretization (default ``Numerics()``: about 1e-4 on e_z, e_x) or a preset
+        name (``"fast"``, ``"default"``, ``"precise"``, ``"thesis"``).
+    trajectory : bool, optional
+        Also record the time series (``ImpactResult.trajectory``, a DataFrame with
+        columns ``t_s, u_z_m, v_z_m_s, v_x_m_s, omega_rad_s, F_z_N, F_x_N, a_m,
+        slip_width_m``, SI units; about 500 rows per Hertz time on the element path,
+        one row per accepted step on the continuum path).
+
+    Returns
+    -------
+    ImpactResult
+        The outcome, SI units (:data:`vimpact.UNITS`).
 
     Raises
     ------
