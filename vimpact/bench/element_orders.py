@@ -103,6 +103,7 @@ def old_kernel():
 
 
 def orders(err):
+    """Return the observed orders between successive halvings of a ladder."""
     err = np.asarray(err, dtype=float)
     return (np.log(err[:-1] / err[1:]) / np.log(2.0)).tolist()
 
@@ -222,6 +223,7 @@ def tolerance_check(tolerances) -> dict:
 
 
 def run(quick: bool) -> dict:
+    """Measure every case; return the JSON-ready record."""
     steps = np.array([150, 300, 600] if quick else [150, 300, 600, 1200, 2400])
     fine_steps = 2400 if quick else 9600
     elems = np.array([25, 50, 100] if quick else [25, 50, 100, 200, 400])
@@ -362,6 +364,7 @@ def error_model_points(quick: bool) -> dict:
 
 
 def plot(data: dict, path) -> None:
+    """Draw the errors and orders of each case to ``path``."""
     import matplotlib
 
     matplotlib.use("Agg")

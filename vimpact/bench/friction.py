@@ -49,6 +49,7 @@ MATERIALS = {"elastic": (0.0, (), ()), "standard_solid_Q2_0.5": (0.0, (2.0,), (0
 
 
 def run(quick: bool) -> dict:
+    """Measure the cost and the beta_x ladder of each case; return the JSON-ready record."""
     steps, elements = (300, 50) if quick else (1400, 200)
     rows = 4 if quick else 8
     repeats = 5 if quick else 9
@@ -109,6 +110,7 @@ def run(quick: bool) -> dict:
 
 
 def plot(data: dict, path) -> None:
+    """Draw the time ratios and the beta_x ladder to ``path``."""
     import matplotlib
 
     matplotlib.use("Agg")

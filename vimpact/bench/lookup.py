@@ -69,6 +69,7 @@ def grid_axes(spec_path: Path) -> tuple[str, dict, float | None, str]:
 
 
 def measure_grid(name: str, spec_path: Path, n_random: int) -> tuple[dict, object]:
+    """Build the table of grid ``name`` and measure its interpolation error."""
     from vimpact.lookup.refine import grid_table
     from vimpact.lookup.verify import interpolation_error
     from vimpact.model.numerics import Numerics
@@ -175,6 +176,7 @@ def time_lookups(table, repeats: int, n_points: int = N_LOOKUPS) -> dict:
 
 
 def run(quick: bool) -> dict:
+    """Time the lookups of the shipped tables (and measure a grid); return the record."""
     import numba
 
     numba.set_num_threads(1)  # one core
@@ -239,6 +241,7 @@ def report(data: dict) -> str:
 
 
 def plot(data: dict, path: Path) -> None:
+    """Draw the lookup times (and grid errors) to ``path``."""
     use_agg()
     import matplotlib.pyplot as plt
 

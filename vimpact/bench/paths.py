@@ -143,6 +143,7 @@ def _specialization(quick: bool) -> dict:
 
 
 def run(quick: bool = False) -> dict:
+    """Measure the continuum and element paths and the specialization; return the record."""
     threads = numba.get_num_threads()
     numba.set_num_threads(1)  # per-core cost; the machine is shared
     try:

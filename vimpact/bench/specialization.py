@@ -192,6 +192,7 @@ def run(quick: bool = False) -> dict:
 
 
 def figures(data: dict) -> dict:
+    """Return the headline numbers of a specialization run."""
     out = {}
     for name, c in data["cases"].items():
         key = name.replace(" ", "_")
@@ -202,6 +203,7 @@ def figures(data: dict) -> dict:
 
 
 def report(data: dict) -> str:
+    """Return the specialized over run-time-flag times as a text table."""
     lines = [f"{'case':<32}{'spec us':>10}{'runtime us':>12}{'ratio':>8}  identical"]
     for name, c in data["cases"].items():
         lines.append(f"{name:<32}{c['specialized_us_per_impact']:>10.1f}"
@@ -214,6 +216,7 @@ def report(data: dict) -> str:
 
 
 def plot(data: dict, path: Path) -> None:
+    """Draw the time per row of both kernels to ``path``."""
     use_agg()
     import matplotlib.pyplot as plt
 

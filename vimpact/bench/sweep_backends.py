@@ -53,6 +53,7 @@ nu = [0.0, 0.5]
 
 
 def machine() -> dict:
+    """Return the platform, Python, CPUs, load and date of the run."""
     return {"platform": platform.platform(), "python": platform.python_version(),
             "cpus": os.cpu_count(), "load_average_1min": os.getloadavg()[0],
             "date_utc": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime())}
@@ -65,6 +66,7 @@ def _spec(tmp: Path, name: str, rows: int, chunk: int) -> Path:
 
 
 def backends(rows: int, chunk: int) -> dict:
+    """Time one sweep in process and on a local Dask cluster, side by side."""
     import numba
     from distributed import Client
 
@@ -101,6 +103,7 @@ def backends(rows: int, chunk: int) -> dict:
 
 
 def large(rows: int, chunk: int) -> dict:
+    """Time a large in-process sweep against its kernel time."""
     from vimpact.sweep import run_sweep, summary
 
     with tempfile.TemporaryDirectory() as folder:

@@ -147,6 +147,7 @@ def figures(data: dict) -> dict:
 
 
 def report(data: dict) -> str:
+    """Return the per-configuration launch times as a text table."""
     lines = [f"{ROWS}-row kv_normal_batch launch, mean of {data['repeats']} (median in brackets)"]
     lines.append(f"{'configuration':<28}{'load':<7}{'layer':<11}{'1 thread ms':>12}"
                  f"{'2 threads ms':>13}{'2/1':>8}")

@@ -10,6 +10,7 @@ from vimpact.model.numerics import CONVERGED_PRESETS
 
 
 def add_parser(sub) -> None:
+    """Register ``vimpact dem`` and its options on the subcommand parser ``sub``."""
     from vimpact.dem import CODES  # the light list: the exports load scipy
 
     p = sub.add_parser(
@@ -44,6 +45,7 @@ def add_parser(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    """Run ``vimpact dem`` and return the exit code."""
     import json
     import sys
 

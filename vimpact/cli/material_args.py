@@ -26,6 +26,7 @@ def add_material_arguments(g, *, prony: bool) -> None:
 
 
 def missing(name: str, why: str) -> ValueError:
+    """Return the error for a missing option ``--name``, saying ``why`` it is needed."""
     return ValueError(f"--{name} is missing: {why}")
 
 

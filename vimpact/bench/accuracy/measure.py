@@ -62,6 +62,7 @@ class Timer:
         return df
 
     def more(self, row_job) -> None:
+        """Take one more timing sample of a setting."""
         row, scenes, numerics, copies = row_job
         _, t, c = self._once(scenes * copies, numerics)
         row["seconds_samples"].append(t / row["timed_batch_size"])
@@ -75,6 +76,7 @@ class Timer:
             self.more(job)
 
     def passes(self) -> None:
+        """Take the remaining samples in passes over all settings, alternating the order."""
         for k in range(self.cfg["repeats"] - 1):
             jobs = self.jobs if k % 2 else self.jobs[::-1]
             for job in jobs:

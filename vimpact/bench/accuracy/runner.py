@@ -27,6 +27,7 @@ from .models import _num, pareto
 
 
 def run(quick: bool = False) -> dict:
+    """Measure every setting, preset and path on the scenes; return the JSON-ready record."""
     cfg = CONFIGS["quick" if quick else "full"]
     numba.set_num_threads(min(THREADS, max_threads()))
     load_start = load_average()
