@@ -221,6 +221,7 @@ def unpack_row(cols: SceneColumns, out: np.ndarray, path_name: str, explicit_eul
                 or (tangential and abs(vc_end) > 1.0 + PASSIVITY_SLACK))
         contact_steps = t_contact * steps_per_T
         relative_gain = contact1 / contact0 - 1.0
+        Q1, Q2 = cols.Q1[0], cols.Q2[0]
     incremental = cols.memory[0] == TANGENTIAL_MEMORY.index("incremental")
     if ok and gain:
         status = (("energy_gain" if explicit_euler else "unstable") if incremental
@@ -252,16 +253,17 @@ def unpack_row(cols: SceneColumns, out: np.ndarray, path_name: str, explicit_eul
         error = "the integration produced a non-finite value"
     if error is None and (status not in FINISHED or status == "not_passive"):
         error = _reason(status, contact_steps, relative_gain)
-    with np.errstate(all="ignore"):
-        result = {
-            **values,
-            "t_hertz": cols.t_H[0], "d_hertz": d, "a_hertz": a_H,
-            "Q1": cols.Q1[0], "Q2": cols.Q2[0], "nu": cols.nu[0],
-            "status": status, "n_steps": int(out[layout.OUT_STEPS].astype(np.int64)),
-            "path": path_name, "error": error,
-        }
-    return {name: (v.item() if isinstance(v, np.generic) else v)
-            for name, v in ((k, result[k]) for k in RESULT_FIELDS)}
+    result = {
+        **values,
+        "t_hertz": cols.t_H[0], "d_hertz": d, "a_hertz": a_H, "Q1": Q1, "Q2": Q2,
+        "nu": cols.nu[0], "status": status,
+        "n_steps": int(out[layout.OUT_STEPS].astype(np.int64)), "path": path_name,
+        "error": error,
+    }
+    for name, v in result.items():
+        if isinstance(v, np.generic):
+            result[name] = v.item()
+    return {name: result[name] for name in RESULT_FIELDS}
 
 
 def clip_round_off(values: dict[str, np.ndarray], ok: np.ndarray, passive: np.ndarray) -> None:
