@@ -48,6 +48,14 @@ def test_overhead_through_the_command(tmp_path, monkeypatch, capsys):
                for p in data["elements"]["paths"])
     assert {"continuum_overhead_met", "element_overhead_met",
             "kv_rows_per_second_met"} <= set(data["targets"])
+    one = data["one_impact"]
+    assert len(one["scenes"]) == 3
+    for rec in one["scenes"].values():
+        # the Python outside the kernel, measured with the kernel replaced by its row
+        assert 0.0 < rec["outside_kernel_us"] and len(rec["outside_kernel_us_samples"]) == 3
+        if one["before_commit"] is not None:  # a checkout with the history at hand
+            assert rec["same_result_as_before"] is True
+            assert rec["before_outside_kernel_us"] > 0.0
 
 
 def test_overhead_columns_are_valid_kelvin_voigt_rows():

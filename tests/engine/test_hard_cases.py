@@ -29,7 +29,7 @@ scene at twice the steps and twice the elements (``test_converged``).
 No row may end with ``half_space`` (or ``row_exceeded``): every scene has
 ``a_H = 0.01 R``, and the contact of a passive material whose Hertz scale is
 set by the relaxed modulus ``G_inf`` stays within ``a_H`` (docs/physics.md
-section 3; the dashpot and the arms only stiffen the loading, so ``u_max <=
+#method-of-dimensionality-reduction; the dashpot and the arms only stiffen the loading, so ``u_max <=
 d``). That includes ``Q1 = 100``: the heavily overdamped sphere is stopped by
 the dashpot at a fraction of ``d`` (``a_max`` about 0.18 ``a_H``), it does not
 sink in. So the allowed statuses are ``ok`` and, for ``v_c0 = 0`` only,

@@ -6,7 +6,7 @@ Oracles, none of them produced by the kernel:
   nondimensionalization, its ``v_c = v_x + R omega`` reduction and the
   normalization of the tangential problem by ``v_c0`` are tested);
 - docs/physics.md#dimensionless-parameters (restitution depends only on ``Q1``, ``Q2``, ``nu``,
-  ``Theta / (m R^2)``), with ``eta`` computed here from the section 2 formulas;
+  ``Theta / (m R^2)``), with ``eta`` computed here from the docs/physics.md#hertz-scales formulas;
 - docs/physics.md#energy-and-passivity (the tangential problem is linear in ``v_c0`` and
   sees ``v_x0``, ``omega0`` only through ``v_c0``).
 
@@ -169,7 +169,7 @@ def test_batch_with_mixed_arm_counts_matches_naive():
         compare_with_naive(scene, row, naive_impact(scene, STEPS, ELEMENTS), "naive batch")
 
 
-# -------------------------------------------------- collapse (section 8)
+# ------------------------------ collapse (docs/physics.md#dimensionless-parameters)
 
 def collapse_scenes(rng, n, Q1, nu, Q2=None, theta_ratio=0.4):
     """``n`` physical scenes spanning decades with the given ``Q1`` (and ``Q2``).
@@ -237,7 +237,7 @@ def test_collapse_tolerance_resolves_q1():
     assert abs(a.e_x - b.e_x) > 1e3 * RTOL_COLLAPSE
 
 
-# -------------------------------------------------- tangential (section 7)
+# ---------------------------------- tangential (docs/physics.md#energy-and-passivity)
 
 R_TAN = 0.5  # a power of two, so v_x0 + R omega0 is exact below
 

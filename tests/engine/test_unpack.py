@@ -16,3 +16,82 @@ def test_member_is_numpy_isin(n):
     got = member(values, FINISHED)
     assert got.dtype == bool and got.shape == (n,)
     assert np.array_equal(got, np.isin(values, list(FINISHED)))
+
+
+def _scenes():
+    """Scenes that take every branch of unpack: tangential or not, rotation held,
+    seed memory, v_c0 = 0, arms."""
+    import vimpact as v
+
+    kv = v.Material.kelvin_voigt(nu=0.3, E=5e10, eta=1e5)
+    sls = v.Material.standard_solid(nu=0.5, G1=1e9, G2=3e9, eta=4e6)
+    return [
+        v.Scene(kv, R=0.2, m=10.0, v_z0=10.0, v_x0=5.0),
+        v.Scene(kv, R=0.2, m=10.0, v_z0=10.0, tangential="none"),
+        v.Scene(kv, R=0.2, m=10.0, v_z0=10.0, v_x0=5.0, omega0=-3.0, rotation=False),
+        v.Scene(sls, R=0.01, m=0.03, v_z0=1.0, v_x0=-0.5, tangential_memory="seed"),
+        v.Scene(sls, R=0.01, m=0.03, v_z0=1.0, v_x0=0.5, omega0=-50.0),  # v_c0 = 0
+        v.Scene(sls, R=0.01, m=0.03, v_z0=1.0, v_x0=2.0, omega0=10.0, mu=0.3),
+    ]
+
+
+def _kernel_rows(rng, n):
+    """Kernel rows of every status, many with energy gain, NaN, a short contact, a
+    contact wider than the half-space limit or outputs just above 1."""
+    from vimpact.kernels import layout
+    from vimpact.kernels import status as status_table
+
+    out = np.zeros((n, layout.N_OUT))
+    out[:, layout.OUT_VZ_END] = -rng.uniform(0.0, 1.0 + 2e-6, n)
+    out[:, layout.OUT_VC_END] = rng.uniform(-1.0, 1.0, n)
+    # a gain beyond the passivity slack, or a round-off excess within it
+    for col in (layout.OUT_VZ_END, layout.OUT_VC_END):
+        above = rng.random(n) < 0.15
+        out[above, col] = -(1.0 + rng.choice([1e-5, 5e-7], above.sum()))
+    out[:, layout.OUT_T_CONTACT] = 10.0 ** rng.uniform(-1.0, 1.0, n)
+    out[:, layout.OUT_U_MAX] = rng.uniform(0.0, 1.0, n)
+    out[:, layout.OUT_B_MAX] = 10.0 ** rng.uniform(-1.0, 4.0, n)
+    codes = list(status_table.BY_CODE) + [layout.STATUS_ASSUMPTION, 99]
+    out[:, layout.OUT_STATUS] = rng.choice(codes, n, p=None)
+    out[rng.random(n) < 0.7, layout.OUT_STATUS] = layout.STATUS_OK
+    out[:, layout.OUT_STEPS] = rng.integers(0, 10_000, n)
+    out[:, layout.OUT_T_GROSS_SLIP] = rng.uniform(0.0, 1.0, n) * out[:, layout.OUT_T_CONTACT]
+    out[:, layout.OUT_W_FRICTION] = rng.uniform(0.0, 0.1, n)
+    nan = rng.random(n) < 0.05
+    out[nan, rng.integers(0, 5, n)[nan]] = np.nan
+    return out
+
+
+def test_unpack_row_is_unpack_of_one_row():
+    """simulate()'s scalar unpack gives exactly what the batch unpack gives for the
+    same row (every field, every status, refused rows too)."""
+    from vimpact.engine.columns import SceneColumns
+    from vimpact.engine.result import RESULT_FIELDS
+    from vimpact.engine.unpack import unpack, unpack_row
+
+    rng = np.random.default_rng(7)
+    statuses = set()
+    for scene in _scenes():
+        cols = SceneColumns.from_scenes([scene])
+        assert cols.valid[0]
+        out = _kernel_rows(rng, 400)
+        for i in range(len(out)):
+            euler = bool(rng.random() < 0.2)
+            steps = float(rng.choice([0.0, 0.5, 50.0]))
+            refused = (("too_costly", "a reason") if rng.random() < 0.03 else None)
+            refused_col = np.full(1, None, dtype=object)
+            refused_col[0] = refused
+            want = unpack(cols, out[i:i + 1], np.array(["p"], dtype=object),
+                          np.array([euler]), np.array([steps]), refused_col)
+            got = unpack_row(cols, out[i], "p", euler, steps, refused)
+            assert list(got) == list(RESULT_FIELDS)
+            for name in RESULT_FIELDS:
+                w = want[name][0]
+                w = w.item() if hasattr(w, "item") else w
+                g = got[name]
+                assert type(g) is type(w), (name, g, w)
+                assert g == w or (g != g and w != w), (name, g, w, want["status"][0])
+            statuses.add(got["status"])
+    # the rows above reach the statuses unpack decides itself
+    assert {"ok", "unstable", "energy_gain", "not_passive", "unresolved", "half_space",
+            "normal_only", "vc0_zero", "non_finite", "too_costly"} <= statuses

@@ -1,4 +1,4 @@
-"""Issue 26: bad rows in a batch and impossible values reported as valid.
+"""Bad rows in a batch and impossible values reported as valid.
 
 - the seed memory with finite friction is refused where the input is checked
   (``Scene``, batch columns, sweep specs, the command line), before any kernel:

@@ -1,4 +1,4 @@
-"""Issue 26: resources and places a sweep may use.
+"""Resources and places a sweep may use.
 
 - ``--workers`` is bounded by the machine (cores and available memory), checked
   before anything starts;

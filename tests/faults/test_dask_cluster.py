@@ -1,4 +1,4 @@
-"""Issue 26: a sweep on a real Dask cluster survives losing a worker.
+"""A sweep on a real Dask cluster survives losing a worker.
 
 The cluster is made of the command-line entry points that ``vimpact[dask]``
 installs, as separate processes on 127.0.0.1 only: ``dask scheduler`` and two

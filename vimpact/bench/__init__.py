@@ -45,8 +45,11 @@ BENCHMARKS: dict[str, str] = {
 
 
 def available(name: str) -> bool:
-    """Whether the module of benchmark ``name`` can be imported here (a
-    benchmark in the repository's ``benchmarks/`` needs a source checkout)."""
+    """Return whether the module of benchmark ``name`` can be imported here.
+
+    Whether the module of benchmark ``name`` can be imported here (a
+    benchmark in the repository's ``benchmarks/`` needs a source checkout).
+    """
     try:
         return importlib.util.find_spec(BENCHMARKS[name]) is not None
     except (ImportError, ValueError):
@@ -54,8 +57,11 @@ def available(name: str) -> bool:
 
 
 def title(name: str) -> str:
-    """``TITLE`` of benchmark ``name``, read from its source without importing
-    it (``vimpact bench list`` stays fast); empty if it has none."""
+    """Return the ``TITLE`` of benchmark ``name``, read from its source.
+
+    ``TITLE`` of benchmark ``name``, read from its source without importing
+    it (``vimpact bench list`` stays fast); empty if it has none.
+    """
     import ast
 
     spec = importlib.util.find_spec(BENCHMARKS[name])
@@ -72,7 +78,7 @@ def title(name: str) -> str:
 
 
 def load(name: str) -> ModuleType:
-    """The module of benchmark ``name``.
+    """Return the module of benchmark ``name``.
 
     Raises
     ------

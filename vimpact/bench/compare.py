@@ -29,7 +29,7 @@ BETTER = {"time": "faster", "accuracy": "more accurate"}
 
 
 def load_result(path: str | Path) -> dict:
-    """A benchmark result file (JSON written by ``vimpact bench``).
+    """Return a benchmark result file (JSON written by ``vimpact bench``).
 
     Raises
     ------
@@ -61,10 +61,12 @@ def load_result(path: str | Path) -> dict:
 
 
 def judge(old: dict, new: dict) -> dict:
-    """One figure's comparison: ``ratio`` (new / old), ``noise`` (relative),
-    ``threshold`` and the ``verdict``."""
+    """One figure's comparison.
+
+    ``ratio`` (new / old), ``noise`` (relative), ``threshold`` and the ``verdict``.
+    """
     kind = new["kind"]
-    spreads = [f.get("spread") if f.get("spread") is not None else UNKNOWN_SPREAD[kind]
+    spreads = [float(f["spread"]) if f.get("spread") is not None else UNKNOWN_SPREAD[kind]
                for f in (old, new)]
     noise = math.sqrt(spreads[0] ** 2 + spreads[1] ** 2)
     threshold = max(2.0 * noise, NOISE_FLOOR[kind])
@@ -94,10 +96,12 @@ def judge(old: dict, new: dict) -> dict:
 
 
 def compare(old: dict, new: dict) -> dict:
-    """Compare two results (:func:`load_result`); returns ``benchmark``,
-    ``warnings`` (different benchmarks, quick vs full, machines), ``figures``
-    (name -> :func:`judge`), ``only_old``/``only_new`` and ``flagged``
-    (the figures that got worse beyond the noise)."""
+    """Compare two results (:func:`load_result`).
+
+    Returns ``benchmark``, ``warnings`` (different benchmarks, quick vs full, machines),
+    ``figures`` (name -> :func:`judge`), ``only_old``/``only_new`` and ``flagged`` (the
+    figures that got worse beyond the noise).
+    """
     warnings = []
     if old["benchmark"] != new["benchmark"]:
         warnings.append(f"different benchmarks: {old['benchmark']} vs {new['benchmark']}")
@@ -121,7 +125,7 @@ def compare(old: dict, new: dict) -> dict:
 
 
 def format_table(result: dict) -> str:
-    """The comparison as a text table (flagged rows marked ``!!``)."""
+    """Return the comparison as a text table (flagged rows marked ``!!``)."""
     lines = [f"benchmark {result['benchmark']}: vimpact {result['versions']['old']} -> "
              f"{result['versions']['new']}"]
     lines += [f"warning: {w}" for w in result["warnings"]]

@@ -36,6 +36,7 @@ from __future__ import annotations
 
 import math
 import time
+from typing import Any
 
 import numpy as np
 
@@ -102,6 +103,7 @@ def old_kernel():
 
 
 def orders(err):
+    """Return the observed orders between successive halvings of a ladder."""
     err = np.asarray(err, dtype=float)
     return (np.log(err[:-1] / err[1:]) / np.log(2.0)).tolist()
 
@@ -139,8 +141,11 @@ ELEMENT_PATH_CASES = {
 
 
 def mu_for(psi_over_chi: float, nu: float = NU, theta_ratio: float = THETA_RATIO) -> float:
-    """Kernel-unit friction coefficient ``mu v_z0 / |v_c0|`` for ``psi = that x chi``
-    (``psi = kappa / mu``, ``chi = kappa (1 + m R^2 / Theta) / 2``); ``inf`` for 0."""
+    """Return the kernel-unit friction coefficient for an incidence ``psi``.
+
+    Kernel-unit friction coefficient ``mu v_z0 / |v_c0|`` for ``psi = that x chi``
+    (``psi = kappa / mu``, ``chi = kappa (1 + m R^2 / Theta) / 2``); ``inf`` for 0.
+    """
     if psi_over_chi == 0.0:
         return math.inf
     chi = (1.0 - nu) / (2.0 - nu) * (1.0 + 1.0 / theta_ratio)
@@ -148,9 +153,12 @@ def mu_for(psi_over_chi: float, nu: float = NU, theta_ratio: float = THETA_RATIO
 
 
 def envelope(spec, ez_ref, ex_ref, levels, **material) -> dict:
-    """Largest |error| of e_z and e_x over ``ENVELOPE_SHIFTS`` element counts at
+    """Return the error envelope over shifted element counts, and its orders.
+
+    Largest |error| of e_z and e_x over ``ENVELOPE_SHIFTS`` element counts at
     each joint level (``N + k / ENVELOPE_SHIFTS`` elements per a_H, ``6 N`` steps
-    per t_H) and the orders fitted to them; e_x is compared signed (beta_x)."""
+    per t_H) and the orders fitted to them; e_x is compared signed (beta_x).
+    """
     ez_env, ex_env = [], []
     for n in levels:
         counts = n + np.arange(ENVELOPE_SHIFTS) / ENVELOPE_SHIFTS
@@ -164,9 +172,12 @@ def envelope(spec, ez_ref, ex_ref, levels, **material) -> dict:
 
 
 def element_reference(spec, **material) -> tuple[float, float, float]:
-    """``(e_z, beta_x, uncertainty)`` of a fine element run (9600 steps per t_H,
+    """Return the fine element reference of one case and its uncertainty.
+
+    ``(e_z, beta_x, uncertainty)`` of a fine element run (9600 steps per t_H,
     1600 elements per a_H and two spacings 0.02 % and 0.04 % apart: their mean,
-    and the spread of beta_x over the three)."""
+    and the spread of beta_x over the three).
+    """
     out = run_rows(spec, h=HERTZ_TIME / 9600 / TANGENTIAL_FACTOR,
                    dxi=1.0 / (1600.0 + np.array([0.0, 0.37, 0.71])), **material)
     assert (out[:, OUT_STATUS] == STATUS_OK).all()
@@ -181,17 +192,20 @@ CHECK_SCENES = [(0.3, 0.3, None, 0.3), (1.0, 0.5, 1.0, 0.1), (0.05, 0.0, None, 1
 
 
 def tolerance_check(tolerances) -> dict:
-    """``Numerics.for_tolerance(tol)`` with its tolerance check switched off (plain
+    """Check ``Numerics.for_tolerance`` against a finer run.
+
+    ``Numerics.for_tolerance(tol)`` with its tolerance check switched off (plain
     steps and elements) on :data:`CHECK_SCENES` with the seed memory and with
     friction, against an 8x finer run (steps and elements; 4x gives the reference's
-    uncertainty): largest error on e_z and beta_x over the tolerance, per scene."""
+    uncertainty): largest error on e_z and beta_x over the tolerance, per scene.
+    """
     import vimpact as v
 
     sets = {"seed": [v.Scene.from_dimensionless(q1, nu, q2, tangential_memory="seed")
                      for q1, nu, q2, _ in CHECK_SCENES],
             "friction": [v.Scene.from_dimensionless(q1, nu, q2, mu=mu)
                          for q1, nu, q2, mu in CHECK_SCENES]}
-    out = {}
+    out: dict[str, dict] = {}
     for name, scenes in sets.items():
         out[name] = {}
         for tol in tolerances:
@@ -209,6 +223,7 @@ def tolerance_check(tolerances) -> dict:
 
 
 def run(quick: bool) -> dict:
+    """Measure every case; return the JSON-ready record."""
     steps = np.array([150, 300, 600] if quick else [150, 300, 600, 1200, 2400])
     fine_steps = 2400 if quick else 9600
     elems = np.array([25, 50, 100] if quick else [25, 50, 100, 200, 400])
@@ -217,7 +232,8 @@ def run(quick: bool) -> dict:
     sweep = np.arange(190.0, 210.01, 2.0 if quick else 0.5)
     sweep_steps = 2400 if quick else 4800
     before = None if quick else old_kernel()
-    data = {"machine": machine_info(), "before_commit": BEFORE if before else None,
+    data: dict[str, Any] = {"machine": machine_info(),
+                            "before_commit": BEFORE if before else None,
             "steps": steps.tolist(), "fine_steps": fine_steps, "elements": elems.tolist(),
             "fine_elements": fine_elems, "joint_steps": joint.tolist(),
             "joint_elements": (joint / 6.0).tolist(), "sweep_elements": sweep.tolist(),
@@ -229,16 +245,16 @@ def run(quick: bool) -> dict:
         kernels = {"after": element_kernel}
         if before is not None and len(g) > 0:
             kernels["before"] = before
-        case = {"continuum_e_z": ez_ref, "continuum_e_x": ex_ref}
+        case: dict[str, Any] = {"continuum_e_z": ez_ref, "continuum_e_x": ex_ref}
         for label, k in kernels.items():
             t0 = time.perf_counter()
-            r = {}
+            r: dict[str, Any] = {}
 
             def errors(out):
                 return (np.abs(-out[:, OUT_VZ_END] - ez_ref).tolist(),
                         np.abs(np.abs(out[:, OUT_VC_END]) - ex_ref).tolist())
 
-            ladders = {
+            ladders: dict[str, dict[str, Any]] = {
                 "time": dict(h=HERTZ_TIME / steps / TANGENTIAL_FACTOR, dxi=1.0 / fine_elems),
                 "space": dict(h=HERTZ_TIME / fine_steps / TANGENTIAL_FACTOR, dxi=1.0 / elems),
                 "joint": dict(h=HERTZ_TIME / joint / TANGENTIAL_FACTOR, dxi=6.0 / joint),
@@ -291,12 +307,15 @@ MODEL_SCENES = [(0.01, 0.0, None), (0.1, 0.5, None), (1.0, 0.25, None), (5.0, 0.
 
 
 def error_model_points(quick: bool) -> dict:
-    """Errors of ``Numerics(continuum=False, steps=S, elements=E)`` against the
+    """Return the errors of the element path on a grid of steps and elements.
+
+    Errors of ``Numerics(continuum=False, steps=S, elements=E)`` against the
     continuum kernel on :data:`MODEL_SCENES`, max over the scenes of
     ``max(|e_z err|, |e_x err|)``, on a grid of (S, E), and the envelope
     ``a / S + b / E^2`` that bounds every point (the form of
     ``vimpact.model.numerics.ERROR_MODEL``); the presets on the element path,
-    measured the same way."""
+    measured the same way.
+    """
     import vimpact as v
     from vimpact.bench.accuracy import continuum_restitution
 
@@ -325,12 +344,13 @@ def error_model_points(quick: bool) -> dict:
     q_fit = -np.polyfit(np.log(E), np.log(err[-1, :]), 1)[0]
     SS, EE = np.meshgrid(np.asarray(S, float), np.asarray(E, float), indexing="ij")
     p, q = 1.0, 2.0
-    best = None
+    best: tuple[float, float, float] | None = None
     for a in np.logspace(-5, 2, 1400):
         b = max(0.0, float(((err - a / SS**p) * EE**q).max()))
         worst = float(((a / SS**p + b / EE**q) / err).max())
         if best is None or worst < best[2]:
             best = (float(a), b, worst)
+    assert best is not None  # the loop above ran
     presets = {}
     for name in (("fast", "default") if quick else ("fast", "default", "precise")):
         df = v.simulate_batch(scenes, v.Numerics.preset(name).with_(continuum=False))
@@ -344,6 +364,7 @@ def error_model_points(quick: bool) -> dict:
 
 
 def plot(data: dict, path) -> None:
+    """Draw the errors and orders of each case to ``path``."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -403,8 +424,11 @@ def plot(data: dict, path) -> None:
 
 
 def figures(data: dict) -> dict:
-    """Fitted observed orders (time-only and joint refinement, e_z and e_x) per case,
-    the element-count sweep's e_x jump, and each preset's max error on elements."""
+    """Return the headline numbers of an element-orders run.
+
+    Fitted observed orders (time-only and joint refinement, e_z and e_x) per case,
+    the element-count sweep's e_x jump, and each preset's max error on elements.
+    """
     from vimpact.bench.machine import figure
 
     out = {}

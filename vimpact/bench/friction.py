@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import math
 import time
+from typing import Any
 
 import numba
 import numpy as np
@@ -29,9 +30,12 @@ TITLE = "Coulomb friction: friction kernel against stick kernel, beta_x error vs
 
 
 def interleaved_medians(fns: dict, repeats: int) -> dict:
-    """Median wall time of each ``fns`` entry, timed in turn within every
-    repeat (so a busy machine slows all of them alike), s."""
-    times = {k: [] for k in fns}
+    """Return the median wall time of each function, timed in turns, s.
+
+    Median wall time of each ``fns`` entry, timed in turn within every
+    repeat (so a busy machine slows all of them alike), s.
+    """
+    times: dict[str, list[float]] = {k: [] for k in fns}
     for _ in range(repeats):
         for k, fn in fns.items():
             t0 = time.perf_counter()
@@ -45,12 +49,13 @@ MATERIALS = {"elastic": (0.0, (), ()), "standard_solid_Q2_0.5": (0.0, (2.0,), (0
 
 
 def run(quick: bool) -> dict:
+    """Measure the cost and the beta_x ladder of each case; return the JSON-ready record."""
     steps, elements = (300, 50) if quick else (1400, 200)
     rows = 4 if quick else 8
     repeats = 5 if quick else 9
     threads = numba.get_num_threads()
     numba.set_num_threads(1)  # one thread: the ratio, not the parallel speed-up
-    data = {"machine": machine_info(), "steps": steps, "elements": elements, "rows": rows,
+    data: dict[str, Any] = {"machine": machine_info(), "steps": steps, "elements": elements, "rows": rows,
             "threads_used": 1, "cost": {}, "ladder": {}}
     h = HERTZ_TIME / steps / TANGENTIAL_FACTOR
     for name, (tau0, g, tau) in MATERIALS.items():
@@ -105,6 +110,7 @@ def run(quick: bool) -> dict:
 
 
 def plot(data: dict, path) -> None:
+    """Draw the time ratios and the beta_x ladder to ``path``."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -133,8 +139,11 @@ def plot(data: dict, path) -> None:
 
 
 def figures(data: dict) -> dict:
-    """Time ratio friction / stick kernel per material and case, and the
-    finest beta_x error of the friction ladder."""
+    """Return the headline numbers of a friction run.
+
+    Time ratio friction / stick kernel per material and case, and the
+    finest beta_x error of the friction ladder.
+    """
     out = {}
     for name, cost in data["cost"].items():
         for label, c in cost.items():

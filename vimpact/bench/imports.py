@@ -52,9 +52,11 @@ print(json.dumps({{"import_s": t1 - t0,
 
 
 def probe(statement: str) -> dict:
-    """Run ``statement`` in a fresh interpreter: ``wall_s`` (the process),
-    ``import_s`` (the statement), ``heavy`` (heavy modules loaded) and
-    ``modules`` (entries in ``sys.modules``)."""
+    """Run ``statement`` in a fresh interpreter.
+
+    ``wall_s`` (the process), ``import_s`` (the statement), ``heavy`` (heavy modules
+    loaded) and ``modules`` (entries in ``sys.modules``).
+    """
     code = _PROBE.format(statement=statement, heavy=HEAVY)
     t0 = time.perf_counter()
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
@@ -69,9 +71,12 @@ def probe(statement: str) -> dict:
 
 
 def run(quick: bool = False) -> dict:
-    """Time every target; returns the JSON-ready record (``targets``: per label
+    """Time every target import.
+
+    Time every target; returns the JSON-ready record (``targets``: per label
     the statement, the samples and medians of ``wall_s`` and ``import_s``,
-    the heavy modules and the module count)."""
+    the heavy modules and the module count).
+    """
     cfg = CONFIGS["quick" if quick else "full"]
     load_before = load_average()
     start = time.perf_counter()
@@ -97,8 +102,11 @@ def run(quick: bool = False) -> dict:
 
 
 def figures(data: dict) -> dict:
-    """Time of each import statement (inside the fresh interpreter) and the
-    wall time of ``python -c "import vimpact"``."""
+    """Return the headline numbers of an imports run.
+
+    Time of each import statement (inside the fresh interpreter) and the
+    wall time of ``python -c "import vimpact"``.
+    """
     out = {}
     for label, rec in data["targets"].items():
         if label == "python":
@@ -119,8 +127,11 @@ def report(data: dict) -> str:
 
 
 def plot(data: dict, path: Path) -> None:
-    """Horizontal bars: import time per target (interpreter start-up stacked
-    below), labelled with the heavy modules each pulls in."""
+    """Draw the import time per target to ``path``.
+
+    Horizontal bars: import time per target (interpreter start-up stacked
+    below), labelled with the heavy modules each pulls in.
+    """
     use_agg()
     import matplotlib.pyplot as plt
 

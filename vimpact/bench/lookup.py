@@ -29,6 +29,7 @@ import math
 import time
 import tomllib
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -43,9 +44,12 @@ N_LOOKUPS = 1_000_000
 
 
 def grid_axes(spec_path: Path) -> tuple[str, dict, float | None, str]:
-    """``(model, axes, tolerance, numerics preset)`` of a grid spec, its axes made as the
+    """Return the model, axes, tolerance and numerics preset of a grid spec.
+
+    ``(model, axes, tolerance, numerics preset)`` of a grid spec, its axes made as the
     sweep makes them (``per_decade``: ``round(log10(stop/start) * per) + 1`` log-spaced
-    values with exact ends; a list as given)."""
+    values with exact ends; a list as given).
+    """
     data = tomllib.loads(spec_path.read_text())
     axes = {}
     for key in ("Q1", "Q2", "nu"):
@@ -65,6 +69,7 @@ def grid_axes(spec_path: Path) -> tuple[str, dict, float | None, str]:
 
 
 def measure_grid(name: str, spec_path: Path, n_random: int) -> tuple[dict, object]:
+    """Build the table of grid ``name`` and measure its interpolation error."""
     from vimpact.lookup.refine import grid_table
     from vimpact.lookup.verify import interpolation_error
     from vimpact.model.numerics import Numerics
@@ -74,7 +79,7 @@ def measure_grid(name: str, spec_path: Path, n_random: int) -> tuple[dict, objec
     t0 = time.perf_counter()
     table = grid_table(model, axes, numerics)
     t_nodes = time.perf_counter() - t0
-    out = {"spec": str(spec_path.relative_to(ROOT)), "model": model,
+    out: dict[str, Any] = {"spec": str(spec_path.relative_to(ROOT)), "model": model,
            "nodes": {a: len(v) for a, v in axes.items()}, "rows": len(table),
            "failed_nodes": int((table.data["status"] != "ok").sum()),
            "tolerance": tolerance, "numerics_preset": preset, "node_simulation_s": t_nodes}
@@ -106,8 +111,11 @@ VARIANTS = (("cubic_lookup", "cubic", None), ("cubic_numba", "cubic", "numba"),
 
 
 def _open_shipped(path: Path):
-    """A shipped table, its rows validated (the file's integrity is the store's
-    concern and its own tests'; it does not change the lookup time)."""
+    """Open a shipped table.
+
+    Return a shipped table, its rows validated (the file's integrity is the store's
+    concern and its own tests'; it does not change the lookup time).
+    """
     from vimpact.lookup.table import RestitutionTable
 
     return RestitutionTable.open(path, validate=False).validate()
@@ -123,8 +131,11 @@ def _lookup(table, pts: dict, variant: tuple) -> dict:
 
 
 def time_lookups(table, repeats: int, n_points: int = N_LOOKUPS) -> dict:
-    """``n_points`` random in-range lookups per variant (:data:`VARIANTS`), alternated,
-    wall and CPU s; the kernel's first call timed apart."""
+    """Time random in-range lookups per variant.
+
+    ``n_points`` random in-range lookups per variant (:data:`VARIANTS`), alternated,
+    wall and CPU s; the kernel's first call timed apart.
+    """
     rng = np.random.default_rng(1)
     grid = table._lookup_grid()
     pts = {}
@@ -165,10 +176,12 @@ def time_lookups(table, repeats: int, n_points: int = N_LOOKUPS) -> dict:
 
 
 def run(quick: bool) -> dict:
+    """Time the lookups of the shipped tables (and measure a grid); return the record."""
     import numba
 
     numba.set_num_threads(1)  # one core
-    data = {"benchmark": "lookup", "machine": machine_info(), "load_before": load_average(),
+    data: dict[str, Any] = {"benchmark": "lookup", "machine": machine_info(),
+                            "load_before": load_average(),
             "grids": {}, "timing": {}}
     for name, path in SHIPPED.items():
         if path.is_file():
@@ -194,8 +207,11 @@ def run(quick: bool) -> dict:
 
 
 def figures(data: dict) -> dict:
-    """Headline numbers: cubic lookup CPU time per 1e6 points (numba kernel and NumPy
-    reference) per shipped table; with the accuracy part, the max errors per grid."""
+    """Return the headline numbers of a lookup run.
+
+    Headline numbers: cubic lookup CPU time per 1e6 points (numba kernel and NumPy
+    reference) per shipped table; with the accuracy part, the max errors per grid.
+    """
     from vimpact.bench.machine import figure
 
     out = {}
@@ -225,6 +241,7 @@ def report(data: dict) -> str:
 
 
 def plot(data: dict, path: Path) -> None:
+    """Draw the lookup times (and grid errors) to ``path``."""
     use_agg()
     import matplotlib.pyplot as plt
 

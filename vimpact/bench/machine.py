@@ -1,5 +1,7 @@
-"""What every benchmark shares: the machine it ran on, the median timer, the
-figures ``vimpact bench compare`` reads, JSON + figure output and progress.
+"""What every benchmark shares.
+
+The machine it ran on, the median timer, the figures ``vimpact bench compare`` reads, JSON
++ figure output and progress.
 
 Every result file is a JSON object with
 
@@ -35,8 +37,11 @@ SCHEMA = 1
 
 # ------------------------------------------------------------------ machine
 def machine_info() -> dict:
-    """CPU model, cores, numba threads and the versions of Python, NumPy, numba
-    and vimpact (and the platform string)."""
+    """Return the machine a result was measured on.
+
+    CPU model, cores, numba threads and the versions of Python, NumPy, numba
+    and vimpact (and the platform string).
+    """
     import numba
 
     import vimpact
@@ -53,7 +58,7 @@ def machine_info() -> dict:
     return {
         "cpu": cpu,
         "cores": os.cpu_count(),
-        "numba_threads": numba.config.NUMBA_NUM_THREADS,
+        "numba_threads": max_threads(),
         "python": platform.python_version(),
         "numpy": np.__version__,
         "numba": numba.__version__,
@@ -70,9 +75,38 @@ def machine_line(info: dict) -> str:
             f"vimpact {info.get('vimpact')}")
 
 
+def max_threads() -> int:
+    """Return the most threads numba may use.
+
+    Threads numba may use at most (``NUMBA_NUM_THREADS``, read from the
+    environment when numba is imported; :func:`numba.set_num_threads` takes up to it).
+    """
+    import numba
+
+    return int(vars(numba.config)["NUMBA_NUM_THREADS"])  # set at run time: no stub has it
+
+
+def element_spec(scene, numerics):
+    """Return the element kernel that runs ``scene`` with ``numerics``.
+
+    The element kernel (:class:`vimpact.kernels.elements.KernelSpec`) that runs
+    ``scene`` with ``numerics``; ``ValueError`` if a continuum kernel runs it (a
+    benchmark of the element kernels passes ``Numerics(continuum=False)``).
+    """
+    from vimpact.engine.routing import choose_path
+
+    path = choose_path(scene, numerics)
+    if path.spec is None:
+        raise ValueError(f"numerics = {numerics!r} is not allowed here: the scene runs on "
+                         f"{path.name}, must be an element kernel (continuum=False)")
+    return path.spec
+
+
 def load_average() -> list[float]:
-    """1, 5 and 15 minute load averages (runnable processes): stored with the
-    times, since the machine may be shared."""
+    """1, 5 and 15 minute load averages (runnable processes).
+
+    Stored with the times, since the machine may be shared.
+    """
     try:
         return [round(x, 2) for x in os.getloadavg()]
     except (AttributeError, OSError):  # not on every platform
@@ -96,8 +130,11 @@ def median_time(fn: Callable[[], object], repeats: int) -> float:
 
 
 def spread(samples: Sequence[float]) -> float | None:
-    """Relative spread of repeated measurements: half their range over their
-    median (``None`` for fewer than two samples or a zero median)."""
+    """Relative spread of repeated measurements.
+
+    Half their range over their median (``None`` for fewer than two samples or a zero
+    median).
+    """
     x = np.asarray([s for s in samples if s is not None], dtype=float)
     x = x[np.isfinite(x)]
     if len(x) < 2:
@@ -111,7 +148,7 @@ def spread(samples: Sequence[float]) -> float | None:
 def figure(value, unit: str, better: str = "lower", kind: str = "time",
            samples: Sequence[float] | None = None, rel_spread: float | None = None,
            note: str | None = None) -> dict:
-    """A headline number of a benchmark, as ``vimpact bench compare`` reads it.
+    """Return a headline number of a benchmark, as ``vimpact bench compare`` reads it.
 
     Parameters
     ----------
@@ -144,8 +181,11 @@ def ratio_spread(*spreads: float | None) -> float | None:
 
 # ------------------------------------------------------------------ output
 def progress(msg: str, start: float | None = None) -> None:
-    """A progress line on stderr (silenced by ``VIMPACT_BENCH_QUIET``), with
-    the seconds since ``start`` (a ``time.perf_counter()`` value) if given."""
+    """Print a progress line on stderr.
+
+    A progress line on stderr (silenced by ``VIMPACT_BENCH_QUIET``), with
+    the seconds since ``start`` (a ``time.perf_counter()`` value) if given.
+    """
     if os.environ.get("VIMPACT_BENCH_QUIET") is not None:
         return
     if start is not None:
@@ -188,9 +228,12 @@ def _json_safe(x):
 
 
 def annotate(name: str, module, data: dict, quick: bool) -> dict:
-    """``data`` with ``benchmark``, ``schema``, ``quick`` and ``figures`` (from
+    """Return a result with its benchmark, schema, quick flag and figures.
+
+    ``data`` with ``benchmark``, ``schema``, ``quick`` and ``figures`` (from
     ``module.figures(data)``, or the ``figures`` the data carry for a module
-    without that function) added, strict-JSON safe."""
+    without that function) added, strict-JSON safe.
+    """
     figs = module.figures(data) if hasattr(module, "figures") else data.get("figures", {})
     head = {"benchmark": name, "schema": SCHEMA, "quick": bool(quick)}
     body = {k: x for k, x in data.items() if k not in ("benchmark", "schema", "quick", "figures")}
@@ -198,7 +241,7 @@ def annotate(name: str, module, data: dict, quick: bool) -> dict:
 
 
 def figures_table(figs: dict) -> str:
-    """The figures of a result as a short text table."""
+    """Return the figures of a result as a short text table."""
     if not figs:
         return "(no figures)"
     w = max(len(k) for k in figs)
@@ -212,11 +255,14 @@ def figures_table(figs: dict) -> str:
 
 def run_and_write(name: str, module, quick: bool, out: Path, json_name: str | None = None,
                   png_name: str | None = None, details: bool = False) -> tuple[dict, Path, Path]:
-    """Run benchmark ``module`` (``run(quick)``, ``plot(data, path)``,
+    """Run a benchmark and write its JSON and chart.
+
+    Run benchmark ``module`` (``run(quick)``, ``plot(data, path)``,
     ``figures(data)``), write ``out/json_name`` and ``out/png_name`` (default
     ``NAME.json`` and ``NAME.png``), print the machine line and the figures
     table (and ``module.report(data)`` with ``details``); returns the data and
-    both paths."""
+    both paths.
+    """
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     start = time.perf_counter()
@@ -235,11 +281,14 @@ def run_and_write(name: str, module, quick: bool, out: Path, json_name: str | No
 
 
 def module_at_commit(commit: str, path: str) -> ModuleType | None:
-    """The repository's module ``path`` (e.g. ``vimpact/kernels/elements.py``) as of
+    """Return a module of the repository as of ``commit``.
+
+    The repository's module ``path`` (e.g. ``vimpact/kernels/elements.py``) as of
     ``commit``, for a benchmark that times a kernel before and after a change; ``None``
     without git or outside a source checkout (an installed package). The source is
     written under the temporary folder with a stable name, so that numba's cache
-    beside it survives the run."""
+    beside it survives the run.
+    """
     checkout = Path(__file__).resolve().parents[2]
     if not (checkout / "pyproject.toml").exists():  # installed: no repository at hand
         return None
@@ -255,6 +304,8 @@ def module_at_commit(commit: str, path: str) -> ModuleType | None:
     if not file.exists() or file.read_text() != src:
         file.write_text(src)
     spec = importlib.util.spec_from_file_location(name, file)
+    if spec is None or spec.loader is None:
+        return None
     module = importlib.util.module_from_spec(spec)
     sys.modules[name] = module  # numba's cache finds the module again by name
     lent = _lend_moved_names()
@@ -266,14 +317,77 @@ def module_at_commit(commit: str, path: str) -> ModuleType | None:
     return module
 
 
+def package_at_commit(commit: str, package: str) -> ModuleType | None:
+    """Return a package of the repository as of ``commit``.
+
+    The repository's package ``package`` (e.g. ``vimpact.engine``) as of ``commit``,
+    imported under its own name beside the current one, for a benchmark that times
+    Python code before and after a change in one run.
+
+    Its modules import each other from the old copy and everything else (kernels,
+    model) from the current package, so the compiled kernels are shared. ``None``
+    without git, outside a source checkout, or if the old code does not import any
+    more (a name it needs has moved).
+
+    Parameters
+    ----------
+    commit : str
+        A commit of the repository (``git show`` names it).
+    package : str
+        Dotted name of a folder of the repository, e.g. ``"vimpact.engine"``.
+
+    Returns
+    -------
+    types.ModuleType or None
+        The old package (its modules are imported as its attributes' modules).
+    """
+    checkout = Path(__file__).resolve().parents[2]
+    folder = package.replace(".", "/")
+    if not (checkout / "pyproject.toml").exists():
+        return None
+    try:
+        names = subprocess.run(["git", "ls-tree", "--name-only", f"{commit}:{folder}"],
+                               cwd=checkout, capture_output=True, text=True,
+                               check=True).stdout.split()
+        sources = {name: subprocess.run(["git", "show", f"{commit}:{folder}/{name}"],
+                                        cwd=checkout, capture_output=True, text=True,
+                                        check=True).stdout
+                   for name in names if name.endswith(".py")}
+    except (OSError, subprocess.CalledProcessError):
+        return None
+    alias = f"{package.replace('.', '_')}_{commit[:10]}"
+    root = Path(tempfile.gettempdir()) / "vimpact_bench_before"
+    target = root / alias
+    target.mkdir(parents=True, exist_ok=True)
+    for name, src in sources.items():
+        src = src.replace(f"{package}.", f"{alias}.").replace(f"from {package} import",
+                                                               f"from {alias} import")
+        file = target / name
+        if not file.exists() or file.read_text() != src:
+            file.write_text(src)
+    if str(root) not in sys.path:
+        sys.path.append(str(root))
+    try:
+        module = importlib.import_module(alias)
+        for name in sources:
+            if name != "__init__.py":
+                importlib.import_module(f"{alias}.{name[:-3]}")
+    except (ImportError, AttributeError):
+        return None
+    return module
+
+
 #: Names an earlier commit's kernel imports from a module they have since left:
 #: ``{old module: {name: module that defines it now}}``.
 MOVED_NAMES = {"vimpact.kernels.layout": {"_record": "vimpact.kernels.record"}}
 
 
 def _lend_moved_names() -> list[tuple[ModuleType, str]]:
-    """Put each moved name back on its old module while an old kernel is imported
-    (the modules themselves keep no alias); return what was lent."""
+    """Lend moved names back to their old modules.
+
+    Put each moved name back on its old module while an old kernel is imported
+    (the modules themselves keep no alias); return what was lent.
+    """
     lent = []
     for old, names in MOVED_NAMES.items():
         home = importlib.import_module(old)

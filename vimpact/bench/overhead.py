@@ -21,11 +21,13 @@ call that compiles or loads the kernels; median over the repeats. Also the
 Kelvin-Voigt normal-only throughput, rows / ``total_s``. Targets:
 overhead <= 5 microseconds per row, throughput >= 50,000 rows/s on 2 threads.
 
-One impact (:func:`one_impact`, issue 24: at most 100 us of Python outside
-the kernel): the CPU time of one ``vimpact.simulate(scene)`` call on one
-thread, minus the kernel's (wall) time, for an oblique and a normal-only
-Kelvin-Voigt scene, and the same call as of the commit before issue 24 side
-by side (from a source checkout, which has that code in git).
+One impact (:func:`one_impact`; target: at most 100 us of Python outside the
+kernel): the CPU time of one ``vimpact.simulate(scene)`` call on one thread,
+minus the kernel's (wall) time, for an oblique and a normal-only Kelvin-Voigt
+scene (continuum paths) and an oblique one with friction (element path), with
+the engine as of :data:`BEFORE_COMMIT` timed in turns with the current one in
+the same run (from a source checkout, which has that code in git) and its
+results compared.
 
 Rows: ``nu`` uniform in [0, 0.5], ``R`` log-uniform in [1 mm, 10 cm], steel
 density (``m = 7800 kg/m^3 * 4/3 pi R^3``), ``v_z0`` log-uniform in [0.1,
@@ -39,6 +41,7 @@ from __future__ import annotations
 import math
 import time
 from pathlib import Path
+from typing import Any
 
 import numba
 import numpy as np
@@ -47,7 +50,8 @@ from .machine import (
     figure,
     load_average,
     machine_info,
-    module_at_commit,
+    max_threads,
+    package_at_commit,
     progress,
     save_figure,
     use_agg,
@@ -98,18 +102,23 @@ def scene_columns(n: int, seed: int = 0, oblique: bool = False) -> dict[str, np.
 
 
 def _measure(columns: dict, numerics, repeats: int) -> dict:
-    """``repeats`` calls of ``simulate_batch(columns, numerics, timings=t)``:
-    per call ``total_s``, ``kernel_s``, overhead per row (us) and rows/s."""
+    """``repeats`` calls of ``simulate_batch(columns, numerics, timings=t)``.
+
+    Per call ``total_s``, ``kernel_s``, overhead per row (us) and rows/s.
+    """
     import vimpact as v
 
     rows = len(columns["nu"])
-    total, kernel = [], []
+    total: list[float] = []
+    kernel: list[float] = []
     frame = None
     for _ in range(repeats):
         t: dict = {}
         frame = v.simulate_batch(columns, numerics, timings=t)
         total.append(t["total_s"])
         kernel.append(t["kernel_s"])
+    if frame is None:
+        raise ValueError(f"repeats = {repeats!r} is not allowed: must be >= 1")
     over = [(a - b) / rows * 1e6 for a, b in zip(total, kernel)]
     rate = [rows / a for a in total]
     statuses = frame["status"].value_counts().to_dict()
@@ -130,81 +139,164 @@ def _measure(columns: dict, numerics, repeats: int) -> dict:
     }
 
 
-#: the commit before issue 24 (simulate() overhead): its ``simulate`` is timed
-#: side by side with the current one where the source is at hand (a checkout)
-BEFORE_COMMIT = "54d8eb1"
-#: issue 24: Python CPU time outside the kernel of one ``simulate()`` call, us
+#: main before the one-impact fast path of :func:`vimpact.simulate` (a scalar unpack of
+#: the one row, no second validation of a ``Scene``, derived columns computed once):
+#: its engine is timed side by side with the current one where the source is at hand
+BEFORE_COMMIT = "7dbf0d8"
+#: Python CPU time outside the kernel of one ``simulate()`` call, us
 TARGET_ONE_IMPACT_US = 100.0
 
 
-def _cpu_us(fn, calls: int, repeats: int) -> tuple[float, list[float]]:
-    """Smallest over ``repeats`` of the CPU time per call of ``fn()`` over ``calls``
-    calls, us (CPU time: robust against other processes on the machine), and all."""
-    fn()
-    samples = []
+def _cpu_us(fn, calls: int) -> float:
+    """Return the CPU time per call of ``fn()``, us.
+
+    CPU time per call of ``fn()`` over ``calls`` calls, us (CPU time: robust
+    against other processes on the machine).
+    """
+    t0 = time.process_time()
+    for _ in range(calls):
+        fn()
+    return (time.process_time() - t0) / calls * 1e6
+
+
+def _side_by_side(fns: dict, calls: int, repeats: int) -> dict[str, list[float]]:
+    """Time functions in turns, CPU time per call in us.
+
+    CPU time per call (us) of each function of ``fns``, ``repeats`` rounds of
+    ``calls`` calls each, the functions taking turns within a round (so a change
+    of load hits all alike); after one warm-up call each.
+    """
+    for fn in fns.values():
+        fn()
+    samples: dict[str, list[float]] = {name: [] for name in fns}
     for _ in range(repeats):
-        t0 = time.process_time()
-        for _ in range(calls):
-            fn()
-        samples.append((time.process_time() - t0) / calls * 1e6)
-    return min(samples), samples
+        for name, fn in fns.items():
+            samples[name].append(_cpu_us(fn, calls))
+    return samples
 
 
-def _before_simulate():
-    """``simulate`` as of :data:`BEFORE_COMMIT` (with that commit's ``unpack``), or
-    ``None`` outside a source checkout."""
-    old_unpack = module_at_commit(BEFORE_COMMIT, "vimpact/engine/unpack.py")
-    old = module_at_commit(BEFORE_COMMIT, "vimpact/engine/simulate.py")
-    if old is None or old_unpack is None:
-        return None
-    old.unpack = old_unpack.unpack
-    return old.simulate
+class _KernelsReplaced:
+    """Replace every kernel by a copy of its output row.
+
+    While active, every kernel the engines call (the two continuum batch kernels
+    and each element kernel, in the current and the :data:`BEFORE_COMMIT` engine's
+    ``pack``) only copies ``row`` into its output: what is left of a
+    ``simulate()`` call is the Python around the kernel. With ``row=None`` the
+    real kernel runs once and its one-row output is kept as ``row``.
+    """
+
+    def __init__(self, packs: list, row: np.ndarray | None = None):
+        self.packs, self.row = packs, row
+        self.saved: list = []
+
+    def _wrap(self, real):
+        def kernel(*args):
+            if self.row is None:
+                real(*args)
+                self.row = args[-1].copy()
+            else:
+                args[-1][:] = self.row  # every batch kernel takes ``out`` last
+        return kernel
+
+    def __enter__(self):
+        from vimpact.kernels import continuum_kv, continuum_maxwell
+
+        for owner, name in ([(continuum_kv, "kv_normal_batch"),
+                             (continuum_maxwell, "maxwell_stick_batch")]
+                            + [(pack, "element_kernel") for pack in self.packs]):
+            real = getattr(owner, name)
+            self.saved.append((owner, name, real))
+            setattr(owner, name, (lambda spec, real=real: self._wrap(real(spec)))
+                    if name == "element_kernel" else self._wrap(real))
+        return self
+
+    def __exit__(self, *exc):
+        for owner, name, value in reversed(self.saved):
+            setattr(owner, name, value)
+        self.saved.clear()
+
+
 
 
 def one_impact(quick: bool = False) -> dict:
-    """CPU time of one ``simulate()`` call on 1 numba thread, the kernel's share
-    (``run_columns`` timings: wall time inside the kernel) and the Python stages
-    around it, for the README's oblique Kelvin-Voigt scene (full-stick continuum
-    path) and a normal-only one (Kelvin-Voigt continuum path); with the
-    :data:`BEFORE_COMMIT` code side by side where available."""
+    """Measure the Python outside the kernel of one ``simulate()`` call.
+
+    CPU time of one ``simulate()`` call on 1 numba thread, the kernel's share
+    (``run_columns`` timings: wall time inside the kernel) and the Python outside
+    it, for the README's oblique Kelvin-Voigt scene (full-stick continuum path), a
+    normal-only one (Kelvin-Voigt continuum path) and an oblique one with friction
+    (element path); with the engine as of :data:`BEFORE_COMMIT` side by side where
+    available, whose results must be the same.
+    """
     import vimpact as v
+    from vimpact.engine import pack
     from vimpact.engine.columns import SceneColumns
     from vimpact.engine.routing import route
     from vimpact.engine.simulate import run_columns
 
-    calls, repeats = (200, 3) if quick else (1000, 5)
-    before = _before_simulate()
+    calls, repeats = (200, 3) if quick else (1000, 7)
+    # the engine as of BEFORE_COMMIT (current kernels and model), if at hand
+    old_engine = package_at_commit(BEFORE_COMMIT, "vimpact.engine")
+    before = None if old_engine is None else old_engine.simulate.simulate
+    packs = [pack] if old_engine is None else [pack, old_engine.pack]
     mat = v.Material.kelvin_voigt(nu=0.5, E=5e10, eta=1e5)
     scenes = {"oblique (README)": v.Scene(mat, R=0.2, m=10.0, v_z0=10.0, v_x0=5.0),
-              "normal only": v.Scene(mat, R=0.2, m=10.0, v_z0=10.0, tangential="none")}
-    numerics = v.Numerics()
+              "normal only": v.Scene(mat, R=0.2, m=10.0, v_z0=10.0, tangential="none"),
+              "friction (elements, fast)": v.Scene(mat, R=0.2, m=10.0, v_z0=10.0, v_x0=5.0,
+                                                   mu=0.3)}
+    numerics = {"friction (elements, fast)": v.Numerics.preset("fast")}
+    unavailable = None if old_engine is not None else "no source checkout with git at hand"
+    if before is not None:
+        try:  # the old engine on today's kernels and model: it may no longer fit them
+            for name, scene in scenes.items():
+                before(scene, numerics.get(name, v.Numerics()))
+        except Exception as exc:  # any failure means: no side-by-side timing
+            before, packs = None, [pack]
+            unavailable = f"the engine as of {BEFORE_COMMIT} fails here: {exc!r}"
     all_threads = numba.get_num_threads()
     numba.set_num_threads(1)
-    out = {"before_commit": BEFORE_COMMIT if before else None, "calls": calls,
-           "repeats": repeats, "scenes": {}}
+    out: dict[str, Any] = {"before_commit": BEFORE_COMMIT if before else None,
+                           "before_unavailable": unavailable, "calls": calls,
+                           "repeats": repeats, "scenes": {}}
     try:
         for name, scene in scenes.items():
+            num = numerics.get(name, v.Numerics())
             cols = SceneColumns.from_scenes([scene])
-            run_columns(cols, numerics)  # load the kernel
+            run_columns(cols, num)  # load the kernel
             kernel = []
             for _ in range(repeats):
                 t: dict = {}
                 for _ in range(calls):
-                    run_columns(cols, numerics, timings=t)
+                    run_columns(cols, num, timings=t)
                 kernel.append(t["kernel_s"] / calls * 1e6)
             kernel_us = min(kernel)
-            rec = {"path": v.simulate(scene).path, "kernel_us": kernel_us}
-            rec["simulate_us"], rec["simulate_us_samples"] = _cpu_us(
-                lambda: v.simulate(scene), calls, repeats)
-            rec["from_scenes_us"], _ = _cpu_us(lambda: SceneColumns.from_scenes([scene]),
-                                               calls, repeats)
-            rec["route_us"], _ = _cpu_us(lambda: route(cols, numerics), calls, repeats)
-            rec["outside_kernel_us"] = rec["simulate_us"] - kernel_us
+            result = v.simulate(scene, num)
+            rec = {"path": result.path, "kernel_us": kernel_us}
+            fns = {"now": lambda: v.simulate(scene, num)}
             if before is not None:
-                rec["before_simulate_us"], rec["before_simulate_us_samples"] = _cpu_us(
-                    lambda: before(scene), calls, repeats)
-                rec["before_outside_kernel_us"] = rec["before_simulate_us"] - kernel_us
+                fns["before"] = lambda: before(scene, num)
+                old = before(scene, num)
+                rec["same_result_as_before"] = repr(old.to_dict()) == repr(result.to_dict())
+            samples = _side_by_side(fns, calls, repeats)  # with the kernel
+            rec["simulate_us"], rec["simulate_us_samples"] = min(samples["now"]), samples["now"]
+            with _KernelsReplaced(packs) as recorder:  # the real kernel's row
+                v.simulate(scene, num)
+            with _KernelsReplaced(packs, recorder.row):
+                outside = _side_by_side(fns, calls, repeats)
+            rec["outside_kernel_us"] = min(outside["now"])
+            rec["outside_kernel_us_samples"] = outside["now"]
+            rec["from_scenes_us"] = min(_side_by_side(
+                {"x": lambda: SceneColumns.from_scenes([scene])}, calls, repeats)["x"])
+            rec["route_us"] = min(_side_by_side({"x": lambda: route(cols, num)}, calls,
+                                                repeats)["x"])
+            if before is not None:
+                rec["before_simulate_us"] = min(samples["before"])
+                rec["before_simulate_us_samples"] = samples["before"]
+                rec["before_outside_kernel_us"] = min(outside["before"])
+                rec["before_outside_kernel_us_samples"] = outside["before"]
                 rec["before_over_now"] = rec["before_simulate_us"] / rec["simulate_us"]
+                rec["outside_before_over_now"] = (rec["before_outside_kernel_us"]
+                                                  / rec["outside_kernel_us"])
             out["scenes"][name] = rec
     finally:
         numba.set_num_threads(all_threads)
@@ -213,12 +305,15 @@ def one_impact(quick: bool = False) -> dict:
 
 
 def run(quick: bool = False) -> dict:
-    """Measure both paths; returns the JSON-ready record (``continuum``,
-    ``elements``: see :func:`_measure`; ``targets`` and whether they are met)."""
+    """Measure both paths and one impact.
+
+    Measure both paths; returns the JSON-ready record (``continuum``,
+    ``elements``: see :func:`_measure`; ``targets`` and whether they are met).
+    """
     import vimpact as v
 
     cfg = CONFIGS["quick" if quick else "full"]
-    all_threads = numba.config.NUMBA_NUM_THREADS
+    all_threads = max_threads()
     threads = min(THREADS, all_threads)
     load_before = load_average()
     start = time.perf_counter()
@@ -273,8 +368,11 @@ def figures(data: dict) -> dict:
         key = "one_impact_" + name.split(" ")[0]
         out[f"{key}_simulate_cpu_us"] = figure(rec["simulate_us"], "us",
                                                samples=rec["simulate_us_samples"])
+        out[f"{key}_outside_kernel_us"] = figure(rec["outside_kernel_us"], "us")
         if "before_over_now" in rec:
             out[f"{key}_before_over_now"] = figure(rec["before_over_now"], "-", better="higher")
+            out[f"{key}_outside_before_over_now"] = figure(rec["outside_before_over_now"], "-",
+                                                           better="higher")
     kv = data["continuum"]
     out["continuum_rows_per_second"] = figure(kv["median_rows_per_second"], "rows/s",
                                               better="higher", samples=kv["rows_per_second"])
@@ -294,11 +392,15 @@ def report(data: dict) -> str:
     one = data.get("one_impact", {})
     for name, rec in one.get("scenes", {}).items():
         line = (f"one simulate(), {name} [{rec['path']}]: {rec['simulate_us']:.0f} us CPU, "
-                f"kernel {rec['kernel_us']:.0f} us, outside it {rec['outside_kernel_us']:.0f} us "
-                f"(from_scenes {rec['from_scenes_us']:.0f}, route {rec['route_us']:.0f})")
+                f"kernel {rec['kernel_us']:.0f} us, Python outside it "
+                f"{rec['outside_kernel_us']:.0f} us (target "
+                f"{one['target_outside_kernel_us']:.0f}; from_scenes "
+                f"{rec['from_scenes_us']:.0f}, route {rec['route_us']:.0f})")
         if "before_over_now" in rec:
-            line += (f"; at {one['before_commit']}: {rec['before_simulate_us']:.0f} us "
-                     f"({rec['before_over_now']:.2f}x now)")
+            line += (f"; at {one['before_commit']}, same run: {rec['before_simulate_us']:.0f} us,"
+                     f" outside the kernel {rec['before_outside_kernel_us']:.0f} us "
+                     f"({rec['outside_before_over_now']:.2f}x now; results "
+                     f"{'identical' if rec['same_result_as_before'] else 'DIFFERENT'})")
         lines.append(line)
     t = data["targets"]
     lines.append(f"targets ({data['threads']} threads): overhead <= "
@@ -311,8 +413,11 @@ def report(data: dict) -> str:
 
 
 def plot(data: dict, path: Path) -> None:
-    """Left: time per row split into kernel and Python overhead, per path, with
-    the overhead target; right: Kelvin-Voigt rows/s per repeat with the target."""
+    """Draw the kernel and Python time per row and the throughput to ``path``.
+
+    Left: time per row split into kernel and Python overhead, per path, with
+    the overhead target; right: Kelvin-Voigt rows/s per repeat with the target.
+    """
     use_agg()
     import matplotlib.pyplot as plt
 

@@ -16,6 +16,8 @@ Kernel time only (inputs packed once, median of repeats, one numba thread).
 
 from __future__ import annotations
 
+from typing import Any
+
 import numba
 import numpy as np
 
@@ -28,16 +30,27 @@ from vimpact.kernels import elements as kernel
 from vimpact.kernels import layout
 from vimpact.reference.closed_forms import kelvin_voigt_continuum
 
-from .machine import figure, machine_info, ratio_spread, save_figure, time_samples, use_agg
+from .machine import (
+    element_spec,
+    figure,
+    machine_info,
+    ratio_spread,
+    save_figure,
+    time_samples,
+    use_agg,
+)
 
 TITLE = "cost per impact of each kernel path vs the general element kernel"
 
 def general_spec(spec: kernel.KernelSpec) -> kernel.KernelSpec:
-    """The element kernel with the tangential problem and the arms on (full
+    """Return the general element kernel for ``spec``.
+
+    The element kernel with the tangential problem and the arms on (full
     stick), and the dashpot flag of ``spec``: the dashpot flag also decides
     how an element in contact for part of a step is weighed (only with a
     dashpot is the normal force discontinuous at entry and exit), so it is
-    not only a folded branch and must match the rows."""
+    not only a folded branch and must match the rows.
+    """
     return kernel.KernelSpec(layout.VERLET, True, 0, True, spec.dashpot, False)
 
 
@@ -48,8 +61,11 @@ def _timed(call, repeats: int, per: float) -> tuple[float, list[float]]:
 
 
 def _kv_normal(quick: bool) -> dict:
-    """Kernel time only (inputs packed once): the Python layer around a batch
-    is the same for both paths and would hide the kernels' ratio."""
+    """Kernel time only (inputs packed once).
+
+    The Python layer around a batch is the same for both paths and would hide the kernels'
+    ratio.
+    """
     q1 = np.geomspace(1e-3, 10.0, 4 if quick else 16)
     scenes = [v.Scene.from_dimensionless(q, 0.5, tangential="none") for q in q1]
     repeat = 1 if quick else 64  # the continuum batch is microseconds: amortize the launch
@@ -58,7 +74,7 @@ def _kv_normal(quick: bool) -> dict:
                                               {"steps": 8000, "elements": 1600}))
     settings = {"continuum rtol=1e-7": (v.Numerics(rtol=1e-7), _continuum_call, repeat),
                 f"elements {elements.steps}/{elements.elements}": (elements, _element_call, 1)}
-    out = {}
+    out: dict[str, dict[str, Any]] = {}
     for name, (numerics, make, k) in settings.items():
         call, result = make(scenes * k, numerics)
         call()  # compile / load
@@ -67,8 +83,8 @@ def _kv_normal(quick: bool) -> dict:
         out[name] = {"path": choose_path(scenes[0], numerics).name,
                      "max_e_z_error": float(np.max(np.abs(e_z - exact))),
                      "us_per_impact": t, "us_per_impact_samples": samples}
-    a, b = out.values()
-    return {"settings": out, "speedup": b["us_per_impact"] / a["us_per_impact"]}
+    a, b = (x["us_per_impact"] for x in out.values())
+    return {"settings": out, "speedup": b / a}
 
 
 def _continuum_call(scenes, numerics: v.Numerics):
@@ -79,9 +95,12 @@ def _continuum_call(scenes, numerics: v.Numerics):
 
 
 def _element_call(scenes, numerics: v.Numerics, spec=None):
-    """The element kernel ``spec`` (default: the scenes' own) on inputs packed
-    for the scenes' own kernel: a call and the output rows."""
-    own = choose_path(scenes[0], numerics).spec
+    """Return a call of an element kernel and its output rows.
+
+    The element kernel ``spec`` (default: the scenes' own) on inputs packed
+    for the scenes' own kernel: a call and the output rows.
+    """
+    own = element_spec(scenes[0], numerics)
     a = element_arrays(SceneColumns.from_scenes(scenes), numerics, own)
     n = len(scenes)
     out = np.zeros((n, layout.N_OUT))
@@ -109,7 +128,7 @@ def _specialization(quick: bool) -> dict:
     for name, scenes in cases.items():
         special, special_out = _element_call(scenes, numerics)
         general, general_out = _element_call(
-            scenes, numerics, general_spec(choose_path(scenes[0], numerics).spec))
+            scenes, numerics, general_spec(element_spec(scenes[0], numerics)))
         special()
         general()
         diff = float(np.max(np.abs(special_out()[:, layout.OUT_VZ_END]
@@ -124,6 +143,7 @@ def _specialization(quick: bool) -> dict:
 
 
 def run(quick: bool = False) -> dict:
+    """Measure the continuum and element paths and the specialization; return the record."""
     threads = numba.get_num_threads()
     numba.set_num_threads(1)  # per-core cost; the machine is shared
     try:
@@ -157,8 +177,7 @@ def plot(data: dict, path) -> None:
 
 
 def figures(data: dict) -> dict:
-    """Time per impact of each path, the continuum's speedup at equal accuracy
-    and its e_z error."""
+    """Time per impact of each path, the continuum's speedup at equal accuracy and its e_z error."""
     out = {}
     kv = data["kelvin_voigt_normal_equal_accuracy"]
     spreads = []

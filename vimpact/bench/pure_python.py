@@ -37,7 +37,9 @@ from __future__ import annotations
 import math
 
 from vimpact import Numerics, Scene
-from vimpact.engine.routing import choose_path, refinement
+from vimpact.engine.routing import refinement
+
+from .machine import element_spec
 
 
 def _arm_coefficients(tau: float, dt: float) -> tuple[float, float, float]:
@@ -63,15 +65,18 @@ def _advance(q: float, w0: float, w1: float, c: tuple[float, float, float]) -> f
 
 def kernel_refinement(scene: Scene, steps: int, elements: int, row_width: float = 1.05,
                       ) -> tuple[float, float]:
-    """The element kernel's ``(time_factor, element_factor)`` for ``scene``
-    (:func:`vimpact.engine.routing.refinement`), dimensionless, >= 1."""
+    """Return the element kernel's refinement factors for ``scene``.
+
+    The element kernel's ``(time_factor, element_factor)`` for ``scene``
+    (:func:`vimpact.engine.routing.refinement`), dimensionless, >= 1.
+    """
     numerics = Numerics(steps=steps, elements=elements, row_width=row_width, continuum=False)
-    return refinement(scene, numerics, choose_path(scene, numerics).spec)
+    return refinement(scene, numerics, element_spec(scene, numerics))
 
 
 def refined_row(scene: Scene, steps: int, elements: int, row_width: float = 1.05,
                 ) -> tuple[float, int, int]:
-    """The discretization of ``scene`` as the kernel and ``naive_impact`` refine it.
+    """Return the discretization of ``scene`` as the kernel and ``naive_impact`` refine it.
 
     Returns the factor by which the time step is shorter than ``t_H /
     steps``, the elements per Hertz radius ``a_H`` and the elements in the

@@ -47,8 +47,11 @@ CONFIGS = {
 
 
 def fit_power_law(x: list[float], t: list[float]) -> dict:
-    """Least-squares fit of ``log t = log c + p log x``; returns ``{"exponent": p, "prefactor": c}``
-    (``c`` in the units of ``t`` per unit of ``x**p``)."""
+    """Least-squares fit of ``log t = log c + p log x``.
+
+    Returns ``{"exponent": p, "prefactor": c}`` (``c`` in the units of ``t`` per unit of
+    ``x**p``).
+    """
     p, log_c = np.polyfit(np.log(x), np.log(t), 1)
     return {"exponent": float(p), "prefactor": float(np.exp(log_c))}
 

@@ -42,9 +42,12 @@ _KERNEL = None
 
 
 def runtime_flags_kernel():
-    """The batch element kernel with the effects as run-time arguments
+    """Return the batch element kernel with its effects as run-time flags.
+
+    The batch element kernel with the effects as run-time arguments
     ``(integrator, tangential, memory, arms, dashpot, friction, ...)`` followed
-    by the arguments of :func:`~vimpact.kernels.elements.element_kernel`'s kernels."""
+    by the arguments of :func:`~vimpact.kernels.elements.element_kernel`'s kernels.
+    """
     global _KERNEL
     if _KERNEL is None:
         from numba import prange
@@ -87,6 +90,9 @@ def _case(name: str, rows: int):
     r = route(sc, numerics)
     k = max(range(len(r.paths)), key=lambda j: int((r.group == j).sum()))
     spec = r.paths[k].spec
+    if spec is None:
+        raise ValueError("the columns' largest group runs on a continuum kernel, must be an "
+                         "element kernel (continuum=False)")
     sub = sc.take(np.flatnonzero(r.group == k))
     a = element_arrays(sub, numerics, spec)
     args = (a["tau0"], a["g"], a["tau"], a["n_arms"], a["kappa"], a["mu_t"], a["mu"], a["h"],
@@ -97,8 +103,11 @@ def _case(name: str, rows: int):
 
 
 def _compile_cpu(case: str, which: str) -> float:
-    """In this process (fresh cache): CPU seconds of the first call of ``which``
-    (``specialized`` or ``runtime``) on ``case``."""
+    """In this process (fresh cache).
+
+    CPU seconds of the first call of ``which`` (``specialized`` or ``runtime``) on
+    ``case``.
+    """
     from vimpact.kernels import layout
     from vimpact.kernels.elements import element_kernel
 
@@ -120,9 +129,11 @@ print(json.dumps({c: _compile_cpu(c, sys.argv[1]) for c in sys.argv[2:]}))
 
 
 def _compile_times() -> dict:
-    """CPU seconds to compile: each case's specialized kernel, and the run-time-flag
-    kernel (its first case pays; the others find it compiled), each in a fresh
-    process with an empty numba cache."""
+    """CPU seconds to compile.
+
+    Each case's specialized kernel, and the run-time-flag kernel (its first case pays; the
+    others find it compiled), each in a fresh process with an empty numba cache.
+    """
     out = {}
     with tempfile.TemporaryDirectory(prefix="vimpact_spec_") as tmp:
         for which in ("specialized", "runtime"):
@@ -181,6 +192,7 @@ def run(quick: bool = False) -> dict:
 
 
 def figures(data: dict) -> dict:
+    """Return the headline numbers of a specialization run."""
     out = {}
     for name, c in data["cases"].items():
         key = name.replace(" ", "_")
@@ -191,6 +203,7 @@ def figures(data: dict) -> dict:
 
 
 def report(data: dict) -> str:
+    """Return the specialized over run-time-flag times as a text table."""
     lines = [f"{'case':<32}{'spec us':>10}{'runtime us':>12}{'ratio':>8}  identical"]
     for name, c in data["cases"].items():
         lines.append(f"{name:<32}{c['specialized_us_per_impact']:>10.1f}"
@@ -203,6 +216,7 @@ def report(data: dict) -> str:
 
 
 def plot(data: dict, path: Path) -> None:
+    """Draw the time per row of both kernels to ``path``."""
     use_agg()
     import matplotlib.pyplot as plt
 

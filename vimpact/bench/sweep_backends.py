@@ -28,6 +28,8 @@ import tempfile
 import time
 from pathlib import Path
 
+from .machine import max_threads
+
 TITLE = "Sweeps: in-process against a Dask LocalCluster, and a large sweep's wall over kernel time"
 
 SPEC = """
@@ -51,6 +53,7 @@ nu = [0.0, 0.5]
 
 
 def machine() -> dict:
+    """Return the platform, Python, CPUs, load and date of the run."""
     return {"platform": platform.platform(), "python": platform.python_version(),
             "cpus": os.cpu_count(), "load_average_1min": os.getloadavg()[0],
             "date_utc": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime())}
@@ -63,15 +66,16 @@ def _spec(tmp: Path, name: str, rows: int, chunk: int) -> Path:
 
 
 def backends(rows: int, chunk: int) -> dict:
+    """Time one sweep in process and on a local Dask cluster, side by side."""
     import numba
     from distributed import Client
 
     from vimpact.sweep import run_sweep
     from vimpact.sweep.runner import local_cluster
 
-    numba.set_num_threads(min(2, numba.config.NUMBA_NUM_THREADS))
-    with tempfile.TemporaryDirectory() as tmp:
-        tmp = Path(tmp)
+    numba.set_num_threads(min(2, max_threads()))
+    with tempfile.TemporaryDirectory() as folder:
+        tmp = Path(folder)
         warm, spec = _spec(tmp, "warm", 8, 2), _spec(tmp, "sweep", rows, chunk)
         t0 = time.perf_counter()
         cluster = local_cluster(2)
@@ -99,10 +103,11 @@ def backends(rows: int, chunk: int) -> dict:
 
 
 def large(rows: int, chunk: int) -> dict:
+    """Time a large in-process sweep against its kernel time."""
     from vimpact.sweep import run_sweep, summary
 
-    with tempfile.TemporaryDirectory() as tmp:
-        tmp = Path(tmp)
+    with tempfile.TemporaryDirectory() as folder:
+        tmp = Path(folder)
         spec = _spec(tmp, "large", rows, chunk)
         timings: dict = {}
         t0 = time.perf_counter()
@@ -122,8 +127,11 @@ def large(rows: int, chunk: int) -> dict:
 
 
 def run(quick: bool) -> dict:
-    """Both parts (``quick``: 200 rows side by side, a 2000-row large sweep;
-    full: 2000 rows side by side, a 1e6-row large sweep)."""
+    """Measure both parts.
+
+    Both parts (``quick``: 200 rows side by side, a 2000-row large sweep;
+    full: 2000 rows side by side, a 1e6-row large sweep).
+    """
     return {"machine": machine(),
             "backends": backends(200 if quick else 2000, 20 if quick else 100),
             "large": large(2000 if quick else 1_000_000, 500 if quick else 10_000)}
@@ -150,8 +158,11 @@ def plot(data: dict, path) -> None:
 
 
 def figures(data: dict) -> dict:
-    """Dask over in-process time, the large sweep's wall over kernel time, its
-    rows/s and Python overhead per row."""
+    """Return the headline numbers of a sweep-backends run.
+
+    Dask over in-process time, the large sweep's wall over kernel time, its
+    rows/s and Python overhead per row.
+    """
     from vimpact.bench.machine import figure
 
     b, big = data["backends"], data["large"]

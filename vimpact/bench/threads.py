@@ -27,16 +27,17 @@ import subprocess
 import sys
 import time
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
-from .machine import figure, load_average, machine_info, progress, save_figure, use_agg
+from .machine import figure, load_average, machine_info, max_threads, progress, save_figure, use_agg
 
 TITLE = "1 vs 2 numba threads for a 64-row launch per threading layer, quiet and busy"
 
 ROWS = 64
 #: name -> environment of the probe process (None: remove the variable)
-CONFIGS = {
+CONFIGS: dict[str, dict[str, str | None]] = {
     "package default": {},
     "tbb": {"NUMBA_THREADING_LAYER": "tbb"},
     "omp passive": {"NUMBA_THREADING_LAYER": "omp", "OMP_WAIT_POLICY": "PASSIVE"},
@@ -56,9 +57,12 @@ print(json.dumps(probe(int(sys.argv[1]))))
 
 
 def probe(repeats: int) -> dict:
-    """In this process: mean (what a sweep of many launches pays), median and
+    """Time a ``kv_normal_batch`` launch with 1 and with 2 threads.
+
+    In this process: mean (what a sweep of many launches pays), median and
     90th percentile wall time (s) of a ``ROWS``-row ``kv_normal_batch`` launch
-    with 1 and with 2 threads, and the layer numba took."""
+    with 1 and with 2 threads, and the layer numba took.
+    """
     import numba
 
     from vimpact.kernels import layout
@@ -67,9 +71,9 @@ def probe(repeats: int) -> dict:
     tau0 = np.linspace(0.01, 1.0, ROWS)
     out = np.zeros((ROWS, layout.N_OUT))
     kv_normal_batch(tau0, 1e-8, 100_000, out)  # compile or load, start the threads
-    res = {"layer": numba.threading_layer()}
+    res: dict[str, Any] = {"layer": numba.threading_layer()}
     for nt in (1, 2):
-        numba.set_num_threads(min(nt, numba.config.NUMBA_NUM_THREADS))
+        numba.set_num_threads(min(nt, max_threads()))
         kv_normal_batch(tau0, 1e-8, 100_000, out)
         ts = []
         for _ in range(repeats):
@@ -143,6 +147,7 @@ def figures(data: dict) -> dict:
 
 
 def report(data: dict) -> str:
+    """Return the per-configuration launch times as a text table."""
     lines = [f"{ROWS}-row kv_normal_batch launch, mean of {data['repeats']} (median in brackets)"]
     lines.append(f"{'configuration':<28}{'load':<7}{'layer':<11}{'1 thread ms':>12}"
                  f"{'2 threads ms':>13}{'2/1':>8}")

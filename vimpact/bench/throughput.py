@@ -46,6 +46,7 @@ from .machine import (
     figure,
     load_average,
     machine_info,
+    max_threads,
     progress,
     ratio_spread,
     save_figure,
@@ -93,7 +94,9 @@ def random_scenes(n: int, seed: int = 0) -> list[v.Scene]:
 
 def kernel_counts(table: pd.DataFrame, scenes: list[v.Scene], numerics: v.Numerics,
                   ) -> tuple[list[int], list[int]]:
-    """Time steps the kernel took (``n_steps`` column of
+    """Return the time steps and half-row elements of each scene.
+
+    Time steps the kernel took (``n_steps`` column of
     :func:`vimpact.simulate_batch`) and elements in the half row of each scene.
 
     Raises
@@ -121,16 +124,18 @@ def _baseline(impact: Callable[..., dict], scene: v.Scene, numerics: v.Numerics)
 
 def _naive_as_kernel(scene: v.Scene, steps: int, elements: int, row_width: float,
                      max_time: float) -> dict:
-    """The NumPy reference at the kernel's refinement of ``scene`` (the same work)."""
+    """Return the NumPy reference at the kernel's refinement of ``scene`` (the same work)."""
     return naive_impact(scene, steps, elements, row_width, max_time,
                         refinement=kernel_refinement(scene, steps, elements, row_width))
 
 
 def _entry(threads: int, steps: list[int], elements: list[int], seconds: list[float],
            cpu_seconds: list[float] | None = None) -> dict:
-    """One implementation's record: per-scene steps and row elements, raw,
-    median and least wall times (s), process CPU times (s, all threads) if
-    measured, and the rate (1/s) from the median."""
+    """One implementation's record.
+
+    Per-scene steps and row elements, raw, median and least wall times (s), process CPU
+    times (s, all threads) if measured, and the rate (1/s) from the median.
+    """
     updates = sum(k * n for k, n in zip(steps, elements))
     median = float(np.median(seconds))
     return {"threads": threads, "n_scenes": len(steps), "steps": steps, "elements": elements,
@@ -155,7 +160,7 @@ def run(quick: bool = False) -> dict:
     load_before = load_average()
     numerics: v.Numerics = cfg["numerics"]
     scenes = random_scenes(cfg["n_scenes"])
-    all_threads = numba.config.NUMBA_NUM_THREADS
+    all_threads = max_threads()
     thread_counts = [1, 2] if all_threads >= 2 else [1]
 
     # kernel: warm up (compile / load the cache), then 1 and 2 threads alternately
@@ -257,7 +262,7 @@ def figures(data: dict) -> dict:
 
 
 def report(data: dict) -> str:
-    """The rates as a text table, the ratios and the cores the 2 threads got."""
+    """Return the rates as a text table, the ratios and the cores the 2 threads got."""
     lines = ["kernels: " + ", ".join(data["kernel_paths"]),
              f"{'implementation':<18}{'threads':>8}{'scenes':>8}{'updates':>12}"
              f"{'median s':>10}{'updates/s':>11}"]

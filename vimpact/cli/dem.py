@@ -3,12 +3,14 @@
 from __future__ import annotations
 
 import argparse
+import math
 import os
 
 from vimpact.model.numerics import CONVERGED_PRESETS
 
 
 def add_parser(sub) -> None:
+    """Register ``vimpact dem`` and its options on the subcommand parser ``sub``."""
     from vimpact.dem import CODES  # the light list: the exports load scipy
 
     p = sub.add_parser(
@@ -43,6 +45,7 @@ def add_parser(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    """Run ``vimpact dem`` and return the exit code."""
     import json
     import sys
 
@@ -73,9 +76,11 @@ def run(args: argparse.Namespace) -> int:
                                          Numerics.preset(args.preset),
                                          steps_per_contact=args.steps_per_contact,
                                          progress=progress)
-        worst = max(f.res_e_z.max_abs for f in result.fits)
-        classes = {"size_classes": result.problem.size_classes,
-                   "types": len(result.problem.types), "target": args.residual,
+        worst = max((f.res_e_z.max_abs for f in result.fits if f.res_e_z is not None),
+                    default=math.nan)
+        final = result.problem or problem  # the problem refined to meet the residual
+        classes = {"size_classes": final.size_classes,
+                   "types": len(final.types), "target": args.residual,
                    "max_residual_e_z": worst, "met": met, "classes_needed": needed}
     else:
         result = export(problem, args.code, out, Numerics.preset(args.preset),
@@ -117,8 +122,11 @@ def _number(x):
 
 
 def to_json(result) -> dict:
-    """The fits of an export as plain data: per contact the constants (SI), the residuals
-    (code minus vimpact, dimensionless) and the notes; the files written."""
+    """Return the fits of an export as plain data.
+
+    Per contact the constants (SI), the residuals (code minus vimpact, dimensionless) and
+    the notes; the files written.
+    """
     def res(r):
         return None if r is None else {"max_abs": r.max_abs, "rms": r.rms}
 

@@ -26,7 +26,7 @@ class _Parser(argparse.ArgumentParser):
 
 
 def build_parser() -> argparse.ArgumentParser:
-    """The full ``vimpact`` parser (every subcommand registered)."""
+    """Return the full ``vimpact`` parser (every subcommand registered)."""
     parser = _Parser(prog="vimpact", description=(
         "Coefficients of restitution of a sphere hitting a viscoelastic "
         "half-space (method of dimensionality reduction)."))
@@ -38,9 +38,12 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def _negative_values(argv: list[str]) -> list[str]:
-    """``--E -1e9`` -> ``--E=-1e9``: argparse takes a token like ``-1e9`` (or
-    ``-inf``, ``-1/4``) for an option; joined to its flag it is read as the value
-    it is (and then refused by the option's own check with a message that names it)."""
+    """``--E -1e9`` -> ``--E=-1e9``.
+
+    Argparse takes a token like ``-1e9`` (or ``-inf``, ``-1/4``) for an option; joined to
+    its flag it is read as the value it is (and then refused by the option's own check
+    with a message that names it).
+    """
     out: list[str] = []
     for token in argv:
         if (out and out[-1].startswith("--") and "=" not in out[-1] and token.startswith("-")

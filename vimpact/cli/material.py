@@ -95,7 +95,7 @@ def _shift(a):
 
 
 def run_fit(a: argparse.Namespace) -> int:
-    """Handler of ``vimpact material fit``; returns the exit code."""
+    """Run ``vimpact material fit`` and return the exit code."""
     from vimpact.model.fit import DEFAULT_PER_DECADE, load_measurements
     from vimpact.model.material import Material, shear_modulus
     from vimpact.model.material_file import material_toml
@@ -156,7 +156,7 @@ def _named(data: str, fit, *args, **kwargs):
 
 
 def run_show(a: argparse.Namespace) -> int:
-    """Handler of ``vimpact material show``; returns the exit code."""
+    """Run ``vimpact material show`` and return the exit code."""
     from vimpact.model.material_file import load_material
 
     mat = load_material(a.file)
@@ -167,9 +167,11 @@ def run_show(a: argparse.Namespace) -> int:
         except ValueError as exc:
             raise ValueError(str(exc).replace("temperature (K) =", "--temperature =", 1)) \
                 from None
-        a_T = mat.shift.shift_factor(a.temperature)
+        shift = mat.shift
+        assert shift is not None  # at_temperature refused a material without a shift law
+        a_T = shift.shift_factor(a.temperature)
         lines.append(f"at {a.temperature:g} K: shift factor a_T = {a_T:.4g} "
-                     f"(log10 a_T = {mat.shift.log10_shift(a.temperature):.4g})")
+                     f"(log10 a_T = {shift.log10_shift(a.temperature):.4g})")
         mat = shifted
     lines.append(f"{mat.model}, nu = {mat.nu:g}")
     lines.append(f"  G_inf    {mat.G_inf:.4g} Pa (relaxed)")

@@ -26,11 +26,12 @@ def add_material_arguments(g, *, prony: bool) -> None:
 
 
 def missing(name: str, why: str) -> ValueError:
+    """Return the error for a missing option ``--name``, saying ``why`` it is needed."""
     return ValueError(f"--{name} is missing: {why}")
 
 
 def material_from_args(a) -> Material:
-    """The material described by parsed options (model inferred unless ``a.model``)."""
+    """Return the material described by parsed options (model inferred unless ``a.model``)."""
     if a.nu is None:
         raise missing("nu", "the Poisson ratio in [0, 0.5] is required")
     prony = getattr(a, "prony", None)
@@ -82,10 +83,12 @@ def material_from_args(a) -> Material:
 
 
 def as_flags(exc: ValueError, flags: dict[str, str]) -> ValueError:
-    """The error of an API parameter named by its command-line flag: every ``name = ``
-    (or ``name missing``) of ``flags`` (parameter -> flag) at the message's start or
-    after ``(``, ``, `` or ``; `` becomes ``flag = `` (``flag is missing``); the value
-    stays as it is."""
+    """Return the error of an API parameter named by its command-line flag.
+
+    Every ``name = `` (or ``name missing``) of ``flags`` (parameter -> flag) at the
+    message's start or after ``(``, ``, `` or ``; `` becomes ``flag = `` (``flag is
+    missing``); the value stays as it is.
+    """
     named = re.compile(r"(^|\(|, |; )(" + "|".join(sorted(map(re.escape, flags), key=len,
                                                            reverse=True))
                        + r")( = | is missing| missing)")

@@ -8,6 +8,7 @@ import json
 import math
 import os
 from pathlib import Path
+from typing import Any
 
 from vimpact import __version__
 from vimpact.cli.material_args import add_material_arguments, as_flags, material_from_args, missing
@@ -112,8 +113,11 @@ def add_parser(sub) -> argparse.ArgumentParser:
 
 
 def _count(text: str) -> int:
-    """An integer option; an integral float such as ``1e3`` is read as that integer (its
-    range is checked by :class:`Numerics`, with a message that names the option)."""
+    """Read an integer option.
+
+    Return an integer option; an integral float such as ``1e3`` is read as that integer (its
+    range is checked by :class:`Numerics`, with a message that names the option).
+    """
     try:
         return int(text)
     except ValueError:
@@ -142,12 +146,12 @@ _SCALE_OPTIONS = ("E", "G", "G1", "G2", "eta", "prony", "R", "m", "Theta", "vz0"
 
 
 def _as_flags(exc: ValueError) -> InputError:
-    """The error of a Scene/Material/Numerics parameter, named by its command-line flag."""
+    """Return the error of a Scene/Material/Numerics parameter, named by its command-line flag."""
     return InputError(str(as_flags(exc, _FLAGS)))
 
 
 def scene_from_args(a) -> Scene:
-    """The scene described by parsed ``simulate`` options (errors name the flags)."""
+    """Return the scene described by parsed ``simulate`` options (errors name the flags)."""
     try:
         return _scene_from_args(a)
     except ScaleError as exc:  # no one input is at fault: name the options that set the scales
@@ -163,7 +167,7 @@ def scene_from_args(a) -> Scene:
 
 
 def _scene_from_args(a) -> Scene:
-    effects = {k: getattr(a, k) if getattr(a, k) is not None else default
+    effects: dict[str, Any] = {k: getattr(a, k) if getattr(a, k) is not None else default
                for k, default in _EFFECTS.items()}
     effects["rotation"] = not a.no_rotation
     if a.mu is not None:
@@ -208,8 +212,10 @@ def _scene_from_args(a) -> Scene:
 
 
 def _material_file(a):
-    """The material of ``--material FILE`` (at ``--temperature``); material options
-    beside it are refused."""
+    """Return the material of ``--material FILE`` (at ``--temperature``).
+
+    Material options beside it are refused.
+    """
     from vimpact.model.material_file import load_material  # TOML reading: only when asked
 
     given = [f"--{n}" for n in ("model", "E", "G", "eta", "G1", "G2", "prony", "nu")
@@ -255,7 +261,7 @@ def _scene_file(a) -> tuple[Scene, Numerics | None]:
 
 
 def _numerics(a, base: Numerics | None = None) -> Numerics:
-    """The numerics of the options: a preset, a tolerance or the file's, then overrides."""
+    """Return the numerics of the options: a preset, a tolerance or the file's, then overrides."""
     if a.tolerance is not None and a.numerics is not None:
         raise ValueError(f"--tolerance = {a.tolerance:g} cannot be combined with "
                          f"--numerics = {a.numerics}: give one of them")
@@ -281,8 +287,10 @@ def numerics_from_args(a, base: Numerics | None = None) -> Numerics:
 
 
 def _check_output(flag: str, path: str, suffixes: tuple[str, ...]) -> Path:
-    """Refuse an output path before any work: wrong extension, a directory, a
-    missing or unwritable folder."""
+    """Refuse an output path before any work.
+
+    Wrong extension, a directory, a missing or unwritable folder.
+    """
     from vimpact.sweep.store import refuse_symlink  # the one rule for files vimpact writes
 
     out = Path(path)
@@ -301,7 +309,7 @@ def _check_output(flag: str, path: str, suffixes: tuple[str, ...]) -> Path:
 
 
 def run(a) -> int:
-    """Handler of ``vimpact simulate``; returns the exit code."""
+    """Run ``vimpact simulate`` and return the exit code."""
     if a.trajectory:
         _check_output("--trajectory", a.trajectory, (".csv", ".parquet"))
     if a.scene is not None:
@@ -329,11 +337,13 @@ def run(a) -> int:
 
         out = Path(a.trajectory)
         csv = out.suffix.lower() == ".csv"
+        trajectory = res.trajectory
+        assert trajectory is not None  # simulate(..., trajectory=True) recorded it
         with atomic_file(out, "--trajectory", mode="w" if csv else "wb") as f:
             if csv:
-                res.trajectory.to_csv(f, index=False)
+                trajectory.to_csv(f, index=False)
             else:
-                res.trajectory.to_parquet(f, index=False)
+                trajectory.to_parquet(f, index=False)
     extra = _adhesion_outputs(scene, numerics, a.sticking_velocity)
     if a.json:
         d = res.to_json_dict()
@@ -351,7 +361,7 @@ def run(a) -> int:
 
 
 def _adhesion_outputs(scene: Scene, numerics: Numerics, sticking: bool) -> dict:
-    """The adhesive impact's own outputs (empty without adhesion), SI units in the names."""
+    """Return the adhesive impact's own outputs (empty without adhesion), SI units in names."""
     if scene.adhesion <= 0.0:
         return {}
     from vimpact.engine.adhesion import STICKING_RTOL, simulate_adhesive, sticking_velocity

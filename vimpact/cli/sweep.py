@@ -63,7 +63,7 @@ def add_parser(subparsers):
 
 
 def cmd_sweep(args) -> int:
-    """Handler of ``vimpact sweep``: returns the exit code (0, or 130 on Ctrl-C)."""
+    """Run ``vimpact sweep`` and return the exit code (0, or 130 on Ctrl-C)."""
     from vimpact.sweep import SweepInterrupted, run_sweep, summary
 
     t0 = time.perf_counter()

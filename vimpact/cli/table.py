@@ -174,8 +174,11 @@ def _open(path):
 
 
 def _plain(x):
-    """``x`` with non-finite floats as text (``"inf"``: mu of a full-stick row), so the
-    JSON is standard."""
+    """Return ``x`` with non-finite floats as text.
+
+    ``x`` with non-finite floats as text (``"inf"``: mu of a full-stick row), so the
+    JSON is standard.
+    """
     if isinstance(x, dict):
         return {k: _plain(v) for k, v in x.items()}
     if isinstance(x, (list, tuple)):

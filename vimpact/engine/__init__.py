@@ -1,2 +1,5 @@
-"""From validated scenes to results: routing (which kernel, why), packing into
-kernel arrays, running, and unpacking into SI result columns."""
+"""From validated scenes to results.
+
+Routing (which kernel, why), packing into kernel arrays, running, and unpacking into SI
+result columns.
+"""

@@ -85,16 +85,20 @@ class AdhesiveResult:
 
 
 def adhesion_number(scene: Scene) -> float:
-    """``lam = sqrt(2 pi a_H dgamma / E*) / d``: the critical elongation of the rule of
-    Hess at the Hertz radius in units of the Hertz indentation (relaxed modulus),
-    dimensionless (0 without adhesion)."""
+    """Return the adhesion number ``lam = sqrt(2 pi a_H dgamma / E*) / d``, dimensionless.
+
+    The critical elongation of the rule of Hess at the Hertz radius in units of the
+    Hertz indentation (relaxed modulus); 0 without adhesion.
+    """
     hz = scene.hertz
     return math.sqrt(2.0 * math.pi * float(hz.a_H) * scene.adhesion / scene.E_star) / float(hz.d)
 
 
 def adhesion_for_number(scene: Scene, lam: float) -> float:
-    """The work of adhesion (J/m^2) that gives ``scene`` the adhesion number ``lam``
-    (the inverse of :func:`adhesion_number`): ``dgamma = lam^2 d^2 E* / (2 pi a_H)``."""
+    """Return the work of adhesion (J/m^2) that gives ``scene`` the adhesion number ``lam``.
+
+    The inverse of :func:`adhesion_number`: ``dgamma = lam^2 d^2 E* / (2 pi a_H)``.
+    """
     lam = positive("lam", lam)
     hz = scene.hertz
     return lam**2 * float(hz.d) ** 2 * scene.E_star / (2.0 * math.pi * float(hz.a_H))
@@ -173,7 +177,7 @@ def _result(scene: Scene, out: np.ndarray, lam: float) -> AdhesiveResult:
 
 def sticking_velocity(scene: Scene, numerics: Numerics | None = None, *,
                       rtol: float = STICKING_RTOL, v_max: float | None = None) -> float:
-    """The impact speed (m/s) below which the sphere of ``scene`` sticks.
+    """Return the impact speed (m/s) below which the sphere of ``scene`` sticks.
 
     Bisection on ``v_z0`` (the other inputs of ``scene`` kept) between a speed at
     which the sphere sticks and one at which it separates, to the relative
@@ -229,7 +233,7 @@ def sticking_velocity(scene: Scene, numerics: Numerics | None = None, *,
 def jkr_quasi_static(E_star: float, R: float, dgamma: float, d_path: np.ndarray,
                      elements_per_unit: float = 200.0, length: float | None = None
                      ) -> tuple[np.ndarray, np.ndarray]:
-    """The elastic adhesive element row under a prescribed indentation path.
+    """Run the elastic adhesive element row under a prescribed indentation path.
 
     Parameters
     ----------
@@ -268,9 +272,11 @@ def jkr_quasi_static(E_star: float, R: float, dgamma: float, d_path: np.ndarray,
 
 
 def impact_result(scene: Scene, numerics: Numerics | None = None) -> ImpactResult:
-    """:func:`simulate_adhesive` as the :class:`~vimpact.ImpactResult` of
-    :func:`vimpact.simulate` (normal impact only: e_x, beta_x NaN; status ``stuck``
-    when the sphere did not separate, else ``normal_only``/``vc0_zero``)."""
+    """Return :func:`simulate_adhesive` as the :class:`~vimpact.ImpactResult` of simulate.
+
+    Normal impact only: e_x, beta_x NaN; status ``stuck`` when the sphere did not
+    separate, else ``normal_only``/``vc0_zero``.
+    """
     res = simulate_adhesive(scene, numerics)
     hz = scene.hertz
     status = res.status

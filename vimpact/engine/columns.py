@@ -1,6 +1,6 @@
 """Scenes as columns: validated, vectorized inputs of the batch path.
 
-Data flow (DESIGN.md): inputs -> :class:`SceneColumns` (this module) -> kernel
+Data flow: inputs -> :class:`SceneColumns` (this module) -> kernel
 arrays (:mod:`vimpact.engine.pack`) -> kernels -> SI result columns
 (:mod:`vimpact.engine.unpack`). One scene is one row; nothing here builds a
 Python object per row.
@@ -80,6 +80,27 @@ _OTHER = ("Theta_kg_m2", "theta_ratio", "rotation", "model")
 MODEL_ELASTIC, MODEL_KELVIN_VOIGT, MODEL_STANDARD_SOLID, MODEL_PRONY = range(4)
 
 
+class _once:  # noqa: N801 - used as a decorator, like property
+    """Decorate a derived column: computed on first access, then kept.
+
+    A derived column computed on first access and then kept in the instance
+    (``functools.cached_property`` without its lock, which costs more than the
+    one-row arithmetic it saves).
+    """
+
+    def __init__(self, fn):
+        self.fn, self.__doc__ = fn, fn.__doc__
+
+    def __set_name__(self, owner, name: str) -> None:
+        self.name = name
+
+    def __get__(self, obj, owner=None):
+        if obj is None:
+            return self
+        value = obj.__dict__[self.name] = self.fn(obj)
+        return value
+
+
 @dataclass
 class SceneColumns:
     """A batch of scenes as arrays (SI units), validated, with derived Hertz scales.
@@ -128,43 +149,49 @@ class SceneColumns:
         return self.nu.shape[0]
 
     # ---- derived, vectorized (docs/physics.md#method-of-dimensionality-reduction,
-    # docs/physics.md#energy-and-passivity, docs/physics.md#dimensionless-parameters) ------
-    @property
+    # docs/physics.md#energy-and-passivity, docs/physics.md#dimensionless-parameters);
+    # the ones routing, packing and unpacking all read are computed once per batch
+    # (:data:`_DERIVED`; :meth:`check_scales` forgets them when it rewrites rows) ----
+    @_once
     def valid(self) -> np.ndarray:
-        """Rows without a reason to refuse them (valid scenes), bool."""
+        """Rows without a reason to refuse them, bool.
+
+        Rows without a reason to refuse them (valid scenes), bool (kept until
+        :meth:`check_scales` gives a row a reason).
+        """
         return is_none(self.reasons)
 
-    @property
+    @_once
     def v_c0(self) -> np.ndarray:
         """Initial contact-point velocity ``v_x0 + R omega0``, m/s."""
         return self.v_x0 + self.R * self.omega0
 
-    @property
+    @_once
     def theta_ratio(self) -> np.ndarray:
         """``Theta / (m R^2)``, dimensionless."""
         return self.Theta / (self.m * self.R**2)
 
-    @property
+    @_once
     def contact_mass_factor(self) -> np.ndarray:
         """``1 + m R^2 / Theta`` (1 without rotation), dimensionless."""
         return np.where(self.rotation, 1.0 + 1.0 / self.theta_ratio, 1.0)
 
-    @property
+    @_once
     def kappa(self) -> np.ndarray:
         """``c_t / c_n = 2 (1 - nu) / (2 - nu)``, dimensionless."""
         return 2.0 * (1.0 - self.nu) / (2.0 - self.nu)
 
-    @property
+    @_once
     def computes_tangential(self) -> np.ndarray:
         """The tangential problem is solved: asked for and ``v_c0 != 0``."""
         return (self.tangential != TANGENTIAL_EFFECTS.index("none")) & (self.v_c0 != 0.0)
 
-    @property
+    @_once
     def has_arms(self) -> np.ndarray:
         """Rows with at least one Maxwell arm, bool."""
         return np.any(self.G_arm > 0.0, axis=1)
 
-    @property
+    @_once
     def dashpot_time(self) -> np.ndarray:
         """``eta0 / G_inf``, s."""
         return self.eta0 / self.G_inf
@@ -185,7 +212,7 @@ class SceneColumns:
         return np.where(self.model == MODEL_STANDARD_SOLID, q2, np.nan)
 
     def take(self, index) -> SceneColumns:
-        """The rows ``index`` (an integer array or a mask) as a new batch."""
+        """Return the rows ``index`` (an integer array or a mask) as a new batch."""
         fields = {k: getattr(self, k)[index] for k in _FIELDS}
         return SceneColumns(**fields)
 
@@ -196,37 +223,38 @@ class SceneColumns:
         n = len(scenes)
         k = max((len(s.material.arms) for s in scenes if isinstance(s, Scene)), default=0)
         G_arm, tau_arm = np.zeros((n, k)), np.zeros((n, k))
-        get = {name: np.empty(n) for name in ("nu", "G_inf", "eta0", "R", "m", "v_z0", "v_x0",
-                                               "omega0", "Theta", "mu")}
-        codes = {name: np.zeros(n, dtype=np.int8) for name in ("tangential", "memory", "model")}
-        rotation = np.ones(n, dtype=bool)
-        large = np.zeros(n, dtype=bool)
         reasons = np.full(n, None, dtype=object)
+        numbers, codes, flags = [], [], []  # a tuple per row, one array each at the end
         for i, s in enumerate(scenes):
             if not isinstance(s, Scene):  # a bad entry is a bad row, not a lost batch
                 reasons[i] = message(f"scenes[{i}]", s, "a vimpact.Scene")
+                numbers.append(_NEUTRAL_ROW)
+                codes.append((0, 0, 0))
+                flags.append((True, False))
                 continue
             mat = s.material
-            get["nu"][i], get["G_inf"][i], get["eta0"][i] = mat.nu, mat.G_inf, mat.eta0
+            numbers.append((mat.nu, mat.G_inf, mat.eta0, s.R, s.m, s.v_z0, s.v_x0, s.omega0,
+                            s.Theta, s.mu))
             for j, (G, tau) in enumerate(mat.arms):
                 G_arm[i, j], tau_arm[i, j] = G, tau
-            get["R"][i], get["m"][i], get["v_z0"][i] = s.R, s.m, s.v_z0
-            get["v_x0"][i], get["omega0"][i], get["Theta"][i], get["mu"][i] = (
-                s.v_x0, s.omega0, s.Theta, s.mu)
-            codes["tangential"][i] = TANGENTIAL_EFFECTS.index(s.tangential)
-            codes["memory"][i] = TANGENTIAL_MEMORY.index(s.tangential_memory)
-            codes["model"][i] = MODELS.index(mat.model)
-            rotation[i], large[i] = s.rotation, s.allow_large_contact
+            codes.append((TANGENTIAL_EFFECTS.index(s.tangential),
+                          TANGENTIAL_MEMORY.index(s.tangential_memory), MODELS.index(mat.model)))
+            flags.append((s.rotation, s.allow_large_contact))
             if s.adhesion > 0.0:  # not a batch effect: never run it as if without adhesion
                 reasons[i] = (f"scenes[{i}]: adhesion = {s.adhesion!r} J/m^2 is simulated one "
                               "scene at a time (vimpact.simulate); the batch path has no "
                               "adhesion")
-        cols = dict(G_arm=G_arm, tau_arm=tau_arm, rotation=rotation, allow_large_contact=large,
-                    reasons=reasons, **get, **codes)
+        # (fields, n) copies: every column a contiguous row of one array
+        number = np.array(numbers, dtype=float).reshape(n, len(_SCENE_NUMBERS)).T.copy()
+        code = np.array(codes, dtype=np.int8).reshape(n, 3).T.copy()
+        flag = np.array(flags, dtype=bool).reshape(n, 2).T.copy()
+        cols = dict(zip(_SCENE_NUMBERS, number), G_arm=G_arm, tau_arm=tau_arm,
+                    tangential=code[0], memory=code[1], model=code[2], rotation=flag[0],
+                    allow_large_contact=flag[1], reasons=reasons)
         _neutralize(cols)
-        out = cls(**cols)
-        out.check_scales()
-        return out
+        # no check_scales: a Scene checked the same ranges when it was made
+        # (ScaleError), and a row that is not a Scene is already marked
+        return cls(**cols)
 
     @classmethod
     def from_columns(cls, data) -> SceneColumns:
@@ -303,8 +331,10 @@ class SceneColumns:
         return out
 
     def check_scales(self) -> None:
-        """Mark rows whose Hertz scales (or kernel-unit inputs) are not finite numbers:
-        inputs whose arithmetic leaves the float range (e.g. ``v_z0 = 1e200``)."""
+        """Mark rows whose Hertz scales (or kernel-unit inputs) are not finite numbers.
+
+        Inputs whose arithmetic leaves the float range (e.g. ``v_z0 = 1e200``).
+        """
         with np.errstate(all="ignore"):
             tau0 = self.dashpot_time / self.T
             ok = (np.isfinite(self.d) & (self.d > 0) & np.isfinite(self.T) & (self.T > 0)
@@ -317,6 +347,7 @@ class SceneColumns:
                                 + self.Theta * self.omega0**2)
                   & np.isfinite(self.v_c0**2 / self.contact_mass_factor))
         for i in np.flatnonzero(~ok & self.valid):
+            self.__dict__.pop("valid", None)
             self.reasons[i] = (
                 f"the inputs of this row (G_inf = {self.G_inf[i]:.3g} Pa, R = {self.R[i]:.3g} m, "
                 f"m = {self.m[i]:.3g} kg, v_z0 = {self.v_z0[i]:.3g} m/s, v_x0 = "
@@ -326,6 +357,7 @@ class SceneColumns:
         with np.errstate(all="ignore"):
             damped = ok & (tau0 > MAX_DASHPOT_TIME)
         for i in np.flatnonzero(damped & self.valid):
+            self.__dict__.pop("valid", None)
             self.reasons[i] = (
                 f"eta0_Pa_s = {self.eta0[i]:.3g} is not allowed in this row: the dashpot time "
                 f"eta0 / G_inf must be <= {MAX_DASHPOT_TIME:.0e} T = "
@@ -337,18 +369,28 @@ class SceneColumns:
             fields = {k: getattr(self, k) for k in _FIELDS}
             _neutralize(fields)
             self.__post_init__()
+            for name in _DERIVED:  # computed from the rows before they were neutralized
+                self.__dict__.pop(name, None)
 
 
 _FIELDS = ("nu", "G_inf", "eta0", "G_arm", "tau_arm", "R", "m", "v_z0", "v_x0", "omega0",
            "Theta", "mu", "tangential", "memory", "model", "rotation", "allow_large_contact",
            "reasons")
+#: the numeric fields of :meth:`SceneColumns.from_scenes`, in the order it reads them
+_SCENE_NUMBERS = ("nu", "G_inf", "eta0", "R", "m", "v_z0", "v_x0", "omega0", "Theta", "mu")
+#: derived columns computed once per batch (:class:`_once`)
+_DERIVED = ("valid", "v_c0", "theta_ratio", "contact_mass_factor", "kappa", "computes_tangential",
+            "has_arms", "dashpot_time")
 #: harmless values written into invalid rows, so that no arithmetic on them warns
 _NEUTRAL = {"nu": 0.5, "G_inf": 1.0, "eta0": 0.0, "R": 1.0, "m": 1.0, "v_z0": 1.0, "v_x0": 0.0,
             "omega0": 0.0, "Theta": 0.4, "mu": math.inf}
 
+#: a row that is not a Scene, in the order of :data:`_SCENE_NUMBERS`
+_NEUTRAL_ROW = tuple(_NEUTRAL[name] for name in _SCENE_NUMBERS)
+
 
 def _as_array(values) -> np.ndarray:
-    """A column as an array without NumPy's coercion of mixed lists to strings."""
+    """Return a column as an array without NumPy's coercion of mixed lists to strings."""
     if isinstance(values, np.ndarray) or hasattr(values, "dtype"):
         return np.asarray(values)
     if np.ndim(values) == 0 or isinstance(values, (str, bytes)):

@@ -21,10 +21,13 @@ MAX_TIME_STRETCH = 1e4
 
 
 def stiffness_ratio(cols) -> np.ndarray:
-    """How much stiffer than the relaxed modulus the half-space acts during the
+    """Return how much stiffer than relaxed the half-space acts in contact, per row.
+
+    How much stiffer than the relaxed modulus the half-space acts during the
     contact, ``1 + sum g_i tau_i / (tau_i + t_H)`` (``g_i = G_i / G_inf``):
     an arm whose time is long against the Hertz time is a spring, one whose
-    time is short relaxes away. Dimensionless, >= 1, one value per row."""
+    time is short relaxes away. Dimensionless, >= 1, one value per row.
+    """
     g = cols.G_arm / cols.G_inf[:, None]
     tau = cols.tau_arm
     return 1.0 + (g * tau / (tau + cols.t_H[:, None])).sum(axis=1)
@@ -32,7 +35,9 @@ def stiffness_ratio(cols) -> np.ndarray:
 
 def refinement(cols, numerics: Numerics, tangential: np.ndarray, integrator: int
                ) -> tuple[np.ndarray, np.ndarray]:
-    """Factors (>= 1) by which the time step and the element spacing are made
+    """Return the factors (>= 1) refining the time step and the element spacing, per row.
+
+    Factors (>= 1) by which the time step and the element spacing are made
     finer than ``t_H / steps`` and ``a_H / elements``, per row: the numerics
     resolve the stiffest mode as well as they resolve a relaxed elastic impact.
 
@@ -77,16 +82,21 @@ def refinement(cols, numerics: Numerics, tangential: np.ndarray, integrator: int
 
 
 def time_limit(cols, numerics: Numerics) -> np.ndarray:
-    """Time limit of each impact in units of ``T``: ``max_time`` Hertz times,
-    stretched by the slow creep back of a viscous surface."""
+    """Time limit of each impact in units of ``T``.
+
+    ``max_time`` Hertz times, stretched by the slow creep back of a viscous surface.
+    """
     viscous = cols.dashpot_time + (cols.G_arm * cols.tau_arm).sum(axis=1) / cols.G_inf  # s
     stretch = np.minimum(10.0 * viscous / cols.T, MAX_TIME_STRETCH)
     return numerics.max_time * HERTZ_TIME_FACTOR * (1.0 + stretch)
 
 
 def element_row(cols, numerics: Numerics, tangential: np.ndarray, integrator: int) -> dict:
-    """Step ``h`` / T, element spacing ``dxi`` / a_H, elements in the half row
-    ``n_elem`` and the time limit in steps ``max_steps``, per row."""
+    """Return the element row and time step of each row, kernel units.
+
+    Step ``h`` / T, element spacing ``dxi`` / a_H, elements in the half row
+    ``n_elem`` and the time limit in steps ``max_steps``, per row.
+    """
     time_factor, element_factor = refinement(cols, numerics, tangential, integrator)
     h = HERTZ_TIME_FACTOR / numerics.steps / time_factor
     per_a_H = np.ceil(numerics.elements * element_factor)

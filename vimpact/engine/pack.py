@@ -24,8 +24,11 @@ CONTINUUM_STICK_MAX_STEPS = 200_000
 
 
 def arm_arrays(cols: SceneColumns, keep: bool = True) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """``g = G_i / G_inf``, ``tau = tau_i / T`` as ``(n, max_arms)`` with the real arms of
-    a row first, and their count ``n_arms`` (``keep=False``: no arms at all)."""
+    """Return the arms in kernel units, the real arms of a row first, and their count.
+
+    ``g = G_i / G_inf``, ``tau = tau_i / T`` as ``(n, max_arms)`` with the real arms of
+    a row first, and their count ``n_arms`` (``keep=False``: no arms at all).
+    """
     n = len(cols)
     real = cols.G_arm > 0.0
     n_arms = real.sum(axis=1).astype(np.int64)
@@ -67,9 +70,12 @@ def element_arrays(cols: SceneColumns, numerics: Numerics, spec: KernelSpec) -> 
 
 def run_path(path: Path, cols: SceneColumns, numerics: Numerics, rec: np.ndarray,
              rec_every: int, out: np.ndarray, arrays: dict | None = None) -> None:
-    """Run the rows ``cols`` on ``path``, results into ``out`` (``(n, N_OUT)``) and
+    """Run the rows ``cols`` on the kernel of ``path``.
+
+    Run the rows ``cols`` on ``path``, results into ``out`` (``(n, N_OUT)``) and
     the trajectory buffer ``rec`` (``(n, n_rec, N_REC)``; ``n_rec`` may be 0).
-    ``arrays``: the element-kernel inputs if already made (:func:`element_arrays`)."""
+    ``arrays``: the element-kernel inputs if already made (:func:`element_arrays`).
+    """
     if path.kind == CONTINUUM_STICK:
         g, tau, n_arms = arm_arrays(cols)
         args = (cols.dashpot_time / cols.T, g, tau, n_arms, cols.kappa, cols.contact_mass_factor,
@@ -100,6 +106,9 @@ def run_path(path: Path, cols: SceneColumns, numerics: Numerics, rec: np.ndarray
 
 
 def interleave(n: int, threads: int) -> np.ndarray:
-    """An order that hands every thread of a static ``prange`` split a mix of the
-    rows (neighbouring rows of a grid cost alike)."""
+    """Return a row order that gives every thread a mix of the rows.
+
+    An order that hands every thread of a static ``prange`` split a mix of the
+    rows (neighbouring rows of a grid cost alike).
+    """
     return np.concatenate([np.arange(k, n, threads) for k in range(threads)])

@@ -106,11 +106,11 @@ class ImpactResult:
     trajectory: pd.DataFrame | None = field(default=None, repr=False, compare=False)
 
     def to_dict(self) -> dict:
-        """Outputs as a plain dict (NaN kept as float NaN; no trajectory)."""
+        """Return the outputs as a plain dict (NaN kept as float NaN; no trajectory)."""
         return {name: getattr(self, name) for name in RESULT_FIELDS}
 
     def to_json_dict(self) -> dict:
-        """Outputs for JSON: NaN and inf become ``None`` (JSON null); units under ``"units"``."""
+        """Return the outputs for JSON: NaN and inf become ``None`` (JSON null); units under ``"units"``."""
         d = {k: (None if isinstance(v, float) and not math.isfinite(v) else v)
              for k, v in self.to_dict().items()}
         d["units"] = dict(UNITS)

@@ -135,7 +135,8 @@ def route(cols: SceneColumns, numerics: Numerics) -> Routes:
     key = np.where(valid, key, -1)
     paths: list[Path] = []
     group = np.full(len(cols), -1, dtype=np.int64)
-    for k in np.unique(key[key >= 0]):
+    keys = key[key >= 0]
+    for k in (np.unique(keys) if len(keys) > 16 else sorted(set(keys.tolist()))):
         rows = key == k
         if k >> 5 == 1:
             path = CONTINUUM_KV

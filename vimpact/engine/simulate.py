@@ -1,6 +1,6 @@
 """Run impacts: scenes in, results out.
 
-Data flow (DESIGN.md): scenes (``Scene`` objects or input columns) ->
+Data flow: scenes (``Scene`` objects or input columns) ->
 :class:`~vimpact.engine.columns.SceneColumns` (validated, vectorized) ->
 routing by masks (:func:`~vimpact.engine.routing.route`) -> kernel arrays per
 path (:mod:`~vimpact.engine.pack`) -> one parallel kernel call per path ->
@@ -19,7 +19,7 @@ from vimpact.engine.columns import SceneColumns, scene_columns
 from vimpact.engine.pack import element_arrays, interleave, run_path
 from vimpact.engine.result import RESULT_FIELDS, ImpactResult
 from vimpact.engine.routing import CONTINUUM_STICK, choose_path, route
-from vimpact.engine.unpack import unpack
+from vimpact.engine.unpack import unpack, unpack_row
 from vimpact.kernels import layout
 from vimpact.model.hertz import HERTZ_TIME_FACTOR
 from vimpact.model.numerics import MAX_ELEMENTS_IN_ROW, MAX_STEPS_PER_T_H, Numerics
@@ -53,11 +53,27 @@ def _numerics(numerics) -> Numerics:
 def run_columns(cols: SceneColumns, numerics: Numerics, n_rec: int = 0, rec_every: int = 1,
                 timings: dict | None = None
                 ) -> tuple[dict[str, np.ndarray], np.ndarray, np.ndarray]:
-    """Route, pack, run and unpack a batch: the result columns, the trajectory
-    buffer ``(n, n_rec, N_REC)`` (kernel units) and the rows written in it.
+    """Route, pack, run and unpack a batch.
+
+    The result columns, the trajectory buffer ``(n, n_rec, N_REC)`` (kernel units) and the
+    rows written in it.
 
     Rows the full-stick continuum kernel hands back (its assumptions broke, or
     its step limit) run again on the element kernel their effects call for.
+    """
+    out, rec, path_names, explicit_euler, steps_per_T, refused = _run(
+        cols, numerics, n_rec, rec_every, timings)
+    written = out[:, layout.OUT_N_REC].astype(np.int64)
+    return unpack(cols, out, path_names, explicit_euler, steps_per_T, refused), rec, written
+
+
+def _run(cols: SceneColumns, numerics: Numerics, n_rec: int, rec_every: int,
+         timings: dict | None) -> tuple[np.ndarray, ...]:
+    """Route, pack and run a batch; return the kernel rows and what unpack takes.
+
+    Route, pack and run: the kernel rows ``out``, the trajectory buffer, and per
+    row the path name, explicit Euler, steps per ``T`` and refusal that
+    :func:`~vimpact.engine.unpack.unpack` takes (:func:`run_columns`).
     """
     import numba
 
@@ -93,10 +109,11 @@ def run_columns(cols: SceneColumns, numerics: Numerics, n_rec: int = 0, rec_ever
                 costly[:] = True
             explicit_euler[idx] = path.spec.integrator == layout.EULER
             steps_per_T[idx] = 1.0 / arrays["h"]
-            idx = idx[~costly]
-            arrays = {key: value[~costly] for key, value in arrays.items()}
-            if len(idx) == 0:
-                continue
+            if costly.any():
+                idx = idx[~costly]
+                arrays = {key: value[~costly] for key, value in arrays.items()}
+                if len(idx) == 0:
+                    continue
         if n_rec == 0 and len(idx) > threads:
             order = interleave(len(idx), threads)
             idx = idx[order]
@@ -128,14 +145,16 @@ def run_columns(cols: SceneColumns, numerics: Numerics, n_rec: int = 0, rec_ever
                 queue.extend((p, rows[again.group == k]) for k, p in enumerate(again.paths))
     if timings is not None:
         timings["kernel_s"] = timings.get("kernel_s", 0.0) + kernel_s
-    written = out[:, layout.OUT_N_REC].astype(np.int64)
-    return unpack(cols, out, path_names, explicit_euler, steps_per_T, refused), rec, written
+    return out, rec, path_names, explicit_euler, steps_per_T, refused
 
 
 def _rows(cols: SceneColumns, idx: np.ndarray) -> SceneColumns:
-    """``cols.take(idx)``, or ``cols`` itself if ``idx`` is all its rows in order
-    (one path for the whole batch, as for a single impact: no copy)."""
-    if len(idx) == len(cols) and (len(idx) == 0 or (idx[0] == 0 and idx[-1] == len(idx) - 1
+    """Return the rows ``idx`` of ``cols``, without a copy when they are all of it.
+
+    ``cols.take(idx)``, or ``cols`` itself if ``idx`` is all its rows in order
+    (one path for the whole batch, as for a single impact: no copy).
+    """
+    if len(idx) == len(cols) and (len(idx) <= 1 or (idx[0] == 0 and idx[-1] == len(idx) - 1
                                                     and bool(np.all(np.diff(idx) == 1)))):
         return cols
     return cols.take(idx)
@@ -147,24 +166,27 @@ def simulate_batch(scenes, numerics: Numerics | str | None = None, *,
 
     Parameters
     ----------
-    scenes : a sequence of :class:`vimpact.Scene`, or scene columns: a
-        ``DataFrame`` or a mapping of equal-length arrays (names and units in
-        :mod:`vimpact.engine.columns`: ``nu``, ``G_inf_Pa``, ``R_m``, ``m_kg``,
-        ``v_z0_m_s`` required; ``eta0_Pa_s``, ``G_arm<i>_Pa``, ``tau_arm<i>_s``,
-        ``v_x0_m_s``, ``omega0_rad_s``, ``Theta_kg_m2`` or ``theta_ratio``,
-        ``tangential``, ``tangential_memory``, ``rotation``, ``mu``, ``model``
-        optional)
-    numerics : discretization (default ``Numerics()``) or a preset name
-    timings : if given, a dict that receives ``kernel_s`` (seconds in the
-        kernels) and ``total_s`` (the whole call)
+    scenes : sequence of Scene, pandas.DataFrame or mapping of array_like
+        The impacts: :class:`vimpact.Scene` objects, or scene columns of equal
+        length (names and units in :mod:`vimpact.engine.columns`: ``nu``,
+        ``G_inf_Pa``, ``R_m``, ``m_kg``, ``v_z0_m_s`` required; ``eta0_Pa_s``,
+        ``G_arm<i>_Pa``, ``tau_arm<i>_s``, ``v_x0_m_s``, ``omega0_rad_s``,
+        ``Theta_kg_m2`` or ``theta_ratio``, ``tangential``, ``tangential_memory``,
+        ``rotation``, ``mu``, ``model`` optional).
+    numerics : Numerics or str, optional
+        Discretization (default ``Numerics()``) or a preset name.
+    timings : dict, optional
+        If given, receives ``kernel_s`` (s in the kernels) and ``total_s`` (s, the
+        whole call).
 
     Returns
     -------
-    One row per scene, in order, with the columns of :class:`vimpact.ImpactResult`
-    (units in :data:`vimpact.UNITS`) and ``error``. A row that fails (bad input:
-    status ``invalid`` with the reason in ``error``; half-space exceeded, time
-    limit, ...) gets its status and NaN outputs; the others are unaffected.
-    Nothing is raised for a bad row.
+    pandas.DataFrame
+        One row per scene, in order, with the columns of :class:`vimpact.ImpactResult`
+        (units in :data:`vimpact.UNITS`) and ``error``. A row that fails (bad input:
+        status ``invalid`` with the reason in ``error``; half-space exceeded, time
+        limit, ...) gets its status and NaN outputs; the others are unaffected.
+        Nothing is raised for a bad row.
     """
     t0 = time.perf_counter()
     numerics = _numerics(numerics)
@@ -185,13 +207,21 @@ def simulate(scene: Scene, numerics: Numerics | str | None = None, *,
 
     Parameters
     ----------
-    scene : the impact
-    numerics : discretization (default ``Numerics()``: about 1e-4 on e_z, e_x)
-        or a preset name (``"fast"``, ``"default"``, ``"precise"``, ``"thesis"``)
-    trajectory : also record the time series (``ImpactResult.trajectory``, a
-        DataFrame with columns ``t_s, u_z_m, v_z_m_s, v_x_m_s, omega_rad_s,
-        F_z_N, F_x_N, a_m, slip_width_m``; about 500 rows per Hertz time on the element
-        path, one row per accepted step on the continuum path)
+    scene : Scene
+        The impact.
+    numerics : Numerics or str, optional
+        Discretization (default ``Numerics()``: about 1e-4 on e_z, e_x) or a preset
+        name (``"fast"``, ``"default"``, ``"precise"``, ``"thesis"``).
+    trajectory : bool, optional
+        Also record the time series (``ImpactResult.trajectory``, a DataFrame with
+        columns ``t_s, u_z_m, v_z_m_s, v_x_m_s, omega_rad_s, F_z_N, F_x_N, a_m,
+        slip_width_m``, SI units; about 500 rows per Hertz time on the element path,
+        one row per accepted step on the continuum path).
+
+    Returns
+    -------
+    ImpactResult
+        The outcome, SI units (:data:`vimpact.UNITS`).
 
     Raises
     ------
@@ -234,11 +264,13 @@ def _simulate(scene: Scene, numerics: Numerics, trajectory: bool) -> ImpactResul
             rec_every = max(1, int(per_t_H) // TRAJECTORY_ROWS_PER_T_H)
             n_rec = int(a["max_steps"][0] // rec_every) + 2
         n_rec = min(n_rec, MAX_TRAJECTORY_ROWS)
-    result, rec, written = run_columns(cols, numerics, n_rec, rec_every)
-    row = {name: (v[0].item() if hasattr(v[0], "item") else v[0]) for name, v in result.items()}
+    out, rec, path_names, explicit_euler, steps_per_T, refused = _run(
+        cols, numerics, n_rec, rec_every, None)
+    row = unpack_row(cols, out[0], path_names[0], bool(explicit_euler[0]),
+                     float(steps_per_T[0]), refused[0])
     traj = None
     if trajectory:
-        traj = _trajectory(scene, rec[0, :written[0]])
+        traj = _trajectory(scene, rec[0, :int(out[0, layout.OUT_N_REC])])
     return ImpactResult(trajectory=traj, **row)
 
 

@@ -62,8 +62,11 @@ class PronyFit(NamedTuple):
 
 
 def relaxation_times(lo: float, hi: float, per_decade: float) -> np.ndarray:
-    """Log-spaced relaxation times from ``lo`` to ``hi`` (s, both included),
-    ``per_decade`` per decade (rounded to a whole number of intervals, at least 1)."""
+    """Return log-spaced relaxation times from ``lo`` to ``hi``, s.
+
+    Log-spaced relaxation times from ``lo`` to ``hi`` (s, both included),
+    ``per_decade`` per decade (rounded to a whole number of intervals, at least 1).
+    """
     n = max(1, round(per_decade * math.log10(hi / lo)))
     return np.geomspace(lo, hi, n + 1)
 
@@ -81,8 +84,10 @@ def storage_loss(material: Material, frequency_Hz) -> tuple[np.ndarray, np.ndarr
 
 
 def relaxation_modulus(material: Material, time_s) -> np.ndarray:
-    """``G(t) = G_inf + sum_i G_i exp(-t/tau_i)`` (Pa) of ``material`` at ``time_s`` (s);
-    the dashpot's delta at ``t = 0`` is left out."""
+    """``G(t) = G_inf + sum_i G_i exp(-t/tau_i)`` (Pa) of ``material`` at ``time_s`` (s).
+
+    The dashpot's delta at ``t = 0`` is left out.
+    """
     t = np.asarray(time_s, dtype=float)
     out = np.full_like(t, material.G_inf)
     for G, tau in material.arms:
@@ -144,7 +149,7 @@ def _per_decade(value) -> float:
 
 
 def _columns(data: dict) -> tuple[np.ndarray, ...]:
-    """The data as 1-D float arrays of one length, finite and > 0, sorted by the first."""
+    """Return the data as 1-D float arrays of one length, finite and > 0, sorted by the first."""
     out = []
     for name, values in data.items():
         try:
@@ -176,8 +181,11 @@ def _enough(A: np.ndarray, name: str, per_decade: float) -> None:
 
 
 def _nnls(A: np.ndarray) -> tuple[np.ndarray, float]:
-    """Non-negative ``x`` minimising ``|A x - 1|`` (rows already divided by the data)
-    and the RMS relative residual. Columns are scaled to unit norm for the solver."""
+    """Solve the non-negative least-squares problem of a fit.
+
+    Non-negative ``x`` minimising ``|A x - 1|`` (rows already divided by the data)
+    and the RMS relative residual. Columns are scaled to unit norm for the solver.
+    """
     from scipy.optimize import nnls
 
     norms = np.linalg.norm(A, axis=0)

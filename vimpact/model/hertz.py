@@ -47,11 +47,28 @@ class HertzScales(NamedTuple):
 
 
 def hertz_scales(G, nu, R, m, v_z0) -> HertzScales:
-    """Hertz scales for shear modulus ``G`` (Pa), Poisson ratio ``nu`` (-),
-    sphere radius ``R`` (m), mass ``m`` (kg) and impact speed ``v_z0`` (m/s).
+    """Return the Hertz scales of an elastic impact (works on arrays).
 
     Works elementwise on arrays. For a viscoelastic material pass the relaxed
     (long-time) modulus ``G_inf``.
+
+    Parameters
+    ----------
+    G : float or array_like
+        Shear modulus, Pa.
+    nu : float or array_like
+        Poisson ratio, dimensionless.
+    R : float or array_like
+        Sphere radius, m.
+    m : float or array_like
+        Sphere mass, kg.
+    v_z0 : float or array_like
+        Normal impact speed, m/s.
+
+    Returns
+    -------
+    HertzScales
+        ``d`` (m), ``a_H`` (m), ``T`` (s) and ``t_H`` (s); floats for scalar inputs.
     """
     E_star = effective_modulus(G, nu)
     R = np.asarray(R, dtype=float)

@@ -95,8 +95,11 @@ class Material:
 
     @classmethod
     def standard_solid(cls, nu: float, G1: float, G2: float, eta: float) -> Material:
-        """Standard linear solid: spring ``G1`` parallel to a Maxwell arm (spring ``G2``,
-        dashpot ``eta``). Moduli in Pa, ``eta`` in Pa s; arm time ``tau = eta / G2``."""
+        """Return a standard linear solid.
+
+        Spring ``G1`` parallel to a Maxwell arm (spring ``G2``, dashpot ``eta``). Moduli
+        in Pa, ``eta`` in Pa s; arm time ``tau = eta / G2``.
+        """
         nu = poisson_ratio("nu", nu)
         G1, G2 = positive("G1", G1), positive("G2", G2)
         eta = non_negative("eta", eta)
@@ -106,8 +109,11 @@ class Material:
 
     @classmethod
     def prony(cls, nu: float, G_inf: float, arms, eta0: float = 0.0) -> Material:
-        """Prony series: relaxed modulus ``G_inf`` (Pa), arms ``[(G_i [Pa], tau_i [s]), ...]``,
-        optional parallel dashpot ``eta0`` (Pa s)."""
+        """Return a Prony series material.
+
+        Prony series: relaxed modulus ``G_inf`` (Pa), arms ``[(G_i [Pa], tau_i [s]), ...]``,
+        optional parallel dashpot ``eta0`` (Pa s).
+        """
         nu = poisson_ratio("nu", nu)
         require("arms", arms, isinstance(arms, (tuple, list)),
                 "a list of pairs (G_i [Pa], tau_i [s])")
@@ -123,7 +129,7 @@ class Material:
     def from_dma(cls, frequency_Hz, storage_Pa, loss_Pa, nu: float, *,
                  per_decade: float = 2.0, dashpot: bool = False,
                  shift: ShiftLaw | None = None) -> PronyFit:
-        """A Prony material fitted to a dynamic (DMA) master curve of the shear moduli.
+        """Return a Prony material fitted to a dynamic (DMA) master curve of the shear moduli.
 
         Non-negative least squares on log-spaced relaxation times
         (:func:`vimpact.model.fit.fit_dma`); returns ``(material, residual)``, the
@@ -146,7 +152,7 @@ class Material:
     @classmethod
     def from_relaxation(cls, time_s, modulus_Pa, nu: float, *, per_decade: float = 2.0,
                         shift: ShiftLaw | None = None) -> PronyFit:
-        """A Prony material fitted to a shear relaxation modulus ``G(t)`` (Pa at ``t`` in s).
+        """Return a Prony material fitted to a shear relaxation modulus ``G(t)`` (Pa at ``t`` in s).
 
         Non-negative least squares on log-spaced relaxation times
         (:func:`vimpact.model.fit.fit_relaxation`); returns ``(material, residual)``,
@@ -158,14 +164,18 @@ class Material:
 
     # ---- temperature --------------------------------------------------
     def with_shift(self, shift: ShiftLaw | None) -> Material:
-        """This material with the temperature shift law ``shift`` (its ``T_ref`` is the
-        temperature of this material's times)."""
+        """Return this material with the temperature shift law ``shift``.
+
+        This material with the temperature shift law ``shift`` (its ``T_ref`` is the
+        temperature of this material's times).
+        """
         return dataclasses.replace(self, shift=shift)
 
     def at_temperature(self, T: float) -> Material:
-        """This material at the temperature ``T`` (K): every relaxation time and the
-        dashpot viscosity times the shift factor ``a_T`` of :attr:`shift`, moduli
-        unchanged; the result's shift law is referenced to ``T``.
+        """Return this material at the temperature ``T`` (K).
+
+        Every relaxation time and the dashpot viscosity times the shift factor ``a_T`` of
+        :attr:`shift`, moduli unchanged; the result's shift law is referenced to ``T``.
 
         Raises :class:`~vimpact.model.validation.InputError` for ``T <= 0 K``, a
         ``T`` outside the law's range, or a material without a shift law.
@@ -190,8 +200,11 @@ class Material:
 
     @property
     def kappa(self) -> float:
-        """Tangential over normal element stiffness ``c_t / c_n = 2 (1 - nu) / (2 - nu)``
-        (docs/physics.md#method-of-dimensionality-reduction), dimensionless."""
+        """Tangential over normal element stiffness ``c_t / c_n``, dimensionless.
+
+        Tangential over normal element stiffness ``c_t / c_n = 2 (1 - nu) / (2 - nu)``
+        (docs/physics.md#method-of-dimensionality-reduction), dimensionless.
+        """
         return 2.0 * (1.0 - self.nu) / (2.0 - self.nu)
 
     @property
@@ -207,9 +220,11 @@ class Material:
         return self.G_inf / self.arms[0][0] if self.arms else float("inf")
 
     def viscous_time(self) -> float:
-        """The time ``eta / G_inf`` that defines ``Q1`` (s): the dashpot of a
-        Kelvin-Voigt body, the arm dashpot of a standard solid over ``G1``;
-        0 for an elastic body, NaN for a general Prony series."""
+        """Return the time ``eta / G_inf`` that defines ``Q1`` (s).
+
+        The dashpot of a Kelvin-Voigt body, the arm dashpot of a standard solid over
+        ``G1``; 0 for an elastic body, NaN for a general Prony series.
+        """
         if self.model in ("elastic", "kelvin_voigt"):
             return self.dashpot_time
         if self.model == "standard_solid":

@@ -49,12 +49,12 @@ SHIFT_KEYS = {"wlf": ("law", "T_ref_K", "C1", "C2_K"),
 
 
 def bad_value(source: str, what: str, value, allowed: str) -> InputError:
-    """The error of a bad TOML value: ``SOURCE: what = value is not allowed: must be ...``."""
+    """Return the error of a bad TOML value: ``SOURCE: what = value is not allowed: must be ...``."""
     return InputError(f"{source}: " + message(what, value, allowed))
 
 
 def toml_number(source: str, where: str, value) -> float:
-    """A TOML integer or float (not a bool) as a float; else :func:`bad_value`."""
+    """Return a TOML integer or float (not a bool) as a float; else :func:`bad_value`."""
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         raise bad_value(source, where, value, "a number")
     return float(value)
@@ -64,7 +64,7 @@ _err, _num = bad_value, toml_number
 
 
 def shift_from_table(table, where: str = "shift", source: str = "<string>") -> ShiftLaw:
-    """A :class:`~vimpact.model.temperature.ShiftLaw` from a ``[shift]`` table (module doc)."""
+    """Return a :class:`~vimpact.model.temperature.ShiftLaw` from a ``[shift]`` table (module doc)."""
     if not isinstance(table, dict):
         raise _err(source, where, table, 'a table with "law" and "T_ref_K"')
     law = table.get("law")
@@ -87,7 +87,7 @@ def shift_from_table(table, where: str = "shift", source: str = "<string>") -> S
 
 
 def material_from_table(table, where: str = "material", source: str = "<string>") -> Material:
-    """A :class:`vimpact.Material` from a material table (keys in the module doc)."""
+    """Return a :class:`vimpact.Material` from a material table (keys in the module doc)."""
     if not isinstance(table, dict):
         raise _err(source, where, table, 'a table with "model" and its moduli')
     model = str(table.get("model"))
@@ -142,8 +142,11 @@ def load_material(path) -> Material:
 
 
 def resolve_material(value, where: str, source: str, base: Path | None = None) -> Material:
-    """The material a TOML key gives: a material table, or a string naming a material
-    file relative to ``base`` (the directory of the file being read)."""
+    """Return the material a TOML key gives.
+
+    A material table, or a string naming a material file relative to ``base`` (the
+    directory of the file being read).
+    """
     if isinstance(value, str):
         path = Path(value)
         if not path.is_absolute() and base is not None:
@@ -169,9 +172,12 @@ MATERIAL_FILE_KEYS = ("material", "temperature_K")
 
 
 def table_values(material: Material) -> tuple[dict, list]:
-    """The value keys of a scene file's ``[scene]`` (a sweep's ``[random]``) that give
+    """Return the value keys of a scene file that give ``material``.
+
+    The value keys of a scene file's ``[scene]`` (a sweep's ``[random]``) that give
     ``material``: ``(values, arms)`` with ``nu``, the material keys of its model
-    (``G_Pa``, ``eta_Pa_s``, ``G1_Pa``, ``G2_Pa``) and the arms as ``{G_Pa, tau_s}``."""
+    (``G_Pa``, ``eta_Pa_s``, ``G1_Pa``, ``G2_Pa``) and the arms as ``{G_Pa, tau_s}``.
+    """
     values = {"nu": material.nu}
     if material.model == "standard_solid":
         G2, tau = material.arms[0] if material.arms else (material.G_inf, 0.0)
@@ -186,7 +192,9 @@ def table_values(material: Material) -> tuple[dict, list]:
 
 def inline_material(source: str, data: dict, table: str,
                     base: Path | None) -> tuple[dict, str]:
-    """``data`` (a parsed scene file or sweep spec) with the material file named by
+    """Return ``data`` with its material file written out as value keys.
+
+    ``data`` (a parsed scene file or sweep spec) with the material file named by
     ``[table] material`` (shifted to ``[table] temperature_K``) written out as the
     table's value keys, and ``model`` set to the file's; unchanged without ``material``.
 
@@ -233,8 +241,11 @@ def inline_material(source: str, data: dict, table: str,
 
 
 def material_toml(material: Material, comment: str = "") -> str:
-    """The text of a material file for ``material`` (``comment`` lines go on top, as
-    TOML comments); :func:`load_material` of it gives ``material`` back exactly."""
+    """Return the text of a material file for ``material``.
+
+    The text of a material file for ``material`` (``comment`` lines go on top, as
+    TOML comments); :func:`load_material` of it gives ``material`` back exactly.
+    """
     lines = [f"# {line}".rstrip() for line in comment.splitlines()]
     lines += [f'model = "{material.model}"', f"nu = {material.nu!r}"]
     if material.model == "prony":

@@ -123,10 +123,13 @@ class Numerics:
         return self.tolerance is None or self.tolerance >= ELEMENT_TOLERANCE_FLOOR
 
     def element_refusal(self, path_name: str, seed_memory: bool) -> str | None:
-        """Why the element path ``path_name`` must refuse these numerics' tolerance
+        """Return why the element path must refuse these numerics' tolerance, or None.
+
+        Why the element path ``path_name`` must refuse these numerics' tolerance
         (one line, for the error column), or ``None`` (no tolerance, or one the error
         model bounds there). ``seed_memory``: the path runs the tangential problem
-        with the thesis's seed memory, which the model does not bound."""
+        with the thesis's seed memory, which the model does not bound.
+        """
         if not self.element_tolerance_reachable:
             return (f"tolerance = {self.tolerance:g} is not reachable on the element path "
                     f"this scene needs ({path_name}): the smallest it reaches is "
@@ -137,23 +140,24 @@ class Numerics:
 
     @classmethod
     def preset(cls, name: str) -> Numerics:
-        """Named settings (:data:`PRESETS`): ``fast`` (2.3e-4 on e_z, e_x on the
-        element path), ``default`` (3.1e-5 there), ``precise`` (1e-9 and better
-        on the continuum paths; 4.9e-7 on the element path at its caps, the best
-        it reaches; :meth:`for_tolerance` refuses less than twice that there,
-        :data:`ELEMENT_TOLERANCE_FLOOR`) and ``thesis`` (explicit Euler, 5000
-        steps per t_H, 1000 elements across the contact diameter, as in the
-        thesis). The element
-        path figures are :data:`ERROR_MODEL` at the preset; measured largest
-        errors against the continuum kernel on its eleven oblique scenes: 2.1e-4,
-        2.8e-5, 2.0e-7 (``python -m benchmarks.element_orders``). They hold for
-        the incremental memory, with or without friction; the seed memory
-        converges more slowly (:data:`SEED_MEMORY_UNVERIFIED`)."""
+        """Named settings (:data:`PRESETS`).
+
+        ``fast`` (2.3e-4 on e_z, e_x on the element path), ``default`` (3.1e-5 there),
+        ``precise`` (1e-9 and better on the continuum paths; 4.9e-7 on the element path at
+        its caps, the best it reaches; :meth:`for_tolerance` refuses less than twice that
+        there, :data:`ELEMENT_TOLERANCE_FLOOR`) and ``thesis`` (explicit Euler, 5000 steps
+        per t_H, 1000 elements across the contact diameter, as in the thesis). The element
+        path figures are :data:`ERROR_MODEL` at the preset; measured largest errors
+        against the continuum kernel on its eleven oblique scenes: 2.1e-4, 2.8e-5, 2.0e-7
+        (``python -m benchmarks.element_orders``). They hold for the incremental memory,
+        with or without friction; the seed memory converges more slowly
+        (:data:`SEED_MEMORY_UNVERIFIED`).
+        """
         one_of("numerics preset", name, tuple(PRESETS))
         return PRESETS[name]
 
     def with_(self, **changes) -> Numerics:
-        """A copy with some fields changed (validated)."""
+        """Return a copy with some fields changed (validated)."""
         return replace(self, **changes)
 
     @property
@@ -188,8 +192,11 @@ ERROR_MODEL_SAFETY = 2.0
 
 
 def element_error_bound(steps: float, elements: float) -> float:
-    """:data:`ERROR_MODEL`'s bound on ``max(|e_z err|, |e_x err|)`` of the Verlet element
-    path at ``steps`` per t_H and ``elements`` per a_H (dimensionless)."""
+    """Return the error model's bound on the Verlet element path, dimensionless.
+
+    :data:`ERROR_MODEL`'s bound on ``max(|e_z err|, |e_x err|)`` of the Verlet element
+    path at ``steps`` per t_H and ``elements`` per a_H (dimensionless).
+    """
     m = ERROR_MODEL
     return m["a"] / steps ** m["p"] + m["b"] / elements ** m["q"]
 
@@ -246,8 +253,11 @@ CONVERGED_PRESETS = tuple(n for n, p in PRESETS.items() if p.integrator != "eule
 
 
 def preset_summary(name: str) -> str:
-    """One line on preset ``name`` for help texts: its error bound on the element
-    path (:func:`element_error_bound`, dimensionless), or what the thesis preset is."""
+    """One line on preset ``name`` for help texts.
+
+    Its error bound on the element path (:func:`element_error_bound`, dimensionless), or
+    what the thesis preset is.
+    """
     p = PRESETS[name]
     if p.integrator == "euler":
         return f"{name} (explicit Euler as in the thesis)"

@@ -155,7 +155,7 @@ def _is_elastic(mat: Material) -> bool:
 
 
 def pair_material(mat1: Material | None, mat2: Material | None) -> Material:
-    """The one half-space material equivalent to two bodies' materials in contact.
+    """Return the one half-space material equivalent to two bodies' materials in contact.
 
     Parameters
     ----------
@@ -214,7 +214,7 @@ def _partner(other: Body | Wall) -> tuple[Material | None, float, float, float, 
 def pair_scene(body1: Body, other: Body | Wall, *, tangential: str = "auto",
                tangential_memory: str = "incremental", mu: float = math.inf,
                allow_large_contact: bool = False) -> Scene:
-    """The rigid-sphere scene equivalent to ``body1`` hitting ``other``.
+    """Return the rigid-sphere scene equivalent to ``body1`` hitting ``other``.
 
     Returns a :class:`vimpact.Scene` with the pair material
     (:func:`pair_material`), ``R``, ``m`` the effective radius and mass,

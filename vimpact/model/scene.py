@@ -88,7 +88,7 @@ class Scene:
         ``omega`` keeps ``omega0`` (``Theta`` is then not used)
     mu : Coulomb friction coefficient, dimensionless, >= 0 (default ``inf``:
         full stick, docs/physics.md#full-stick; finite: every element obeys
-        ``|f_t| <= mu f_n``, section 12)
+        ``|f_t| <= mu f_n``, docs/physics.md#coulomb-friction)
     adhesion : work of adhesion ``dgamma`` of the sphere-half-space pair, J/m^2,
         >= 0 (default 0: no adhesion, the impact exactly as without this field).
         ``> 0``: the adhesive normal impact of docs/physics.md#adhesion
@@ -174,7 +174,7 @@ class Scene:
                            theta_ratio: float = DEFAULT_THETA_RATIO,
                            tangential_memory: str = "incremental", tangential: str = "auto",
                            rotation: bool = True, mu: float = math.inf) -> Scene:
-        """A physical scene with the given dimensionless parameters.
+        """Return a physical scene with the given dimensionless parameters.
 
         Kelvin-Voigt for ``Q2 = None``, standard solid otherwise. Restitution
         depends only on ``Q1`` (``Q2``), ``nu`` and ``theta_ratio = Theta /
@@ -222,20 +222,28 @@ class Scene:
 
     @property
     def computes_tangential(self) -> bool:
-        """The tangential problem is solved: asked for (``tangential`` is not
-        ``"none"``) and not trivially zero (``v_c0 != 0``, docs/physics.md#energy-and-passivity)."""
+        """The tangential problem is solved.
+
+        Asked for (``tangential`` is not ``"none"``) and not trivially zero (``v_c0 !=
+        0``, docs/physics.md#energy-and-passivity).
+        """
         return self.tangential != "none" and self.v_c0 != 0.0
 
     @property
     def contact_mass_factor(self) -> float:
-        """``1 + m R^2 / Theta`` (``1`` without rotation): the contact point
-        accelerates this much faster than the centre under a tangential force
-        (docs/physics.md#energy-and-passivity), dimensionless."""
+        """``1 + m R^2 / Theta`` (``1`` without rotation).
+
+        The contact point accelerates this much faster than the centre under a tangential
+        force (docs/physics.md#energy-and-passivity), dimensionless.
+        """
         return 1.0 + 1.0 / self.theta_ratio if self.rotation else 1.0
 
     def tangential_end_state(self, vc_ratio):
-        """Centre velocity (m/s) and spin (rad/s) when the contact-point velocity
-        has become ``vc_ratio * v_c0`` (works on arrays)."""
+        """Return the centre velocity (m/s) and spin (rad/s) at a contact-point velocity.
+
+        Centre velocity (m/s) and spin (rad/s) when the contact-point velocity
+        has become ``vc_ratio * v_c0`` (works on arrays).
+        """
         impulse = (1.0 - vc_ratio) / self.contact_mass_factor * self.v_c0  # J / m, m/s
         spin = impulse * self.m * self.R / self.Theta if self.rotation else 0.0 * impulse
         return self.v_x0 - impulse, self.omega0 - spin

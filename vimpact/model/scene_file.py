@@ -127,14 +127,20 @@ _CHECKS = {
 
 
 def allowed_scene_keys(model: str) -> tuple[str, ...]:
-    """Keys of the ``[scene]`` table for ``model`` (those of a sweep's ``[random]``
-    without ``rows``)."""
+    """Return the keys the ``[scene]`` table may have for ``model``.
+
+    Keys of the ``[scene]`` table for ``model`` (those of a sweep's ``[random]``
+    without ``rows``).
+    """
     return input_keys(model) + (("arms",) if model == "prony" else ())
 
 
 def required_scene_keys(model: str) -> tuple[str, ...]:
-    """Keys that ``[scene]`` must have (besides one of ``E_Pa`` / ``G_Pa`` for
-    elastic and Kelvin-Voigt)."""
+    """Return the keys the ``[scene]`` table must have for ``model``.
+
+    Keys that ``[scene]`` must have (besides one of ``E_Pa`` / ``G_Pa`` for
+    elastic and Kelvin-Voigt).
+    """
     return required_keys(model)
 
 
@@ -226,7 +232,7 @@ def _number(spec: TomlSource, key: str, value, name: str) -> float:
 
 
 def _scene_table(spec: TomlSource, model: str, table) -> tuple[dict, tuple]:
-    """The ``[scene]`` values (key -> number) and the arms ``((G_Pa, tau_s), ...)``."""
+    """Return the ``[scene]`` values (key -> number) and the arms ``((G_Pa, tau_s), ...)``."""
     if not isinstance(table, dict):
         raise spec.bad("scene", table, "a table [scene]")
     spec.unknown(table, allowed_scene_keys(model), "scene")

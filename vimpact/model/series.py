@@ -50,8 +50,11 @@ _DROP = 1e-12
 
 
 def operator_modulus(mat: Material, s) -> np.ndarray:
-    """``M(s) = G_inf + eta0 s + sum G_i tau_i s / (1 + tau_i s)`` of ``mat`` (Pa) at the
-    Laplace variable ``s`` (1/s; real or complex, scalar or array)."""
+    """Return the operator modulus ``M(s)`` of ``mat`` at ``s``, Pa.
+
+    ``M(s) = G_inf + eta0 s + sum G_i tau_i s / (1 + tau_i s)`` of ``mat`` (Pa) at the
+    Laplace variable ``s`` (1/s; real or complex, scalar or array).
+    """
     s = np.asarray(s)
     out = mat.G_inf + mat.eta0 * s
     for G, tau in mat.arms:
@@ -60,8 +63,10 @@ def operator_modulus(mat: Material, s) -> np.ndarray:
 
 
 def _arms_by_rate(mats: tuple[Material, ...]) -> tuple[np.ndarray, np.ndarray]:
-    """Arms of the sum of ``mats`` with equal times merged: rates ``1/tau`` (ascending, 1/s)
-    and moduli (Pa)."""
+    """Arms of the sum of ``mats`` with equal times merged.
+
+    Rates ``1/tau`` (ascending, 1/s) and moduli (Pa).
+    """
     arms = sorted((1.0 / tau, G) for m in mats for G, tau in m.arms)
     rates: list[float] = []
     moduli: list[float] = []
@@ -81,8 +86,11 @@ def _sum_on_axis(G_inf: float, eta0: float, rates: np.ndarray, moduli: np.ndarra
 
 
 def _zeros(G_inf: float, eta0: float, rates: np.ndarray, moduli: np.ndarray) -> np.ndarray:
-    """The rates ``p > 0`` (1/s) where ``S(-p) = 0``: one below the first pole, one between
-    each two poles, one above the last with a dashpot."""
+    """Return the rates ``p > 0`` (1/s) where ``S(-p) = 0``.
+
+    One below the first pole, one between each two poles, one above the last with a
+    dashpot.
+    """
     edges = [0.0, *rates.tolist()]
     intervals = list(zip(edges[:-1], edges[1:]))
     if eta0 > 0.0:
@@ -116,7 +124,7 @@ def _model_name(arms: list, eta0: float) -> str:
 
 
 def series_material(mat1: Material, mat2: Material) -> Material:
-    """The one material whose operator modulus is ``M_1 M_2 / (M_1 + M_2)`` (module doc).
+    """Return the one material whose operator modulus is ``M_1 M_2 / (M_1 + M_2)`` (module doc).
 
     Parameters
     ----------

@@ -39,7 +39,7 @@ UNIVERSAL_WLF = (17.44, 51.6)
 
 
 def temperature(name: str, value) -> float:
-    """An absolute temperature in kelvin as a float: a finite number > 0 K."""
+    """Return an absolute temperature in kelvin as a float: a finite number > 0 K."""
     ok = isinstance(value, numbers.Real) and not isinstance(value, bool) \
         and math.isfinite(float(value)) and float(value) > 0.0
     require(name, value, ok, "an absolute temperature in kelvin, a finite number > 0")
@@ -81,8 +81,10 @@ class ShiftLaw:
     @classmethod
     def wlf(cls, T_ref: float, C1: float = UNIVERSAL_WLF[0],
             C2: float = UNIVERSAL_WLF[1]) -> ShiftLaw:
-        """WLF law at ``T_ref`` (K) with ``C1`` (dimensionless) and ``C2`` (K); the
-        defaults are the universal constants, meant for ``T_ref = T_g``."""
+        """WLF law at ``T_ref`` (K) with ``C1`` (dimensionless) and ``C2`` (K).
+
+        The defaults are the universal constants, meant for ``T_ref = T_g``.
+        """
         return cls("wlf", float(T_ref), C1=float(C1), C2=float(C2))
 
     @classmethod
@@ -106,7 +108,7 @@ class ShiftLaw:
         return self.E_a / GAS_CONSTANT * (1.0 / T - 1.0 / self.T_ref) / math.log(10.0)
 
     def shift_factor(self, T: float) -> float:
-        """The shift factor ``a_T`` at ``T`` (K): ``tau(T) = a_T tau(T_ref)``; dimensionless.
+        """Return the shift factor ``a_T`` at ``T`` (K): ``tau(T) = a_T tau(T_ref)``; dimensionless.
 
         Refuses (``InputError``) a temperature where ``a_T`` leaves the float range.
         """
@@ -118,9 +120,12 @@ class ShiftLaw:
         return math.exp(self.E_a / GAS_CONSTANT * (1.0 / T - 1.0 / self.T_ref))
 
     def referenced_to(self, T: float) -> ShiftLaw:
-        """The same law with ``T`` (K) as its reference temperature: for a material
-        already shifted to ``T``. For WLF ``C1' = C1 C2 / (C2 + T - T_ref)`` and
-        ``C2' = C2 + T - T_ref``, which give the same shift between any two temperatures."""
+        """Return the same law with ``T`` (K) as its reference temperature.
+
+        For a material already shifted to ``T``. For WLF ``C1' = C1 C2 / (C2 + T -
+        T_ref)`` and ``C2' = C2 + T - T_ref``, which give the same shift between any two
+        temperatures.
+        """
         self.log10_shift(T)  # refuses T outside the law's range
         if self.law == "wlf":
             c2 = self.C2 + (T - self.T_ref)

@@ -64,14 +64,15 @@ NUMERICS_KEYS = ("preset",) + tuple(f.name for f in dataclasses.fields(Numerics)
 
 
 def physical_keys(model: str) -> tuple[str, ...]:
-    """Physical value keys of ``model`` in their fixed order: material, sphere,
-    ``nu``, ``theta_ratio`` (arms separately)."""
+    """Physical value keys of ``model`` in their fixed order.
+
+    Material, sphere, ``nu``, ``theta_ratio`` (arms separately).
+    """
     return MATERIAL_KEYS[model] + SPHERE_KEYS + ("nu", "theta_ratio")
 
 
 def required_keys(model: str) -> tuple[str, ...]:
-    """Keys that must be given (besides one of ``E_Pa`` / ``G_Pa`` for elastic and
-    Kelvin-Voigt)."""
+    """Keys that must be given (besides one of ``E_Pa`` / ``G_Pa`` for elastic and Kelvin-Voigt)."""
     if model == "prony":
         return ("G_Pa", "R_m", "m_kg", "v_z0_m_s", "nu")
     return tuple(k for k in MATERIAL_KEYS[model] if k not in ("E_Pa", "G_Pa")) + \
@@ -79,15 +80,18 @@ def required_keys(model: str) -> tuple[str, ...]:
 
 
 def input_keys(model: str) -> tuple[str, ...]:
-    """Every value key of ``model`` in its fixed order: :func:`physical_keys`, then
-    :data:`FRICTION_KEYS` (arms separately)."""
+    """Every value key of ``model`` in its fixed order.
+
+    :func:`physical_keys`, then :data:`FRICTION_KEYS` (arms separately).
+    """
     return physical_keys(model) + FRICTION_KEYS
 
 
 def tangential_speed(v_z0, angle_deg):
-    """Tangential speed of the centre for an impact angle from the normal:
-    ``v_x0 = v_z0 tan(angle)``, m/s (arrays or numbers; the same floating-point
-    operations for a scene file and a sweep column).
+    """Tangential speed of the centre for an impact angle from the normal.
+
+    ``v_x0 = v_z0 tan(angle)``, m/s (arrays or numbers; the same floating-point operations
+    for a scene file and a sweep column).
 
     Parameters
     ----------
@@ -99,8 +103,10 @@ def tangential_speed(v_z0, angle_deg):
 
 
 def friction_coefficient(source: TomlSource, key: str, value) -> float:
-    """A Coulomb friction coefficient: a number >= 0, or ``inf`` (TOML ``inf`` or the
-    string ``"inf"``) for full stick."""
+    """Return a Coulomb friction coefficient.
+
+    A number >= 0, or ``inf`` (TOML ``inf`` or the string ``"inf"``) for full stick.
+    """
     if isinstance(value, str) and value.strip().lower() in ("inf", "+inf", "infinity"):
         return math.inf
     if not is_number(value) or math.isnan(value) or value < 0.0 or value == -math.inf:
@@ -109,14 +115,14 @@ def friction_coefficient(source: TomlSource, key: str, value) -> float:
 
 
 def impact_angle(source: TomlSource, key: str, value) -> float:
-    """An impact angle from the normal, degrees, in [0, 90)."""
+    """Return an impact angle from the normal, degrees, in [0, 90)."""
     lo, hi = ANGLE_RANGE_DEG
     return source.number(key, value, lambda x: lo <= x < hi,
                          f"a number of degrees in [{lo:g}, {hi:g}) from the normal")
 
 
 def is_number(x) -> bool:
-    """A TOML integer or float (not a bool)."""
+    """Return a TOML integer or float (not a bool)."""
     return isinstance(x, (int, float)) and not isinstance(x, bool)
 
 
@@ -127,11 +133,11 @@ class TomlSource:
         self.path = path
 
     def error(self, key: str, message: str) -> ValueError:
-        """The error for ``key`` of this file, with ``message``."""
+        """Return the error for ``key`` of this file, with ``message``."""
         return ValueError(f"{self.path}: {key}: {message}")
 
     def bad(self, key: str, value, allowed: str) -> ValueError:
-        """The error for ``key = value``: not allowed, must be ``allowed``."""
+        """Return the error for ``key = value``: not allowed, must be ``allowed``."""
         return ValueError(f"{self.path}: {key} = {value!r} is not allowed: must be {allowed}")
 
     def unknown(self, table: dict, allowed, where: str = "") -> None:
@@ -170,8 +176,11 @@ class TomlSource:
 
 
 def read_text(path: Path, what: str) -> str:
-    """The UTF-8 text of the file ``path``; ``ValueError`` naming the file and ``what``
-    it should be when it is missing, unreadable or not UTF-8 text."""
+    """Return the UTF-8 text of the file ``path``.
+
+    ``ValueError`` naming the file and ``what`` it should be when it is missing,
+    unreadable or not UTF-8 text.
+    """
     try:
         return Path(path).read_text(encoding="utf-8")
     except FileNotFoundError:
@@ -191,7 +200,7 @@ def read_toml(path: Path, what: str) -> tuple[str, dict]:
 
 
 def parse_toml(source: TomlSource, text: str) -> dict:
-    """The content of the TOML ``text``; ``ValueError`` naming ``source`` if it is not TOML."""
+    """Return the content of the TOML ``text``; ``ValueError`` naming ``source`` if it is not TOML."""
     try:
         return tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
@@ -225,8 +234,11 @@ def parse_header(source: TomlSource, data: dict) -> Header:
 
 
 def parse_numerics(source: TomlSource, table) -> Numerics:
-    """A ``[numerics]`` table: ``preset`` (default ``"default"``) then overrides of any
-    field of :class:`~vimpact.model.numerics.Numerics`; a string is a preset name."""
+    """Return a ``[numerics]`` table.
+
+    ``preset`` (default ``"default"``) then overrides of any field of
+    :class:`~vimpact.model.numerics.Numerics`; a string is a preset name.
+    """
     if isinstance(table, str):
         table = {"preset": table}
     if not isinstance(table, dict):
@@ -248,7 +260,7 @@ def parse_numerics(source: TomlSource, table) -> Numerics:
 
 def scene_from_values(model: str, values: dict, arms=(), *, tangential_memory="incremental",
                       tangential="auto", rotation=True, allow_large_contact=False) -> Scene:
-    """The scene of one set of named physical values.
+    """Return the scene of one set of named physical values.
 
     Parameters
     ----------

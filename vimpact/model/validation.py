@@ -34,13 +34,16 @@ RULES = {
 
 
 def is_none(values) -> np.ndarray:
-    """Elementwise ``value is None`` of an object array (e.g. the reasons column: no
-    reason yet), as a bool array."""
+    """Return elementwise ``value is None`` of an object array, bool.
+
+    Elementwise ``value is None`` of an object array (e.g. the reasons column: no
+    reason yet), as a bool array.
+    """
     return np.equal(values, None)  # type: ignore[call-overload]  # (stubs: no None operand)
 
 
 def message(name: str, value, allowed: str) -> str:
-    """The one wording of every input error."""
+    """Return the one wording of every input error."""
     return f"{name} = {value!r} is not allowed: must be {allowed}"
 
 
@@ -96,7 +99,7 @@ def flag(name: str, value) -> bool:
 
 
 def _number(name: str, value) -> float:
-    """A real number (not a string, not a bool) as a float."""
+    """Return a real number (not a string, not a bool) as a float."""
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
         raise InputError(message(name, value, "a number"))
     try:

@@ -28,7 +28,7 @@ FIGURE_NUMERICS = Numerics.preset("fast")
 
 
 def example_scenes() -> dict[str, Scene]:
-    """The elastic and the Kelvin-Voigt example scene (at 0.1 m/s)."""
+    """Return the elastic and the Kelvin-Voigt example scene (at 0.1 m/s)."""
     p = EXAMPLE
     elastic = Material.elastic(nu=p["nu"], E=p["E_Pa"])
     kv = Material.kelvin_voigt(nu=p["nu"], E=p["E_Pa"], eta=p["eta_Pa_s"])

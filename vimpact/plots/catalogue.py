@@ -1,6 +1,8 @@
-"""The thesis figures that ``vimpact plot`` draws: names, titles and the sweep
-spec of each figure's table, without loading the drawing code (numpy only; the
-command line's parser reads it). The drawings are in :mod:`vimpact.plots.figures`.
+"""The thesis figures that ``vimpact plot`` draws.
+
+Names, titles and the sweep spec of each figure's table, without loading the drawing code
+(numpy only; the command line's parser reads it). The drawings are in
+:mod:`vimpact.plots.figures`.
 """
 
 from __future__ import annotations

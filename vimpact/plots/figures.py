@@ -123,7 +123,7 @@ def _kv_curve(q1_min: float, q1_max: float, n: int = 48):
 
 
 def _table_numerics(table: RestitutionTable) -> Numerics:
-    """The table's numerics (from its metadata), or the ``fast`` preset."""
+    """Return the table's numerics (from its metadata), or the ``fast`` preset."""
     recorded = table.numerics
     if isinstance(recorded, dict):
         fields = Numerics.__dataclass_fields__
@@ -144,9 +144,12 @@ def _log_q1_axis(ax) -> None:
 # --------------------------------------------------------------------------
 
 def fig3_2(out, zeta=None) -> Path:
-    """Thesis fig. 3.2: the linear spring-dashpot model, restitution ``e`` and
+    """Draw thesis fig. 3.2, the linear spring-dashpot model.
+
+    Thesis fig. 3.2: the linear spring-dashpot model, restitution ``e`` and
     contact time ``omega0 t*`` over the damping ratio ``zeta`` (log axis), all
-    three regimes (:func:`vimpact.reference.closed_forms.linear_model_zeta`)."""
+    three regimes (:func:`vimpact.reference.closed_forms.linear_model_zeta`).
+    """
     from vimpact.reference.closed_forms import linear_model_zeta
 
     zeta = np.geomspace(1e-2, 1e2, 600) if zeta is None else np.asarray(zeta, dtype=float)
@@ -177,19 +180,25 @@ def fig3_2(out, zeta=None) -> Path:
 
 
 def thesis_scene() -> Scene:
-    """The example of thesis fig. 4.2 (docs/physics.md#elastic-impact): Kelvin-Voigt
-    ``E = 5e10 Pa``, ``nu = 0.5``, ``eta = 1e5 Pa s``, ``R = 0.2 m``, ``m = 10 kg``,
-    ``v_z0 = 10 m/s``, with ``v_x0 = 5 m/s`` and backspin ``omega0 = -10 rad/s``."""
+    """Return the example of thesis fig. 4.2 (docs/physics.md#elastic-impact).
+
+    Kelvin-Voigt ``E = 5e10 Pa``, ``nu = 0.5``, ``eta = 1e5 Pa s``, ``R = 0.2 m``, ``m =
+    10 kg``, ``v_z0 = 10 m/s``, with ``v_x0 = 5 m/s`` and backspin ``omega0 = -10 rad/s``.
+    """
     material = Material.kelvin_voigt(nu=0.5, E=5e10, eta=1e5)
     return Scene(material, R=0.2, m=10.0, v_z0=10.0, v_x0=5.0, omega0=-10.0)
 
 
 def fig4_2(out, scene: Scene | None = None, numerics: Numerics | None = None) -> Path:
-    """Thesis fig. 4.2: normalized ``v_z/v_z0``, ``v_x/v_x0``, ``omega/omega0``
-    during one impact over ``t / t_H`` (default: :func:`thesis_scene`)."""
+    """Draw thesis fig. 4.2, the velocities during one impact.
+
+    Thesis fig. 4.2: normalized ``v_z/v_z0``, ``v_x/v_x0``, ``omega/omega0``
+    during one impact over ``t / t_H`` (default: :func:`thesis_scene`).
+    """
     scene = scene or thesis_scene()
     res = simulate(scene, numerics, trajectory=True)
     tr = res.trajectory
+    assert tr is not None  # trajectory=True records it
     t = tr["t_s"].to_numpy() / res.t_hertz
     with _drawing(out) as (fig, ax):
         ax.axhline(0.0, color="k", lw=0.8)
@@ -214,7 +223,9 @@ def fig4_2(out, scene: Scene | None = None, numerics: Numerics | None = None) ->
 
 
 def fig4_4(out, steps=(50, 100, 500), scene: Scene | None = None, elements: int = 200) -> Path:
-    """Thesis fig. 4.4: phase plane ``v_z`` over ``u_z`` of an elastic impact,
+    """Draw thesis fig. 4.4, the phase plane of explicit Euler.
+
+    Thesis fig. 4.4: phase plane ``v_z`` over ``u_z`` of an elastic impact,
     explicit Euler with ``steps`` time steps per Hertz time, against the exact
     curve ``v = sqrt(1 - u^(5/2))`` in Hertz units (``u / d``, ``v / v_z0``).
 
@@ -232,6 +243,7 @@ def fig4_4(out, steps=(50, 100, 500), scene: Scene | None = None, elements: int 
             res = simulate(scene, Numerics(integrator="euler", steps=int(n), elements=elements),
                            trajectory=True)
             tr = res.trajectory
+            assert tr is not None  # trajectory=True records it
             ax.plot(tr["u_z_m"] / res.d_hertz, tr["v_z_m_s"] / scene.v_z0,
                     marker=_MARKERS[k % len(_MARKERS)], markevery=max(1, len(tr) // 25),
                     ms=4, lw=1.2, label=f"explicit Euler, {n} steps per $t_H$ "
@@ -249,9 +261,12 @@ def fig4_4(out, steps=(50, 100, 500), scene: Scene | None = None, elements: int 
 # --------------------------------------------------------------------------
 
 def fig5_1(table, out) -> Path:
-    """Thesis fig. 5.1: ``e_z`` and ``e_x`` over ``Q1`` (log) for random
+    """Draw thesis fig. 5.1, restitution of random physical draws.
+
+    Thesis fig. 5.1: ``e_z`` and ``e_x`` over ``Q1`` (log) for random
     physical draws (scatter; ``e_x`` coloured by ``nu``). Table:
-    ``sweeps/fig5_1_kelvin_voigt_random.toml``."""
+    ``sweeps/fig5_1_kelvin_voigt_random.toml``.
+    """
     table = _as_table(table, "fig5_1")
     df = _data(table, "fig5_1")
     q1 = df["Q1"].to_numpy(float)
@@ -287,9 +302,12 @@ def fig5_1(table, out) -> Path:
 
 
 def fig5_2(table, out, nus=(0.5, 0.0)) -> Path:
-    """Thesis fig. 5.2: ``e_z`` over ``Q1`` for ``nu`` = 0.5 and 0 (Kelvin-Voigt
+    """Draw thesis fig. 5.2, ``e_z`` over ``Q1`` (Kelvin-Voigt).
+
+    Thesis fig. 5.2: ``e_z`` over ``Q1`` for ``nu`` = 0.5 and 0 (Kelvin-Voigt
     table), with the linear model's ``e`` at ``zeta = Q1`` and the Kelvin-Voigt
-    continuum curve. Table: ``sweeps/fig5_2_3_kelvin_voigt_nu.toml``."""
+    continuum curve. Table: ``sweeps/fig5_2_3_kelvin_voigt_nu.toml``.
+    """
     table = _as_table(table, "fig5_2")
     _need_model(table, "fig5_2", "kelvin_voigt")
     df = _data(table, "fig5_2")
@@ -316,8 +334,10 @@ def fig5_2(table, out, nus=(0.5, 0.0)) -> Path:
 
 
 def fig5_3(table, out, nus=(0.0, 0.25, 0.5)) -> Path:
-    """Thesis fig. 5.3: ``e_x`` over ``Q1`` for ``nu`` = 0, 0.25, 0.5
-    (Kelvin-Voigt table). Table: ``sweeps/fig5_2_3_kelvin_voigt_nu.toml``."""
+    """Thesis fig. 5.3: ``e_x`` over ``Q1`` for ``nu`` = 0, 0.25, 0.5 (Kelvin-Voigt table).
+
+    Table: ``sweeps/fig5_2_3_kelvin_voigt_nu.toml``.
+    """
     table = _as_table(table, "fig5_3")
     _need_model(table, "fig5_3", "kelvin_voigt")
     df = _data(table, "fig5_3")
@@ -403,21 +423,27 @@ def _family_plot(table, out, name: str, column: str, nu, kv_table=None) -> Path:
 
 
 def fig5_4(table, out, nu=None, kv_table=None) -> Path:
-    """Thesis fig. 5.4: ``e_z`` over ``Q1`` for a family of ``Q2`` (standard
+    """Draw thesis fig. 5.4, ``e_z`` over ``Q1`` (standard solid).
+
+    Thesis fig. 5.4: ``e_z`` over ``Q1`` for a family of ``Q2`` (standard
     solid) with the Kelvin-Voigt curve (``Q2 -> 0``, continuum limit) in black.
     Table: ``sweeps/fig5_4_5_standard_solid_q2.toml (+ sweeps/fig5_4_5_kelvin_voigt.toml)``;
     ``nu`` default 0.5 if present
-    (``kv_table`` is accepted for symmetry with :func:`fig5_5`)."""
+    (``kv_table`` is accepted for symmetry with :func:`fig5_5`).
+    """
     return _family_plot(table, out, "fig5_4", "e_z", nu, kv_table)
 
 
 def fig5_5(table, out, nu=None, kv_table=None) -> Path:
-    """Thesis fig. 5.5: ``e_x`` over ``Q1`` for a family of ``Q2`` (standard
+    """Draw thesis fig. 5.5, ``e_x`` over ``Q1`` (standard solid).
+
+    Thesis fig. 5.5: ``e_x`` over ``Q1`` for a family of ``Q2`` (standard
     solid) with the Kelvin-Voigt curve in black: from ``kv_table`` (a
     Kelvin-Voigt table) if given, else from the table's own Kelvin-Voigt rows
     (``Q2`` 0 or NaN), else computed at the table's ``Q1`` values with its
     numerics. Table: ``sweeps/fig5_4_5_standard_solid_q2.toml
-    (+ sweeps/fig5_4_5_kelvin_voigt.toml)``; ``nu`` default 0.5 if present."""
+    (+ sweeps/fig5_4_5_kelvin_voigt.toml)``; ``nu`` default 0.5 if present.
+    """
     return _family_plot(table, out, "fig5_5", "e_x", nu, kv_table)
 
 
@@ -426,8 +452,11 @@ def fig5_5(table, out, nu=None, kv_table=None) -> Path:
 # --------------------------------------------------------------------------
 
 class Figure(NamedTuple):
-    """A figure of the thesis: its drawing function, a title, and the sweep spec
-    of its table (``None`` when computed on the fly)."""
+    """A figure of the thesis.
+
+    Its drawing function, a title, and the sweep spec of its table (``None`` when computed
+    on the fly).
+    """
 
     func: Callable
     title: str
@@ -435,7 +464,7 @@ class Figure(NamedTuple):
 
 
 def _lazy(module: str, name: str) -> Callable:
-    """The figure ``name`` of ``module`` (imported when drawn)."""
+    """Return the figure ``name`` of ``module`` (imported when drawn)."""
     def draw(out):
         import importlib
         return getattr(importlib.import_module(module), name)(out)
@@ -443,7 +472,7 @@ def _lazy(module: str, name: str) -> Callable:
 
 
 def _friction(name: str) -> Callable:
-    """A figure of :mod:`vimpact.plots.friction` (imported when drawn)."""
+    """Return a figure of :mod:`vimpact.plots.friction` (imported when drawn)."""
     return _lazy("vimpact.plots.friction", name)
 
 

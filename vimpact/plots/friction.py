@@ -47,8 +47,11 @@ def _columns(nu, G, eta, R, m, v_z0, v_x0, theta_ratio, mu) -> dict:
 
 
 def _exit_incidence(nu, theta_ratio, Q1, psi1, mu=0.3) -> np.ndarray:
-    """``psi2`` for incidences ``psi1`` (a dimensionless scene: v_z0 = 1 m/s, R = 1 m,
-    m = 1 kg, a_H = 0.01 R)."""
+    """Return the exit incidences ``psi2`` for incidences ``psi1``.
+
+    ``psi2`` for incidences ``psi1`` (a dimensionless scene: v_z0 = 1 m/s, R = 1 m,
+    m = 1 kg, a_H = 0.01 R).
+    """
     d = REFERENCE_INDENTATION  # m
     G = 15.0 / (16.0 * d**2.5) * (1.0 - nu) / 2.0  # E* from d at 1 m/s
     T = d / 1.0
@@ -103,8 +106,11 @@ CHUNG_OOI = {"E_Pa": 380e9, "nu": 0.23, "density_kg_m3": 4000.0, "R_m": 2.5e-3,
 
 
 def chung_ooi_angles(angles_deg) -> dict:
-    """Rebound angle (deg) and spin (rad/s) of the Chung-Ooi test 4 sphere at the
-    given impact angles (degrees from the normal), elastic, rigid wall."""
+    """Return the rebound angle and spin of the Chung-Ooi test 4 sphere.
+
+    Rebound angle (deg) and spin (rad/s) of the Chung-Ooi test 4 sphere at the
+    given impact angles (degrees from the normal), elastic, rigid wall.
+    """
     p = CHUNG_OOI
     angles = np.radians(np.asarray(angles_deg, dtype=float))
     m = 4.0 / 3.0 * np.pi * p["R_m"] ** 3 * p["density_kg_m3"]

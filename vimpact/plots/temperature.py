@@ -33,8 +33,11 @@ FIGURE_NUMERICS = Numerics.preset("fast")
 
 def restitution_curves(material: Material, temperatures=TEMPERATURES_K, speeds=SPEEDS_M_S,
                        numerics: Numerics = FIGURE_NUMERICS) -> dict[float, np.ndarray]:
-    """``e_z`` at each normal speed (m/s) for each temperature (K) of ``material``
-    (shifted by its shift law), sphere :data:`SPHERE`; temperature -> array."""
+    """Return ``e_z`` over the normal speed at each temperature.
+
+    ``e_z`` at each normal speed (m/s) for each temperature (K) of ``material``
+    (shifted by its shift law), sphere :data:`SPHERE`; temperature -> array.
+    """
     R, m = SPHERE
     out = {}
     for T in temperatures:
@@ -50,9 +53,12 @@ def restitution_curves(material: Material, temperatures=TEMPERATURES_K, speeds=S
 
 
 def fig_temperature(out, material: Material | str | Path | None = None) -> Path:
-    """``e_z`` over the impact speed at :data:`TEMPERATURES_K` for ``material`` (a
+    """Draw ``e_z`` over the impact speed at several temperatures.
+
+    ``e_z`` over the impact speed at :data:`TEMPERATURES_K` for ``material`` (a
     :class:`Material` with a shift law or a material file; default
-    :data:`EXAMPLE_MATERIAL`, read relative to the current directory)."""
+    :data:`EXAMPLE_MATERIAL`, read relative to the current directory).
+    """
     from vimpact.model.material_file import load_material
 
     if material is None:
@@ -65,11 +71,13 @@ def fig_temperature(out, material: Material | str | Path | None = None) -> Path:
         name = Path(material).stem.replace("_", " ")
         material = load_material(material)
     curves = restitution_curves(material)
+    shift = material.shift
+    assert shift is not None  # restitution_curves (at_temperature) needs a shift law
     R, m = SPHERE
     with _drawing(out, figsize=(8.4, 4.4)) as (fig, ax):
         for k, (T, e_z) in enumerate(curves.items()):
             ax.plot(SPEEDS_M_S, e_z, marker=_MARKERS[k % len(_MARKERS)],
-                    label=f"T = {T:g} K (a_T = {material.shift.shift_factor(T):.2g})")
+                    label=f"T = {T:g} K (a_T = {shift.shift_factor(T):.2g})")
         ax.set_xscale("log")
         from matplotlib.ticker import NullFormatter
         ticks = [v for v in (0.02, 0.05, 0.1, 0.2, 0.5) if SPEEDS_M_S[0] <= v <= SPEEDS_M_S[-1]]
@@ -78,7 +86,7 @@ def fig_temperature(out, material: Material | str | Path | None = None) -> Path:
         ax.set_xlabel(r"normal impact speed $v_{z0}$ (m/s)")
         ax.set_ylabel(r"$e_z$ (dimensionless)")
         ax.set_title(f"sphere R = {R * 100:g} cm, m = {m * 1000:g} g on the {name}")
-        ax.legend(title=material.shift.describe().replace(", T_ref", "\nT_ref"),
+        ax.legend(title=shift.describe().replace(", T_ref", "\nT_ref"),
                   title_fontsize=9, loc="center left", bbox_to_anchor=(1.01, 0.5))
     return Path(out)
 

@@ -274,6 +274,21 @@ def kelvin_voigt_small_damping_slope() -> float:
     return 1.5 * float(beta(0.6, 1.5))
 
 
+class _Event:
+    """A terminal event of :func:`scipy.integrate.solve_ivp`.
+
+    ``fn(t, y)`` crossing zero in ``direction`` (-1: from above) stops the integration.
+    """
+
+    terminal = True
+
+    def __init__(self, fn, direction: int):
+        self.fn, self.direction = fn, direction
+
+    def __call__(self, t, y):
+        return self.fn(t, y)
+
+
 def _kv_single(tau_hat: float, rtol: float) -> tuple[float, float, float]:
     """One Kelvin-Voigt continuum impact; see :func:`kelvin_voigt_continuum`."""
     a = 1.25                # Hertz force coefficient, 5/4
@@ -294,12 +309,7 @@ def _kv_single(tau_hat: float, rtol: float) -> tuple[float, float, float]:
         u, v = y
         return [v, -(a * u + c * v) * math.sqrt(max(u, 0.0))]
 
-    def turning(t, y):
-        return y[1]
-
-    turning.terminal = True
-    turning.direction = -1
-
+    turning = _Event(lambda t, y: y[1], direction=-1)  # v = 0 from above
     s1 = solve_ivp(loading, (t0, t_end_max), [u0, v0], events=turning, **opts)
     if s1.status != 1:
         raise RuntimeError(f"Kelvin-Voigt reference: no turning point (tau_hat={tau_hat!r}): {s1.message}")
@@ -314,12 +324,7 @@ def _kv_single(tau_hat: float, rtol: float) -> tuple[float, float, float]:
         f = a * max(w, 0.0) ** 1.5
         return [v - tau_hat * f, -f]
 
-    def separation(t, y):
-        return y[0]
-
-    separation.terminal = True
-    separation.direction = -1
-
+    separation = _Event(lambda t, y: y[0], direction=-1)  # w = 0 from above
     s2 = solve_ivp(unloading, (t1, t1 + t_end_max), [u_max, 0.0], events=separation, **opts)
     if s2.status != 1:
         raise RuntimeError(f"Kelvin-Voigt reference: no separation (tau_hat={tau_hat!r}): {s2.message}")
@@ -329,7 +334,7 @@ def _kv_single(tau_hat: float, rtol: float) -> tuple[float, float, float]:
 
 
 def kelvin_voigt_continuum(q1, rtol: float = 1e-12) -> KelvinVoigtResult:
-    """Normal impact of a rigid sphere on a Kelvin-Voigt half-space, continuum limit.
+    """Solve the normal impact of a rigid sphere on a Kelvin-Voigt half-space, continuum limit.
 
     Kernel units (docs/physics.md#hertz-scales, docs/physics.md#kelvin-voigt-continuum,
     docs/physics.md#dimensionless-parameters): indentation ``u`` in units of

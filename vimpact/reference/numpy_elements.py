@@ -92,7 +92,9 @@ def advance_arms(q, w0, w1, coefficients):
 
 
 class Rheology:
-    """The general element of docs/physics.md#rheologies, per unit length and per
+    """The general element of the rheologies.
+
+    The general element of docs/physics.md#rheologies, per unit length and per
     unit of the geometric factor ``c`` (``c_n`` or ``c_t``)::
 
         stress(w, q, dw/dt) = G_inf w + eta0 dw/dt + sum_i G_i (w - q_i)
@@ -156,9 +158,12 @@ class Rheology:
         return self.G_inf * w + (self.G * kap * (w[:, None] - q)).sum(axis=1)
 
     def arm_mean_stress(self, w0, w1, q0, dt):
-        """The arms' stress averaged over ``dt`` (Pa, per element) on the linear path
+        """Return the arms' stress averaged over ``dt``, Pa per element.
+
+        The arms' stress averaged over ``dt`` (Pa, per element) on the linear path
         ``w0 -> w1`` from ``q0``: ``sum G_i [(1 - phi_i)(w0 - q0_i) + (tau_i phi_i /
-        dt)(w1 - w0)]``; ``dt`` per element."""
+        dt)(w1 - w0)]``; ``dt`` per element.
+        """
         _, _, phi = arm_update_coefficients(self.tau[None, :], dt[:, None])
         x = dt[:, None] / self.tau[None, :]
         phi_x = np.where(x < 1e-3, 0.5 - x * (1.0 / 6.0 - x / 24.0),
@@ -181,12 +186,15 @@ class Rheology:
 # ------------------------------------------------------------------ impact
 
 def stick_path_in_cone(L0, L1, C0, C1, alpha):
-    """Integral over ``t`` in ``[0, alpha]`` (fractions of the step) of a sticking
+    """Integrate a leaving element's tangential force over part of a step.
+
+    Integral over ``t`` in ``[0, alpha]`` (fractions of the step) of a sticking
     element's tangential force as it leaves: the stick path ``L0 + t (L1 - L0)``
     clipped to the cone ``|f_t| <= C0 + t (C1 - C0)``, which reaches 0 with the
     normal force at ``t = alpha``. ``|L| - C`` is convex: the element sticks up to
     ``t*`` (where ``|L| = C``) and then follows the cone, with the sign of
-    ``L(alpha)``, down to 0. Arrays of one length; N s / h."""
+    ``L(alpha)``, down to 0. Arrays of one length; N s / h.
+    """
     L0, L1, C0, C1, alpha = np.broadcast_arrays(*(np.asarray(x, dtype=float)
                                                   for x in (L0, L1, C0, C1, alpha)))
     dL, dC = L1 - L0, C1 - C0
@@ -201,7 +209,9 @@ def stick_path_in_cone(L0, L1, C0, C1, alpha):
 
 def naive_impact(scene, steps, elements, row_width=1.05, max_time=100.0, mu=None,
                  check_cone=True, flat_punch=None, refinement=(1.0, 1.0)):
-    """Simulate ``scene`` (a :class:`vimpact.Scene`) in SI units with the
+    """Simulate ``scene`` with the NumPy reference of the element kernel.
+
+    Simulate ``scene`` (a :class:`vimpact.Scene`) in SI units with the
     Stormer-Verlet scheme of the kernel.
 
     Parameters
