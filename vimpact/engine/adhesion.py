@@ -28,6 +28,7 @@ from vimpact.engine.result import FINISHED, RESULT_FIELDS, STATUSES, ImpactResul
 from vimpact.kernels import adhesion as kernel
 from vimpact.kernels.layout import STATUS_ROW_EXCEEDED, VERLET
 from vimpact.kernels.status import BY_CODE
+from vimpact.model.hertz import effective_modulus, hertz_scales
 from vimpact.model.numerics import Numerics
 from vimpact.model.scene import HALF_SPACE_LIMIT, TANGENTIAL_EFFECTS, Scene
 from vimpact.model.validation import InputError, message, positive, require
@@ -109,6 +110,29 @@ def adhesion_numbers(cols: SceneColumns) -> np.ndarray:
     E_star = 2.0 * cols.G_inf / (1.0 - cols.nu)
     with np.errstate(all="ignore"):  # nu = 1 cannot occur in a valid row
         return np.sqrt(2.0 * np.pi * cols.a_H * cols.adhesion / E_star) / cols.d
+
+
+def work_of_adhesion(lam, G_inf, nu, R, m, v_z0) -> np.ndarray:
+    """Return the work of adhesion (J/m^2) that gives each row the adhesion number ``lam``.
+
+    :func:`adhesion_for_number` on arrays (relaxed shear modulus ``G_inf``, Pa;
+    Poisson ratio ``nu``; sphere radius ``R``, m, and mass ``m``, kg; impact speed
+    ``v_z0``, m/s): ``dgamma = lam^2 d^2 E* / (2 pi a_H)``.
+    """
+    hz = hertz_scales(G_inf, nu, R, m, v_z0)
+    E_star = effective_modulus(G_inf, nu)
+    return np.asarray(lam, dtype=float) ** 2 * hz.d**2 * E_star / (2.0 * np.pi * hz.a_H)
+
+
+def adhesion_number_of(dgamma, G_inf, nu, R, m, v_z0) -> np.ndarray:
+    """Return the adhesion number ``lam`` of each row (inputs as :func:`work_of_adhesion`).
+
+    :func:`adhesion_number` on arrays; ``dgamma`` the work of adhesion, J/m^2.
+    """
+    hz = hertz_scales(G_inf, nu, R, m, v_z0)
+    E_star = effective_modulus(G_inf, nu)
+    with np.errstate(all="ignore"):  # a bad row gives NaN, marked by the engine
+        return np.sqrt(2.0 * np.pi * hz.a_H * np.asarray(dgamma, dtype=float) / E_star) / hz.d
 
 
 def kernel_inputs(cols: SceneColumns, numerics: Numerics, widen: float = 1.0
@@ -311,8 +335,9 @@ def jkr_quasi_static(E_star: float, R: float, dgamma: float, d_path: np.ndarray,
 def impact_result(scene: Scene, numerics: Numerics | None = None) -> ImpactResult:
     """Return :func:`simulate_adhesive` as the :class:`~vimpact.ImpactResult` of simulate.
 
-    Normal impact only: e_x, beta_x NaN; status ``stuck`` when the sphere did not
-    separate, else ``normal_only``/``vc0_zero``.
+    Normal impact only: e_x, beta_x, mu_eff, gross_slip_fraction NaN, friction_energy
+    0 (no slip); status ``stuck`` when the sphere did not separate, else
+    ``normal_only``/``vc0_zero``.
     """
     res = simulate_adhesive(scene, numerics)
     hz = scene.hertz
@@ -325,7 +350,18 @@ def impact_result(scene: Scene, numerics: Numerics | None = None) -> ImpactResul
         energy_ratio=res.energy_ratio, Q1=scene.Q1, Q2=scene.Q2, nu=scene.material.nu,
         v_z_end=res.v_z_end, v_x_end=scene.v_x0, omega_end=scene.omega0, status=status,
         n_steps=res.n_steps, path=PATH_NAME, F_tensile_max=res.F_tensile_max,
+        rebound_angle=float(rebound_angle(np.float64(scene.v_x0), np.float64(res.v_z_end))),
+        friction_energy=0.0 if math.isfinite(res.e_z) else math.nan,
         error=None if status in FINISHED else STATUSES.get(status, status))
+
+
+def rebound_angle(v_x_end, v_z_end):
+    """Angle of the end velocity to the normal, ``atan2(v_x_end, -v_z_end)``, degrees.
+
+    A sphere that stuck (``v_z_end = 0``) has 0 (90 if it slides on with ``v_x0``), not
+    the 180 of the signed zero ``-0.0``.
+    """
+    return np.degrees(np.arctan2(v_x_end, -v_z_end + 0.0))
 
 
 def result_columns(cols: SceneColumns, numerics: Numerics) -> dict[str, np.ndarray]:
@@ -368,6 +404,8 @@ def result_columns(cols: SceneColumns, numerics: Numerics) -> dict[str, np.ndarr
               "omega_end": cols.omega0, "status": status,
               "n_steps": out[:, kernel.ADH_STEPS].astype(np.int64),
               "path": np.full(n, PATH_NAME, dtype=object), "mu_eff": nan.copy(),
-              "rebound_angle": nan.copy(), "gross_slip_fraction": nan.copy(),
-              "friction_energy": nan.copy(), "error": error}
+              "rebound_angle": rebound_angle(cols.v_x0, vals["v_z_end"]),
+              "gross_slip_fraction": nan.copy(),
+              "friction_energy": np.where(np.isfinite(vals["e_z"]), 0.0, np.nan),
+              "error": error}
     return {name: result[name] for name in RESULT_FIELDS}
