@@ -26,7 +26,7 @@ from vimpact.kernels.jit import jit
 CHUNK = 2048
 
 
-@jit()
+@jit(inline="always")
 def _lagrange_thirds(t, w):
     """Cubic Lagrange weights of the nodes ``0, 1/3, 2/3, 1`` at ``t`` into ``w[0:4]``."""
     a = t - 1.0 / 3.0
@@ -38,7 +38,7 @@ def _lagrange_thirds(t, w):
     w[3] = 4.5 * t * a * b
 
 
-@jit()
+@jit(inline="always")
 def _tensor_weights(nodes, x, w):
     """First node of the local stencil on the tensor axis and its Lagrange weights in
     ``w`` (returns ``(first, count)``); a single node has weight 1."""
@@ -64,7 +64,7 @@ def _tensor_weights(nodes, x, w):
     return s, m
 
 
-@jit()
+@jit(inline="always")
 def _eval_point(p, k, lo, hi, child, leaf_of, leaf_nodes, tnodes, values, out_row,
                 u, idx, wa, wt):
     """Interpolated outputs at one point ``p`` (adaptive coordinates, then the tensor one);
@@ -79,18 +79,17 @@ def _eval_point(p, k, lo, hi, child, leaf_of, leaf_nodes, tnodes, values, out_ro
             v = 1.0
         u[d] = v
     cell = 0
-    level = 0
+    scale = 1.0  # 2**level
     while leaf_of[cell] < 0:
         c = 0
         for d in range(k):
-            upper = u[d] * 2.0 ** (level + 1) >= 2 * idx[d] + 1
+            upper = u[d] * (2.0 * scale) >= 2 * idx[d] + 1
             idx[d] = 2 * idx[d] + (1 if upper else 0)
             if upper:
                 c |= 1 << d
         cell = child[cell, c]
-        level += 1
+        scale *= 2.0
     leaf = leaf_of[cell]
-    scale = 2.0 ** level
     for d in range(k):
         t = u[d] * scale - idx[d]
         if t < 0.0:
