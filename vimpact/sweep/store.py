@@ -65,6 +65,10 @@ JSON_KEYS = ("numerics", "units", "columns", "statuses", "paths", "rotation", "c
 #: Metadata keys stored as integers.
 INT_KEYS = ("schema_version", "seed", "rows", "chunk", "row_start", "row_stop", "n_chunks",
             "chunk_size")
+#: Parquet compression of every table and part written (zstd: the shipped adaptive
+#: standard-solid table is 10.1 MB, 11.8 MB with snappy; the content hash is of the data,
+#: not of the file's bytes, so it does not depend on it).
+COMPRESSION = "zstd"
 #: Name of the dataset file that holds the schema and the sweep metadata.
 COMMON_METADATA = "_common_metadata"
 #: Metadata key (without the prefix) of the content hash (:class:`ContentHash`).
@@ -616,12 +620,13 @@ def write_atomic(table, path: Path, *, schema_only: bool = False, more=(),
             if schema_only:
                 pq.write_metadata(table.schema, f)
             elif more:
-                with pq.ParquetWriter(f, table.schema, write_page_checksum=True) as writer:
+                with pq.ParquetWriter(f, table.schema, write_page_checksum=True,
+                                      compression=COMPRESSION) as writer:
                     writer.write_table(table)
                     for other in more:
                         writer.write_table(other.replace_schema_metadata(table.schema.metadata))
             else:
-                pq.write_table(table, f, write_page_checksum=True)
+                pq.write_table(table, f, write_page_checksum=True, compression=COMPRESSION)
     except OSError as exc:
         raise OSError(exc.errno, f"{exc.strerror or _first_line(exc)} while writing "
                       f"{path}") from exc
