@@ -596,7 +596,10 @@ class RestitutionTable:
     # ---- lookup ----------------------------------------------------------
     def _theta_values(self) -> np.ndarray:
         v = self.data["theta_ratio"].to_numpy(float)
-        return cluster_nodes(v[np.isfinite(v)])[0] if np.isfinite(v).any() else np.array([])
+        # distinct values first: clustering is a Python loop over its values, and a
+        # table's rows (489360 in the adaptive standard-solid table) repeat a few values
+        return cluster_nodes(np.unique(v[np.isfinite(v)]))[0] if np.isfinite(v).any() \
+            else np.array([])
 
     def _resolve_theta(self, theta_ratio) -> float | None:
         """The theta_ratio slice to use (None: the table has one value / no column)."""
@@ -626,7 +629,8 @@ class RestitutionTable:
         if "psi" not in self.data.columns:
             return np.array([])
         v = self.data["psi"].to_numpy(float)
-        return cluster_nodes(v[np.isfinite(v)])[0] if np.isfinite(v).any() else np.array([])
+        return cluster_nodes(np.unique(v[np.isfinite(v)]))[0] if np.isfinite(v).any() \
+            else np.array([])
 
     def _base_axes(self) -> list[str]:
         model = self.model
