@@ -1,19 +1,23 @@
-"""Gross slip in closed form: where a friction table's incidence axis ends.
+"""Gross slip in closed form: the part of a friction table's incidence axis not tabulated.
 
 Under Coulomb friction the tangential restitution over the incidence
 ``psi = 2 (1 - nu) / (mu (2 - nu)) v_c0 / v_z0`` has kinks where the course of the
-contact changes (docs/physics.md#coulomb-friction). The last one is the onset of
-gross slip throughout the contact: there the tangential force is ``mu F_z`` at all
-times, so the contact point's velocity changes by ``mu (1 + m R^2 / Theta) (1 + e_z)
-v_z0`` whatever the rheology, and
+contact changes (docs/physics.md#coulomb-friction). Beyond the last one the contact
+slips throughout: the tangential force is ``mu F_z`` at all times, so the contact
+point's velocity changes by ``mu (1 + m R^2 / Theta) (1 + e_z) v_z0`` whatever the
+rheology, and
 
     beta_x = -1 + 2 chi (1 + e_z) / psi,   chi = (1 - nu) (1 + m R^2 / Theta) / (2 - nu),
 
-for ``psi >= psi_g = 2 chi (1 + e_z)``, where the contact point just stops at the end
-of the contact (``beta_x = 0``; for the elastic sphere, ``e_z = 1``, this is Maw,
-Barber and Fawcett's ``psi_1 >= 4 chi``). ``e_z`` is the normal restitution, which
-friction does not change. A friction table therefore needs nodes only on
-``0 <= psi <= psi_g`` (its end node on the kink); beyond, the closed form is exact.
+with ``e_z`` the normal restitution, which friction does not change. Since
+``|F_x| <= mu F_z`` at all times, this is also an upper bound of ``beta_x`` at every
+``psi``. It reaches ``beta_x = 0`` (the contact point just stops at the end) at
+``psi_g = 2 chi (1 + e_z)`` (for the elastic sphere, ``e_z = 1``, Maw, Barber and
+Fawcett's ``psi_1 = 4 chi``). Gross slip throughout holds at least from ``psi_g`` on;
+the tangential compliance lets it begin somewhat below (measured on a Kelvin-Voigt
+half-space, ``Q1 = 0.1``, ``nu = 0.3``: from about ``0.84 psi_g``, where ``beta_x``
+is 0.19), so the kink where microslip meets gross slip is below ``psi_g`` and is
+found by simulation, not by this closed form.
 """
 
 from __future__ import annotations
@@ -38,7 +42,8 @@ def chi(nu, theta_ratio=0.4, rotation: bool = True):
 
 
 def gross_slip_onset(e_z, nu, theta_ratio=0.4, rotation: bool = True):
-    """Incidence ``psi_g = 2 chi (1 + e_z)`` above which the contact slips throughout.
+    """Incidence ``psi_g = 2 chi (1 + e_z)`` where the gross-slip closed form gives
+    ``beta_x = 0``; the contact slips throughout at every ``psi >= psi_g``.
 
     Parameters
     ----------
