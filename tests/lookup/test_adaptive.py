@@ -209,3 +209,35 @@ def test_kelvin_voigt_build_against_direct_simulation(tmp_path):
     look = table.lookup(q1, nu)
     assert np.max(np.abs(look["e_z"] - sim["e_z"].to_numpy())) <= 1e-4
     assert np.max(np.abs(look["beta_x"] - sim["beta_x"].to_numpy())) <= 1e-4
+
+
+def test_grid_only_views_are_refused_with_a_reason(analytic):
+    grid, report = analytic
+    table = _as_table(grid, report)
+    with pytest.raises(InputError, match="adaptive table"):
+        table.to_xarray()
+
+
+@pytest.mark.slow
+def test_standard_solid_refinement_on_a_ridge_meets_its_tolerance(tmp_path):
+    """The real kernel where the standard solid changes course (Q2 = 0.01, Q1 near 4.4):
+    a small adaptive table held to 1e-4 is within it at fresh random points."""
+    from vimpact.lookup.verify import numerics_of, simulate_dimensionless
+    from vimpact.tablebuild.adaptive import build_adaptive
+
+    spec = tmp_path / "ss.toml"
+    spec.write_text('model = "standard_solid"\noutput = "ss.parquet"\n[grid]\n'
+                    'Q1 = { start = 3, stop = 6, num = 2 }\n'
+                    'Q2 = { start = 0.008, stop = 0.012, num = 2 }\nnu = 0.5\n'
+                    'tolerance = 1e-4\nrefine = "adaptive"\nmin_level = 1\nmax_level = 8\n')
+    table, _ = build_adaptive(spec, n_verify=50)
+    assert table.meta("grid_refinement")["met"]
+    assert table.info()["adaptive"]["levels"][1] > 1  # it had to refine
+    rng = np.random.default_rng(99)
+    q1, q2 = np.exp(rng.uniform(np.log(3), np.log(6), 30)), np.exp(
+        rng.uniform(np.log(0.008), np.log(0.012), 30))
+    sim = simulate_dimensionless("standard_solid", q1, np.full(30, 0.5), q2,
+                                 numerics=numerics_of(table))
+    look = table.lookup(q1, 0.5, Q2=q2)
+    for k in ("e_z", "beta_x"):
+        assert np.max(np.abs(look[k] - sim[k].to_numpy())) <= 1e-4

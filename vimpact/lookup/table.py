@@ -920,11 +920,13 @@ class RestitutionTable:
         try:
             import xarray as xr
         except ImportError:
-            from vimpact.model.validation import InputError
-
             raise InputError("to_xarray = xarray is not allowed here: xarray is not installed "
                              "(pip install xarray); RestitutionTable.data is the same table "
                              "as a pandas DataFrame") from None
+        if self.is_adaptive:
+            raise InputError(f"to_xarray is not allowed for the adaptive table"
+                             f"{self._where(self.path)}: its nodes are cells of different "
+                             "sizes, not a grid; evaluate lookup() on the grid you need")
         theta = self._resolve_theta(theta_ratio)
         grid = self._lookup_grid() if theta is None else self._grid(theta)
         units = self.units
