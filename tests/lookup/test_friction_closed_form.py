@@ -39,3 +39,23 @@ def test_closed_form_matches_simulation_above_the_onset_only():
     closed = -1.0 + onset / (0.8 * onset)
     assert np.all(sim["beta_x"].to_numpy() < closed - 1e-3)
     assert np.all(sim["gross_slip_fraction"].to_numpy() < 0.99)
+
+
+@pytest.mark.slow
+def test_gross_slip_starts_below_psi_g_and_the_closed_form_holds_from_there():
+    """The kink where microslip meets gross slip (found by bisection on the simulated
+    gross-slip fraction) is below psi_g; just above it the simulation is the closed
+    form, just below it beta_x is under the closed form (the Coulomb bound)."""
+    from vimpact.lookup.verify import simulate_dimensionless
+    from vimpact.tablebuild.friction import gross_slip_start
+
+    q1, nu = np.array([0.01, 0.1, 1.0]), np.array([0.3, 0.3, 0.5])
+    found = gross_slip_start("kelvin_voigt", q1, nu, rel_tol=1e-3)
+    psi_s, psi_g, e_z = found["psi_s"], found["psi_g"], found["e_z"]
+    assert np.all(psi_s < psi_g) and np.all(psi_s > 0.5 * psi_g)
+    above = simulate_dimensionless("kelvin_voigt", q1, nu, psi=psi_s * 1.001, mu=0.3)
+    np.testing.assert_allclose(above["beta_x"].to_numpy(),
+                               -1.0 + psi_g / (psi_s * 1.001), atol=1e-6)
+    below = simulate_dimensionless("kelvin_voigt", q1, nu, psi=psi_s * 0.99, mu=0.3)
+    assert np.all(below["beta_x"].to_numpy() < -1.0 + psi_g / (psi_s * 0.99))
+    assert np.all(below["gross_slip_fraction"].to_numpy() < 1.0)
