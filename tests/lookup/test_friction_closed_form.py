@@ -51,7 +51,7 @@ def test_gross_slip_starts_below_psi_g_and_the_closed_form_holds_from_there():
 
     q1, nu = np.array([0.01, 0.1, 1.0]), np.array([0.3, 0.3, 0.5])
     found = gross_slip_start("kelvin_voigt", q1, nu, rel_tol=1e-3)
-    psi_s, psi_g, e_z = found["psi_s"], found["psi_g"], found["e_z"]
+    psi_s, psi_g = found["psi_s"], found["psi_g"]
     assert np.all(psi_s < psi_g) and np.all(psi_s > 0.5 * psi_g)
     above = simulate_dimensionless("kelvin_voigt", q1, nu, psi=psi_s * 1.001, mu=0.3)
     np.testing.assert_allclose(above["beta_x"].to_numpy(),
