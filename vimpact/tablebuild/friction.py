@@ -31,7 +31,7 @@ SAME_FRACTION = 1e-9
 def gross_slip_start(model: str, Q1, nu, Q2=None, *, theta_ratio: float = 0.4,
                      numerics=None, rel_tol: float = 1e-4, mu: float = 1.0,
                      simulate=None) -> dict:
-    """The incidence ``psi_s`` above which the contact slips throughout, per point.
+    """Find the incidence ``psi_s`` above which the contact slips throughout, per point.
 
     Parameters
     ----------
