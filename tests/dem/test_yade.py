@@ -31,6 +31,32 @@ def test_yade_runs_the_exported_file_and_restitutes_the_prediction(exported):
     assert diff[1600] < diff[400] / 2  # Yade's time-step error, shrinking with the step
 
 
+@pytest.mark.slow  # 84 s on a loaded 2-core machine (an export and two Yade runs)
+def test_yade_oblique_wall_impacts_give_the_reported_beta():
+    """Yade on the exported file, oblique wall impacts with the set-up's friction at the
+    report's speeds and angles: its beta is the report's prediction (which includes
+    Yade's wall lever arm R - delta) to its time-step error, shrinking with the step, and
+    within the stated beta_x residual (plus that error) of vimpact's."""
+    need(yade.yade_available(), "Yade")
+    from tests.dem.test_round_trip import oblique_rows_against_vimpact
+
+    problem = problem_from_toml(TOML, "round-trip")
+    ex = export(problem, "yade")
+    f = next(x for x in ex.fits if x.contact.key == "a-floor")
+    ob = ex.targets["a-floor"].oblique
+    speeds, angles = sorted(set(ob.v.tolist())), sorted(set(ob.angle_deg.tolist()))
+    diff, rows = {}, {}
+    for steps in (400, 1600):
+        rows[steps] = [r for r in yade.round_trip(problem, speeds, steps, fits=ex.fits,
+                                                  angles_deg=angles) if r["contact"] == "a-floor"]
+        assert len(rows[steps]) == len(speeds) * len(angles)
+        diff[steps] = max(abs(r["beta"] - r["predicted_beta"]) for r in rows[steps])
+    assert diff[1600] < 3e-3
+    assert diff[1600] < diff[400] / 2
+    for r, beta_vimpact in oblique_rows_against_vimpact(rows[1600], ob):
+        assert abs(r["beta"] - beta_vimpact) <= f.res_beta_x.max_abs + diff[1600]
+
+
 def test_exported_yade_file_defines_every_pair_and_one_variable_set(exported):
     problem, fits = exported
     text = yade.render(problem, fits)["yade_materials.py"]
