@@ -124,3 +124,22 @@ def test_stepped_yade_law_in_stick_is_yade_law_and_slides_as_a_rigid_body():
     w0 = np.array([5.0, 10.0, 20.0])
     e, b = laws.yade_coulomb(0.0, w_t / math.sqrt(kn), 0.0, F, 0.3, w0)
     assert b == pytest.approx(0.3 * F * (1 + e) / w0 - 1, abs=1e-9)
+
+
+def test_stepped_liggghts_and_mercurydpm_laws_slide_as_rigid_bodies():
+    """Gross slip without damping: v_c,end = v_c0 - mu F (1 + e) v_z0 for both laws
+    (with damping neither is exact: LIGGGHTS caps with |F_n|, which pulls at the end of a
+    damped contact, and both add their tangential dashpot uncapped while the spring is
+    below the cap, as Yade does)."""
+    F, mu = 3.5, 0.2
+    w0 = np.array([5.0, 10.0])
+    e, b = laws.liggghts_coulomb(1.0, 1.0, 0.0, F, mu, w0)
+    assert e == pytest.approx(1.0, abs=1e-6)
+    assert b == pytest.approx(mu * F * (1 + e) / w0 - 1, abs=1e-9)
+    e, b = laws.mercury_mindlin_coulomb(0.0, 1.0, 0.0, F, mu, w0)
+    assert b == pytest.approx(mu * F * (1 + e) / w0 - 1, abs=1e-9)
+
+
+def test_stepped_liggghts_normal_law_is_tsuji_hertz():
+    e, _ = laws.liggghts_coulomb(0.7, 1.0, 0.5, 3.5, math.inf, np.array([1.0]))
+    assert float(e[0]) == pytest.approx(laws.tsuji_hertz_e(0.7), abs=1e-5)

@@ -242,10 +242,10 @@ def hertz_mindlin_coulomb(alpha, kappa: float, x_gamma: float, F: float, mu: flo
     (e, beta) : arrays; ``beta = -w_end / w0``
     """
     return _stepped(np.asarray(alpha, dtype=float), np.asarray(w0, dtype=float), mu, steps,
-                    _mindlin_force(float(kappa), float(x_gamma), float(F)), hertz=True)
+                    _mindlin_force(float(kappa), float(x_gamma)), float(F))
 
 
-def _mindlin_force(kappa: float, x_gamma: float, F: float):
+def _mindlin_force(kappa: float, x_gamma: float):
     def force(x, v, s, w, alpha, cap):
         r = np.sqrt(np.maximum(x, 0.0))
         f = np.maximum(x * r + 1.5 * alpha * r * v, 0.0)
@@ -257,7 +257,7 @@ def _mindlin_force(kappa: float, x_gamma: float, F: float):
             s = np.where(over & (s != 0.0) & (k > 0.0),
                          (lim - 1.5 * alpha * x_gamma * r * w) / np.where(k > 0.0, k, 1.0), s)
             ft = np.where(over, np.where(s != 0.0, lim, 0.0), ft)
-        return 1.25 * f, 1.25 * F * ft, s
+        return 1.25 * f, 1.25 * ft, s
     return force
 
 
@@ -296,8 +296,47 @@ def mercury_mindlin_coulomb(alpha, K: float, D, F: float, mu: float, w0,
         k = K * r
         s = np.where(over, np.where(k > 0.0, lim / np.where(k > 0.0, k, 1.0), 0.0), s)
         ft = np.where(over, lim, el + Dflat * np.sqrt(r) * w)
-        return 1.25 * f, 1.25 * F * ft, s
-    return _stepped(alpha, w0, mu, steps, force, hertz=True)
+        return 1.25 * f, 1.25 * ft, s
+    return _stepped(alpha, w0, mu, steps, force, F)
+
+
+def liggghts_coulomb(e_in: float, K: float, D: float, F: float, mu: float, w0,
+                     steps: int = FRICTION_STEPS, lever=None) -> tuple[np.ndarray, np.ndarray]:
+    """Normal and tangential restitution of LIGGGHTS' ``model hertz tangential history``
+    in an oblique impact with Coulomb friction, stepped with velocity Verlet.
+
+    In the units of :func:`viscoelastic_hertz_e` (``d_H`` of LIGGGHTS' ``Y*``): normal
+    force ``x^1.5 + 2 |beta| x^(1/4) x'`` (not clipped, :func:`tsuji_hertz_e`);
+    tangential (``tangential_model_history.h``): the spring ``K sqrt(x) s`` with
+    ``K = 6 G*/Y*`` (``k_t = 8 G* sqrt(R delta)``) capped at ``mu |F_n|`` (the spring
+    reset to the cap), and below the cap the dashpot ``D x^(1/4) w`` with
+    ``D = 2 |beta| sqrt(4 G*/Y*)`` (``tangential_damping on``) or 0 (``off``);
+    ``beta`` from the input restitution ``e_in`` (:func:`liggghts_beta`). The law does
+    not depend on the speed: ``beta`` depends on the angle only, unless ``lever``
+    (``d_H / (2 R)`` per point, like ``w0``) is given: LIGGGHTS' contact point is at
+    ``R - delta/2`` from the centre (``cri``), the lever of the spin in the contact-point
+    velocity and of the torque, which shifts ``beta`` by about ``delta/R``.
+
+    Returns
+    -------
+    (e, beta) : arrays; ``beta = -w_end / w0``
+    """
+    b = abs(liggghts_beta(e_in))
+    w0 = np.asarray(w0, dtype=float)
+
+    def force(x, v, s, w, _a, cap):
+        xp = np.maximum(x, 0.0)
+        r = np.sqrt(xp)
+        q = np.sqrt(r)
+        f = xp * r + 2.0 * b * q * v
+        el = K * r * s
+        over = np.abs(el) > cap * np.abs(f)
+        lim = np.sign(el) * cap * np.abs(f)
+        k = K * r
+        s = np.where(over, np.where(k > 0.0, lim / np.where(k > 0.0, k, 1.0), 0.0), s)
+        ft = np.where(over, lim, el + D * q * w)
+        return 1.25 * f, 1.25 * ft, s
+    return _stepped(np.zeros(w0.shape), w0, mu, steps, force, F, lever)
 
 
 def yade_coulomb(zeta: float, w_t: float, zeta_t: float, F: float, mu: float, w0,
@@ -370,38 +409,50 @@ def yade_coulomb(zeta: float, w_t: float, zeta_t: float, F: float, mu: float, w0
     return e.reshape(shape), (-wend / w0).reshape(shape)
 
 
-def _stepped(alpha: np.ndarray, w0: np.ndarray, mu: float, steps: int, force,
-             hertz: bool) -> tuple[np.ndarray, np.ndarray]:
-    """Velocity Verlet over many points until each contact ends (overlap back to zero):
-    ``force(x, v, s, w, alpha, mu) -> (a_n, a_t, s)`` gives the normal and contact-point
-    accelerations (positive decelerates) and the history after the friction cap."""
+def _stepped(alpha: np.ndarray, w0: np.ndarray, mu: float, steps: int, force, F: float,
+             lever=None) -> tuple[np.ndarray, np.ndarray]:
+    """Velocity Verlet over many points (time unit ``T = d_H / v0``; ``steps`` per elastic
+    Hertz contact time) until each contact ends (overlap back to zero):
+    ``force(x, v, s, w, alpha, mu) -> (a_n, a_t, s)`` gives the normal acceleration and the
+    tangential force per unit mass (positive decelerates) and the history after the
+    friction cap. The centre moves by ``-a_t``, the spin (``R omega``) by
+    ``arm (F - 1) a_t`` with the lever ``arm = 1 - lever x`` (``lever`` per point, or 0),
+    and the contact point with ``w = u_x - arm R omega``."""
     alpha, w0 = np.broadcast_arrays(alpha, w0)
     shape = alpha.shape
     alpha, w0 = alpha.ravel().copy(), w0.ravel().copy()
-    h = (2.9432751843 if hertz else math.pi) / steps
+    lev = (np.zeros_like(w0) if lever is None
+           else np.broadcast_to(np.asarray(lever, dtype=float), shape).ravel())
+    spin = F - 1.0
+    h = 2.9432751843 / steps
     cap = min(float(mu), 1e300)  # stick: the tangential force still ends with the normal one
     x = np.zeros_like(alpha)
     v = np.ones_like(alpha)
     s = np.zeros_like(alpha)
-    w = w0.copy()
+    ux = w0.copy()
+    om = np.zeros_like(alpha)
     an = np.zeros_like(alpha)
     at = np.zeros_like(alpha)
     live = np.ones(alpha.shape, dtype=bool)
     e = np.full_like(alpha, np.nan)
     wend = np.full_like(alpha, np.nan)
     for _ in range(50 * steps):
+        arm = 1.0 - lev * x
         v_half = v - 0.5 * h * an
-        w_half = w - 0.5 * h * at
-        x_new = x + h * v_half
-        s_new = s + h * w_half  # the tangential displacement (history) in stick
-        an, at, s_new = force(x_new, v_half, s_new, w_half, alpha, cap)
-        v_new = v_half - 0.5 * h * an
-        w_new = w_half - 0.5 * h * at
-        ended = live & (x_new <= 0.0)
-        e[ended] = -v_new[ended]
-        wend[ended] = w_new[ended]
+        ux_half = ux - 0.5 * h * at
+        om_half = om + 0.5 * h * arm * spin * at
+        x = x + h * v_half
+        arm = 1.0 - lev * x
+        w_half = ux_half - arm * om_half
+        s = s + h * w_half  # the tangential displacement (history) in stick
+        an, at, s = force(x, v_half, s, w_half, alpha, cap)
+        v = v_half - 0.5 * h * an
+        ux = ux_half - 0.5 * h * at
+        om = om_half + 0.5 * h * arm * spin * at
+        ended = live & (x <= 0.0)
+        e[ended] = -v[ended]
+        wend[ended] = (ux - om)[ended]
         live &= ~ended
-        x, v, s, w = x_new, v_new, s_new, w_new
         if not live.any():
             break
     if live.any():
