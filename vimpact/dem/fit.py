@@ -2,7 +2,10 @@
 
 The targets are ``e_z(v)`` (normal impacts, every size level of the contact)
 and, for codes with a tangential restitution, ``beta_x(v)`` (full stick,
-``v_c0 = v_z0``; under stick ``beta_x`` does not depend on ``v_c0``). A fit
+``v_c0 = v_z0``; under stick ``beta_x`` does not depend on ``v_c0``) and, for a
+contact with a finite friction coefficient, vimpact's oblique impacts with it
+(:class:`Oblique`: ``beta_x`` over a few speeds times the set-up's impact angles),
+which the tangential fits then use. A fit
 runs the code's own law (:mod:`vimpact.dem.laws`) with the candidate
 constants at the same points and minimizes the RMS difference; its residual
 is reported as it is, never tuned away.

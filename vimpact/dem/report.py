@@ -92,9 +92,11 @@ def _fmt(x) -> str:
 
 def markdown(code: str, problem: DemProblem, targets: dict[str, Targets],
              fits: list[ContactFit], files: list[str], png: str,
-             steps_per_contact: int | None = None, step_error=None) -> str:
+             steps_per_contact: int | None = None, step_error=None,
+             beta_step_error: str | None = None) -> str:
     """The report text; ``steps_per_contact`` and ``step_error`` (the code module's
-    ``TIME_STEP_ERROR``) add the exported time step and the code's error at it."""
+    ``TIME_STEP_ERROR``) add the exported time step and the code's error at it,
+    ``beta_step_error`` (``BETA_TIME_STEP_ERROR``) its measured error in ``beta_x``."""
     lines = [f"# vimpact dem: {code}", "",
              f"Input: `{problem.source}`; normal impact speeds {problem.speeds.min():g} to "
              f"{problem.speeds.max():g} m/s ({problem.speeds.size} points, log-spaced)"
@@ -123,6 +125,10 @@ def markdown(code: str, problem: DemProblem, targets: dict[str, Targets],
                          f"{C / steps_per_contact:.1e} (first order in the step, "
                          f"{C:g} / steps; measured, largest over the round trip collisions: "
                          f"{measured}). Change it with `--steps-per-contact`.")
+        if beta_step_error is not None and any(f.beta_oblique is not None for f in fits):
+            lines.append(f"Its time-step error in beta_x is larger (measured on oblique wall "
+                         f"impacts: {beta_step_error}); add it to the beta_x residual, or "
+                         "raise `--steps-per-contact`.")
     lines += ["", "## Notes", ""]
     for f in fits:
         for note in f.notes:
