@@ -13,9 +13,15 @@ from vimpact.dem.problem import problem_from_toml
 
 
 @pytest.fixture(scope="module")
-def exported():
+def liggghts_export():
     problem = problem_from_toml(TOML, "round-trip")
-    return problem, export(problem, "liggghts").fits
+    return problem, export(problem, "liggghts")
+
+
+@pytest.fixture(scope="module")
+def exported(liggghts_export):
+    problem, ex = liggghts_export
+    return problem, ex.fits
 
 
 def test_liggghts_runs_the_exported_files_and_restitutes_the_prediction(exported):
@@ -39,7 +45,7 @@ def test_rigid_wall_gets_hard_particles(exported):
     assert text.index("hard_particles yes") < text.index("youngsModulus")
 
 
-def test_liggghts_oblique_wall_impacts_give_the_reported_beta():
+def test_liggghts_oblique_wall_impacts_give_the_reported_beta(liggghts_export):
     """LIGGGHTS on the exported files, oblique wall impacts with the set-up's friction at
     the report's speeds and angles: its beta is the report's prediction (its Hertz-Mindlin
     history law with the lever R - delta/2 at walls) to its time-step error, shrinking with
@@ -47,8 +53,7 @@ def test_liggghts_oblique_wall_impacts_give_the_reported_beta():
     need(liggghts.liggghts_available(), "LIGGGHTS")
     from tests.dem.test_round_trip import oblique_rows_against_vimpact
 
-    problem = problem_from_toml(TOML, "round-trip")
-    ex = export(problem, "liggghts")
+    problem, ex = liggghts_export
     f = next(x for x in ex.fits if x.contact.key == "a-floor")
     ob = ex.targets["a-floor"].oblique
     speeds, angles = sorted(set(ob.v.tolist())), sorted(set(ob.angle_deg.tolist()))

@@ -13,9 +13,15 @@ from vimpact.dem.problem import problem_from_toml
 
 
 @pytest.fixture(scope="module")
-def exported():
+def yade_export():
     problem = problem_from_toml(TOML, "round-trip")
-    return problem, export(problem, "yade").fits
+    return problem, export(problem, "yade")
+
+
+@pytest.fixture(scope="module")
+def exported(yade_export):
+    problem, ex = yade_export
+    return problem, ex.fits
 
 
 def test_yade_runs_the_exported_file_and_restitutes_the_prediction(exported):
@@ -31,8 +37,7 @@ def test_yade_runs_the_exported_file_and_restitutes_the_prediction(exported):
     assert diff[1600] < diff[400] / 2  # Yade's time-step error, shrinking with the step
 
 
-@pytest.mark.slow  # 84 s on a loaded 2-core machine (an export and two Yade runs)
-def test_yade_oblique_wall_impacts_give_the_reported_beta():
+def test_yade_oblique_wall_impacts_give_the_reported_beta(yade_export):
     """Yade on the exported file, oblique wall impacts with the set-up's friction at the
     report's speeds and angles: its beta is the report's prediction (which includes
     Yade's wall lever arm R - delta) to its time-step error, shrinking with the step, and
@@ -40,8 +45,7 @@ def test_yade_oblique_wall_impacts_give_the_reported_beta():
     need(yade.yade_available(), "Yade")
     from tests.dem.test_round_trip import oblique_rows_against_vimpact
 
-    problem = problem_from_toml(TOML, "round-trip")
-    ex = export(problem, "yade")
+    problem, ex = yade_export
     f = next(x for x in ex.fits if x.contact.key == "a-floor")
     ob = ex.targets["a-floor"].oblique
     speeds, angles = sorted(set(ob.v.tolist())), sorted(set(ob.angle_deg.tolist()))
