@@ -394,38 +394,6 @@ def round_trip(problem: DemProblem, speeds=(0.1, 1.0), steps_per_contact: int = 
     return rows
 
 
-def oblique_wall_restitution(fit: ContactFit, v: float, steps_per_contact: int = 2000
-                             ) -> tuple[float, float]:
-    """LAMMPS' ``(e, beta)`` for the wall contact of ``fit`` (nominal size): a sphere hits
-    the wall with normal speed ``v`` and tangential speed ``v`` (m/s), no spin. ``beta =
-    -v_c,end / v_c0`` with the contact point's velocity ``v_x - R omega_y``; the spin is
-    taken from the tangential impulse (``I = 0.4 m R^2``, LAMMPS' solid sphere)."""
-    from vimpact.dem.laws import hertz_contact_time
-
-    c = fit.contact
-    R, m = c.nominal()
-    rho = c.first.density
-    t_c = float(hertz_contact_time(fit.params["E_star_Pa"], R, m, v))
-    dt = t_c / steps_per_contact
-    gap = 1e-3 * R
-    coeffs = _coeffs(fit.params)
-    script = "\n".join([
-        "units si", "atom_style sphere", "atom_modify map array", "boundary f f f",
-        "comm_modify vel yes", "newton off",
-        f"region box block {-40 * R} {40 * R} {-40 * R} {40 * R} {-4 * R} {40 * R}",
-        "create_box 1 box", "pair_style granular", f"pair_coeff * * {coeffs}",
-        f"create_atoms 1 single 0 0 {R + gap:.12g}",
-        f"set atom 1 diameter {2 * R:.12g} density {rho:.12g}",
-        f"velocity all set {v:.12g} 0 {-v:.12g}",
-        f"fix w all wall/gran granular {coeffs} zplane 0.0 NULL",
-        "fix nve all nve/sphere", f"timestep {dt:.12g}",
-        f"run {int(math.ceil((gap / v + 2.0 * t_c) / dt))}",
-        "variable vx equal vx[1]", "variable vz equal vz[1]", ""])
-    vx, vz = run_lammps(script, ["vx", "vz"])
-    omega = R * m * (v - vx) / (0.4 * m * R * R)
-    return vz / v, -(vx - R * omega) / v
-
-
 def level_prediction(fit: ContactFit, R: float, m: float, v) -> np.ndarray:
     """What LAMMPS' law gives with ``fit``'s lines for a pair of effective radius ``R`` (m)
     and mass ``m`` (kg): ``eta_n0`` is fixed, so the dissipation time is ``A m / m_nom``."""
