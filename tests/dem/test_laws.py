@@ -101,7 +101,7 @@ def test_stepped_lammps_law_in_stick_is_the_stick_ode_and_converges(alpha):
 
 def test_stepped_lammps_law_in_gross_slip_is_the_rigid_body_closed_form():
     """Sliding throughout (grazing impacts): F_x = mu F_z at every step, so
-    v_c,end = v_c0 - mu F (1 + e) v_z0 (docs/physics.md#12-coulomb-friction-stick-microslip-gross-slip)."""
+    v_c,end = v_c0 - mu F (1 + e) v_z0 (docs/physics.md#coulomb-friction)."""
     mu, F = 0.3, 3.5
     w0 = np.array([5.0, 10.0, 20.0])
     e, beta = laws.hertz_mindlin_coulomb(np.full(3, 0.05), 0.7, 0.4, F, mu, w0)
