@@ -14,6 +14,12 @@ lists them by time, and ``COMPILE_PROFILE_OUT`` (default
 labelled with their closure constants, in the alphabetical order of their
 names: ``arms, dashpot, friction, integrator, memory, tangential``. Compiles
 in subprocesses (command-line tests) are not seen.
+
+Package functions compiled for more than one signature are listed too: a
+callee that receives a bare literal (``f(x, 0)``, or a counter that starts at
+``0``) is compiled once for ``Literal[int](0)`` and again for ``int64``, each
+time with everything it calls (the continuum kernel compiled its right-hand
+side eight times that way).
 """
 
 from __future__ import annotations
@@ -27,6 +33,7 @@ import pytest
 from numba.core import event
 
 _state = {"test": "<collection>", "depth": 0, "start": 0.0, "func": "", "rows": []}
+_signatures: dict[tuple[str, int], set] = {}  # (function, dispatcher id) -> signatures
 
 
 def _label(dispatcher) -> str:
@@ -45,6 +52,10 @@ def _label(dispatcher) -> str:
 
 class _Listener(event.Listener):
     def on_start(self, ev):
+        f = ev.data["dispatcher"].py_func
+        if f.__module__.startswith("vimpact."):
+            key = (f"{f.__module__}.{f.__qualname__}", id(ev.data["dispatcher"]))
+            _signatures.setdefault(key, set()).add(str(ev.data["args"]))
         if _state["depth"] == 0:
             _state["start"] = time.perf_counter()
             _state["func"] = _label(ev.data["dispatcher"])
@@ -74,6 +85,9 @@ def pytest_terminal_summary(terminalreporter):
     for r in rows:
         if r["seconds"] >= 1.0:
             tr.write_line(f"{r['seconds']:7.1f} s  {r['func']}\n           {r['test']}")
+    for (name, _), sigs in sorted(_signatures.items()):
+        if len(sigs) > 1:
+            tr.write_line(f"compiled for {len(sigs)} signatures: {name}")
     out = Path(os.environ.get("COMPILE_PROFILE_OUT", ".pytest_cache/numba_compiles.json"))
     out.parent.mkdir(parents=True, exist_ok=True)
     out.write_text(json.dumps(rows, indent=1))

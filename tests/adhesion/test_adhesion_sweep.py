@@ -116,3 +116,10 @@ def test_bad_random_adhesion_names_the_key(tmp_path):
                     'adhesion_J_m2 = [-1.0, 1.0]\n')
     with pytest.raises(ValueError, match="random.adhesion_J_m2"):
         load_spec(path)
+
+
+def test_lam_is_not_an_adaptive_axis(tmp_path):
+    grid = ('lam = [0.1]\nQ1 = { start = 0.01, stop = 1, num = 2 }\ntolerance = 1e-3\n'
+            'refine = "adaptive"')
+    with pytest.raises(ValueError, match="grid.lam"):
+        load_spec(tiny(tmp_path, "kelvin_voigt", grid))

@@ -47,8 +47,11 @@ def test_writes_input_and_report_for_every_code(code, tmp_path, capsys):
         assert (out / name).stat().st_size > 0, name
     report = (out / f"report_{code}.md").read_text()
     assert "a-b" in report and "a-floor" in report and "b-floor" in report
-    if code not in ("yade", "mfix", "lammps"):
-        assert "not represented" in report
+    table = report.split("## Notes")[0]
+    if code == "rebound":
+        assert "not represented" in table
+    else:  # every other code gets tangential constants and a beta_x residual
+        assert "not represented" not in table
     text = capsys.readouterr().out
     assert "e_z residual" in text
 
@@ -109,3 +112,23 @@ def test_steps_per_contact_only_for_codes_with_a_time_step(tmp_path, capsys):
     assert main(["dem", str(src), "--for", "rebound", "--steps-per-contact", "50"]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "--steps-per-contact" in err
+
+
+def test_json_gives_the_tangential_residual_over_the_impact_angles(tmp_path, capsys):
+    """With friction, the beta_x residual is over oblique impacts at the set-up's angles
+    (the default angles when it gives none), and the JSON says so."""
+    import json
+
+    from vimpact.dem.fit import DEFAULT_ANGLES_DEG
+
+    src = tmp_path / "setup.toml"
+    src.write_text(TOML)
+    assert main(["dem", str(src), "--for", "lammps", "--out", str(tmp_path), "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    for c in data["contacts"]:
+        basis = c["beta_x_fitted_to"]
+        assert basis["friction"] == 0.5
+        assert basis["angles_deg"] == list(DEFAULT_ANGLES_DEG)
+        assert 0.0 < c["residual_beta_x"]["rms"] <= c["residual_beta_x"]["max_abs"] < 0.1
+    report = (tmp_path / "report_lammps.md").read_text()
+    assert "impact angles 5, 15, 30, 45, 60, 75 deg" in report

@@ -10,9 +10,11 @@ from vimpact.dem.export import export
 from vimpact.dem.problem import problem_from_toml
 
 #: MercuryDPM: the species class (Kernel/Species/HertzianBSHPViscoelasticMindlinSpecies.h) and
-#: the setters of its parts (HertzianViscoelasticNormalSpecies, MindlinSpecies, ParticleSpecies)
+#: the setters of its parts (HertzianViscoelasticNormalSpecies, MindlinSpecies, ParticleSpecies;
+#: MindlinSpecies::setSlidingDissipation is read by MindlinInteraction::computeFrictionForce)
 MERCURY_SETTERS = {"setDensity", "setEffectiveElasticModulus", "setDissipation",
-                   "setEffectiveShearModulus", "setSlidingFrictionCoefficient"}
+                   "setEffectiveShearModulus", "setSlidingDissipation",
+                   "setSlidingFrictionCoefficient"}
 #: MFiX LSD keywords (DES_ETAT_FAC, DES_ETAT_W_FAC in [0, 1]; KT_FAC, KT_W_FAC, not DES_KT_*)
 MFIX_KEYS = {"DES_COLL_MODEL", "DES_EN_INPUT", "DES_EN_WALL_INPUT", "KN", "KN_W", "KT_FAC",
              "KT_W_FAC", "DES_ETAT_FAC", "DES_ETAT_W_FAC", "MEW", "MEW_W"}
@@ -30,8 +32,9 @@ def test_mercurydpm_species_compiles_by_name(problem, tmp_path):
     assert "HertzianBSHPViscoelasticSlidingFrictionSpecies" not in text
     code = "\n".join(ln.split("//")[0] for ln in text.splitlines())
     assert set(re.findall(r"->(set\w+)\(", code)) == MERCURY_SETTERS
-    # friction comes with a tangential stiffness wherever it is set
+    # friction comes with a tangential stiffness and dissipation wherever it is set
     assert text.count("setSlidingFrictionCoefficient") == text.count("setEffectiveShearModulus")
+    assert text.count("setSlidingDissipation") == text.count("setEffectiveShearModulus")
 
 
 def test_mfix_keywords_and_ranges(problem, tmp_path):

@@ -81,3 +81,65 @@ def test_mfix_beta_is_monotonic_in_the_damping_factor():
                                            math.sqrt(1 - laws.zeta_of_restitution(0.7)**2)),
                                  abs=1e-8)
     assert all(x > y for x, y in zip(b, b[1:]))
+
+
+# ---- the stepped oblique laws with Coulomb friction -------------------------
+
+@pytest.mark.parametrize("alpha", [0.01, 0.1])
+def test_stepped_lammps_law_in_stick_is_the_stick_ode_and_converges(alpha):
+    """Without friction the stepped Hertz-Mindlin law (LAMMPS' velocity Verlet) is the
+    stick ODE integrated by DOP853, to first order in the step."""
+    e_ref, b_ref = laws.viscoelastic_hertz_mindlin(alpha, 0.7, 0.4, 3.5)
+    err = []
+    for steps in (500, laws.FRICTION_STEPS, 8000):
+        e, b = laws.hertz_mindlin_coulomb(alpha, 0.7, 0.4, 3.5, math.inf, 1.0, steps)
+        assert float(e) == pytest.approx(e_ref, abs=1e-5)
+        err.append(abs(float(b) - b_ref))
+    assert err[1] < 5e-4
+    assert err[2] < err[1] or err[2] < 1e-5
+
+
+def test_stepped_lammps_law_in_gross_slip_is_the_rigid_body_closed_form():
+    """Sliding throughout (grazing impacts): F_x = mu F_z at every step, so
+    v_c,end = v_c0 - mu F (1 + e) v_z0 (docs/physics.md#coulomb-friction)."""
+    mu, F = 0.3, 3.5
+    w0 = np.array([5.0, 10.0, 20.0])
+    e, beta = laws.hertz_mindlin_coulomb(np.full(3, 0.05), 0.7, 0.4, F, mu, w0)
+    assert beta == pytest.approx(mu * F * (1 + e) / w0 - 1, abs=1e-9)
+
+
+def test_stepped_yade_law_in_stick_is_yade_law_and_slides_as_a_rigid_body():
+    en, et, F = 0.7, 0.5, 3.5
+    e_ref, b_ref, _ = yade_law(1.0, en, et, 1.0, F)
+    kn = math.pi**2 + math.log(en)**2
+    ks = 2 / 7 * (math.pi**2 + math.log(et)**2)
+    zeta = -2 * math.log(en) / (2 * math.sqrt(kn))
+    w_t = math.sqrt(ks * F)
+    zeta_t = -4 / 7 * math.log(et) * F / (2 * w_t)
+    e, b = laws.yade_coulomb(zeta, w_t / math.sqrt(kn), zeta_t, F, math.inf, np.array([1.0]))
+    assert float(e[0]) == pytest.approx(e_ref, abs=5e-4)
+    assert float(b[0]) == pytest.approx(b_ref, abs=5e-4)
+    # no damping: the force is mu F_z throughout when sliding (Yade's viscous tangential
+    # force acts only below the cap, so the closed form needs zeta = zeta_t = 0)
+    w0 = np.array([5.0, 10.0, 20.0])
+    e, b = laws.yade_coulomb(0.0, w_t / math.sqrt(kn), 0.0, F, 0.3, w0)
+    assert b == pytest.approx(0.3 * F * (1 + e) / w0 - 1, abs=1e-9)
+
+
+def test_stepped_liggghts_and_mercurydpm_laws_slide_as_rigid_bodies():
+    """Gross slip without damping: v_c,end = v_c0 - mu F (1 + e) v_z0 for both laws
+    (with damping neither is exact: LIGGGHTS caps with |F_n|, which pulls at the end of a
+    damped contact, and both add their tangential dashpot uncapped while the spring is
+    below the cap, as Yade does)."""
+    F, mu = 3.5, 0.2
+    w0 = np.array([5.0, 10.0])
+    e, b = laws.liggghts_coulomb(1.0, 1.0, 0.0, F, mu, w0)
+    assert e == pytest.approx(1.0, abs=1e-6)
+    assert b == pytest.approx(mu * F * (1 + e) / w0 - 1, abs=1e-9)
+    e, b = laws.mercury_mindlin_coulomb(0.0, 1.0, 0.0, F, mu, w0)
+    assert b == pytest.approx(mu * F * (1 + e) / w0 - 1, abs=1e-9)
+
+
+def test_stepped_liggghts_normal_law_is_tsuji_hertz():
+    e, _ = laws.liggghts_coulomb(0.7, 1.0, 0.5, 3.5, math.inf, np.array([1.0]))
+    assert float(e[0]) == pytest.approx(laws.tsuji_hertz_e(0.7), abs=1e-5)

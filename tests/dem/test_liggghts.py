@@ -13,9 +13,15 @@ from vimpact.dem.problem import problem_from_toml
 
 
 @pytest.fixture(scope="module")
-def exported():
+def liggghts_export():
     problem = problem_from_toml(TOML, "round-trip")
-    return problem, export(problem, "liggghts").fits
+    return problem, export(problem, "liggghts")
+
+
+@pytest.fixture(scope="module")
+def exported(liggghts_export):
+    problem, ex = liggghts_export
+    return problem, ex.fits
 
 
 def test_liggghts_runs_the_exported_files_and_restitutes_the_prediction(exported):
@@ -37,3 +43,28 @@ def test_rigid_wall_gets_hard_particles(exported):
     young = next(ln for ln in text.splitlines() if "youngsModulus" in ln)
     assert max(float(x) for x in young.split()[6:]) > liggghts.SOFT_LIMIT
     assert text.index("hard_particles yes") < text.index("youngsModulus")
+
+
+def test_liggghts_oblique_wall_impacts_give_the_reported_beta(liggghts_export):
+    """LIGGGHTS on the exported files, oblique wall impacts with the set-up's friction at
+    the report's speeds and angles: its beta is the report's prediction (its Hertz-Mindlin
+    history law with the lever R - delta/2 at walls) to its time-step error, shrinking with
+    the step, and within the stated beta_x residual (plus that error) of vimpact's."""
+    need(liggghts.liggghts_available(), "LIGGGHTS")
+    from tests.dem.test_round_trip import oblique_rows_against_vimpact
+
+    problem, ex = liggghts_export
+    f = next(x for x in ex.fits if x.contact.key == "a-floor")
+    ob = ex.targets["a-floor"].oblique
+    speeds, angles = sorted(set(ob.v.tolist())), sorted(set(ob.angle_deg.tolist()))
+    diff, rows = {}, {}
+    for steps in (100, 800):
+        rows[steps] = [r for r in liggghts.round_trip(problem, speeds, steps, fits=ex.fits,
+                                                      angles_deg=angles)
+                       if r["contact"] == "a-floor"]
+        assert len(rows[steps]) == len(speeds) * len(angles)
+        diff[steps] = max(abs(r["beta"] - r["predicted_beta"]) for r in rows[steps])
+    assert diff[800] < 1e-2
+    assert diff[800] < diff[100]
+    for r, beta_vimpact in oblique_rows_against_vimpact(rows[800], ob):
+        assert abs(r["beta"] - beta_vimpact) <= f.res_beta_x.max_abs + diff[800]

@@ -58,7 +58,8 @@ def _stale_reasons(model: str) -> list[str]:
                            f"give today (> {NODE_TOLERANCE:g})")
     if table.interpolation_error is None:
         reasons.append("no measured interpolation error (vimpact table verify TABLE --write)")
-    return [f"{r}: re-run `vimpact sweep {spec_path.relative_to(ROOT)}`" for r in reasons]
+    command = "vimpact table build" if table.is_adaptive else "vimpact sweep"
+    return [f"{r}: re-run `{command} {spec_path.relative_to(ROOT)}`" for r in reasons]
 
 
 @pytest.mark.xfail(not REGENERATED, strict=True,

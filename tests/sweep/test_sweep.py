@@ -177,7 +177,8 @@ def test_shipped_tables_are_current():
     shipped = [s for s in shipped if s.output.exists()]
     assert len(shipped) >= 6
     stale = [s.path.name for s in shipped if not store.is_complete(s, s.output)]
-    assert not stale, f"stale tables, regenerate with `vimpact sweep`: {stale}"
+    assert not stale, ("stale tables, regenerate with `vimpact sweep` (`vimpact table build` "
+                       f"for an adaptive spec): {stale}")
     for spec in shipped:
         assert read_metadata(spec.output)["schema_version"] == sweep.SCHEMA_VERSION
 

@@ -39,6 +39,7 @@ BENCHMARKS: dict[str, str] = {
     "friction": "vimpact.bench.friction",
     "sweep_backends": "vimpact.bench.sweep_backends",
     "lookup": "vimpact.bench.lookup",
+    "adaptive_lookup": "vimpact.bench.adaptive_lookup",
     "continuum_maxwell": "benchmarks.continuum_maxwell",
     "element_orders": "vimpact.bench.element_orders",
 }

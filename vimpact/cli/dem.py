@@ -130,12 +130,23 @@ def to_json(result) -> dict:
     def res(r):
         return None if r is None else {"max_abs": r.max_abs, "rms": r.rms}
 
+    def beta_basis(f):
+        if f.res_beta_x is None:
+            return None
+        ob = result.targets[f.contact.key].oblique
+        if f.beta_oblique is None or ob is None:
+            return {"friction": None, "note": "full stick"}
+        return {"friction": ob.mu, "angles_deg": sorted(set(ob.angle_deg.tolist())),
+                "speeds_m_s": sorted(set(ob.v.tolist())),
+                "note": "oblique impacts with the contact's friction, nominal sizes"}
+
     return {
         "code": result.code,
         "contacts": [{"contact": f.contact.key, "wall": f.contact.is_wall,
                       "params": {k: _number(v) for k, v in f.params.items()
                                  if isinstance(v, (int, float))},
                       "residual_e_z": res(f.res_e_z), "residual_beta_x": res(f.res_beta_x),
+                      "beta_x_fitted_to": beta_basis(f),
                       "notes": f.notes} for f in result.fits],
         "files": [str(p) for p in result.files],
     }

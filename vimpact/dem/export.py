@@ -80,7 +80,8 @@ def export(problem: DemProblem, code: str, out_dir=None, numerics=None,
         png = report.figure(code, problem, targets, fits, out / f"report_{code}.png")
         md = out / f"report_{code}.md"
         md.write_text(report.markdown(code, problem, targets, fits, [p.name for p in files],
-                                      png.name, steps, getattr(mod, "TIME_STEP_ERROR", None)),
+                                      png.name, steps, getattr(mod, "TIME_STEP_ERROR", None),
+                                      getattr(mod, "BETA_TIME_STEP_ERROR", None)),
                       encoding="utf-8")
         files += [md, png]
     return Export(code, fits, targets, files, problem)

@@ -2,7 +2,10 @@
 
 The targets are ``e_z(v)`` (normal impacts, every size level of the contact)
 and, for codes with a tangential restitution, ``beta_x(v)`` (full stick,
-``v_c0 = v_z0``; under stick ``beta_x`` does not depend on ``v_c0``). A fit
+``v_c0 = v_z0``; under stick ``beta_x`` does not depend on ``v_c0``) and, for a
+contact with a finite friction coefficient, vimpact's oblique impacts with it
+(:class:`Oblique`: ``beta_x`` over a few speeds times the set-up's impact angles),
+which the tangential fits then use. A fit
 runs the code's own law (:mod:`vimpact.dem.laws`) with the candidate
 constants at the same points and minimizes the RMS difference; its residual
 is reported as it is, never tuned away.
@@ -20,6 +23,72 @@ from vimpact.dem import laws
 from vimpact.dem.problem import Contact, DemProblem
 from vimpact.engine.pairs import pair_restitution
 
+#: impact angles (degrees from the normal, no spin) of the tangential targets when the
+#: set-up gives no ``[speeds] angles_deg``
+DEFAULT_ANGLES_DEG = (5.0, 15.0, 30.0, 45.0, 60.0, 75.0)
+#: normal speeds (of the set-up's, log-spaced picks, nominal sizes) of the oblique targets
+OBLIQUE_SPEEDS = 4
+
+
+@dataclass
+class Oblique:
+    """vimpact's oblique impacts of one contact with its Coulomb friction (nominal sizes).
+
+    Attributes
+    ----------
+    v : normal approach speed ``v_z0``, m/s; ``angle_deg`` : impact angle from the normal
+        (``tan = v_c0 / v_z0``, no spin), degrees; one entry per point
+    R, m : effective radius (m) and mass (kg)
+    mu : the contact's friction coefficient
+    e_z, beta_x : vimpact's restitutions at the points
+    """
+
+    v: np.ndarray
+    angle_deg: np.ndarray
+    R: float
+    m: float
+    mu: float
+    e_z: np.ndarray
+    beta_x: np.ndarray
+
+    @property
+    def w0(self) -> np.ndarray:
+        """``v_c0 / v_z0`` of each point."""
+        return np.tan(np.radians(self.angle_deg))
+
+
+def oblique_targets(problem: DemProblem, contact: Contact, numerics=None) -> Oblique:
+    """Run vimpact with the contact's friction at :data:`OBLIQUE_SPEEDS` of the set-up's
+    speeds times its impact angles (``[speeds] angles_deg``, else
+    :data:`DEFAULT_ANGLES_DEG`), nominal sizes."""
+    from vimpact.model.numerics import Numerics
+
+    numerics = numerics or Numerics.preset("fast")
+    sp = problem.speeds
+    pick = np.unique(np.linspace(0, sp.size - 1, min(OBLIQUE_SPEEDS, sp.size)).round().astype(int))
+    speeds = sp[pick]
+    angles = problem.angles_deg or DEFAULT_ANGLES_DEG
+    b1, b2 = contact.levels()[len(contact.levels()) // 2]
+    R, m = contact.effective((b1, b2))
+    vs, an, ez, bx = [], [], [], []
+    for a in angles:
+        df = pair_restitution(b1, b2, speeds, tangential=True, vc_ratio=math.tan(math.radians(a)),
+                              mu=contact.mu, numerics=numerics)
+        # like the normal targets: a point counts if it has data (a contact wider than
+        # 0.2 R, status half_space, is kept and noted in the report)
+        done = np.isfinite(df["e_z"].to_numpy(dtype=float)) & np.isfinite(
+            df["beta_x"].to_numpy(dtype=float))
+        if not done.all():
+            bad = sorted(set(df["status"].to_numpy(dtype=str)[~done]))
+            raise ValueError(f"contact {contact.key}: vimpact's oblique impact at {a:g} degrees "
+                             f"ended with status {bad}; narrow the speed range or the angles")
+        vs.append(speeds)
+        an.append(np.full(speeds.size, float(a)))
+        ez.append(df["e_z"].to_numpy(dtype=float))
+        bx.append(df["beta_x"].to_numpy(dtype=float))
+    cat = np.concatenate
+    return Oblique(cat(vs), cat(an), R, m, contact.mu, cat(ez), cat(bx))
+
 
 @dataclass
 class Targets:
@@ -32,6 +101,8 @@ class Targets:
     R, m : effective radius (m) and mass (kg) at each point
     e_z : normal restitution; ``beta_x`` : tangential (full stick), or ``None``
     t_contact : contact time, s; ``status`` : engine status of each point
+    oblique : vimpact's ``beta_x`` with the contact's friction over the impact angles
+        (:class:`Oblique`), for a contact with a finite friction coefficient, else ``None``
     """
 
     contact: Contact
@@ -43,12 +114,14 @@ class Targets:
     beta_x: np.ndarray | None
     t_contact: np.ndarray
     status: np.ndarray
+    oblique: Oblique | None = None
 
     def subset(self, mask: np.ndarray) -> Targets:
         """The points selected by ``mask``."""
         pick = lambda a: None if a is None else a[mask]  # noqa: E731
         return Targets(self.contact, self.v[mask], self.level[mask], self.R[mask], self.m[mask],
-                       self.e_z[mask], pick(self.beta_x), self.t_contact[mask], self.status[mask])
+                       self.e_z[mask], pick(self.beta_x), self.t_contact[mask], self.status[mask],
+                       self.oblique)
 
     @property
     def nominal(self) -> np.ndarray:
@@ -86,6 +159,8 @@ def compute_targets(problem: DemProblem, contact: Contact, *, tangential: bool =
         beta_x=cat([p[4] for p in parts]) if tangential else None,
         t_contact=cat([p[3]["t_contact"].to_numpy(dtype=float) for p in parts]),
         status=cat([p[3]["status"].to_numpy(dtype=str) for p in parts]),
+        oblique=(oblique_targets(problem, contact, numerics)
+                 if tangential and math.isfinite(contact.mu) else None),
     )
 
 
@@ -114,7 +189,10 @@ class ContactFit:
     contact : the contact; ``params`` : the exported constants (name -> value, SI)
     e_z : restitution the code's law gives at the target points with ``params``
     beta_x : likewise for the tangential restitution, or ``None`` if not represented
-    res_e_z, res_beta_x : residuals against vimpact (``None`` if not represented)
+    res_e_z, res_beta_x : residuals against vimpact (``None`` if not represented): of
+        ``beta_x`` over the oblique impacts with friction when the contact has a finite
+        friction coefficient (``beta_oblique``), else over the full-stick curve
+    beta_oblique : the code's ``beta_x`` at the points of ``Targets.oblique``, or ``None``
     notes : what the code cannot represent, conventions applied
     """
 
@@ -125,6 +203,7 @@ class ContactFit:
     res_e_z: Residual | None = None
     res_beta_x: Residual | None = None
     notes: list[str] = field(default_factory=list)
+    beta_oblique: np.ndarray | None = None
 
 
 def fit_constant(target: np.ndarray, lo: float = 0.0, hi: float = 1.0) -> tuple[float, Residual]:

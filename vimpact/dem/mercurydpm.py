@@ -12,26 +12,82 @@ pull, the restitution is lower (MercuryDPM's
 
 Species: ``HertzianBSHPViscoelasticMindlinSpecies`` (header
 ``Species/HertzianBSHPViscoelasticMindlinSpecies.h``; the normal species with
-``MindlinSpecies``): friction needs a tangential stiffness, so the Mindlin
-part gets ``setEffectiveShearModulus(G/(2 - nu))`` of the pair material (the
-Mindlin stiffness ``8 G* a`` of a rigid sphere on the pair's half-space) and
-``setSlidingFrictionCoefficient(mu)``; its tangential dissipation is left at
-MercuryDPM's default and ``beta_x`` is not fitted. Not run here (no Debian or
-PyPI build of MercuryDPM): the class, header and setter names were read from
-MercuryDPM's sources (``Kernel/Species``), not compiled.
+``MindlinSpecies``). Tangential (``MindlinInteraction::computeFrictionForce``):
+a spring ``(2/3) K_t0 xi`` with ``K_t0 = 8 G a`` (``G`` from
+``setEffectiveShearModulus``) and, while the spring force is below the Coulomb
+limit, a dashpot ``c sqrt(m_eff K_t0)`` (``c`` from ``setSlidingDissipation``);
+at the limit the force is ``mu`` times the normal force and the spring is reset.
+``G`` and ``c`` are fitted to vimpact's ``beta_x``: with the contact's friction
+(``setSlidingFrictionCoefficient``) over the set-up's impact angles, or in full
+stick without friction, by stepping that law
+(:func:`vimpact.dem.laws.mercury_mindlin_coulomb`). Not run here (no Debian or
+PyPI build of MercuryDPM): the class, header, setter names and the force law
+were read from MercuryDPM's sources (``Kernel/Species``,
+``Kernel/Interactions``), not compiled.
 """
 
 from __future__ import annotations
 
 import math
 
+import numpy as np
+
+from vimpact.dem import laws, linear
 from vimpact.dem.fit import ContactFit, Residual, Targets, fit_viscoelastic_hertz
-from vimpact.dem.problem import DemProblem
+from vimpact.dem.problem import Contact, DemProblem
 
 CODE = "mercurydpm"
-TANGENTIAL = False
+TANGENTIAL = True
+#: nominal speeds of the full-stick tangential fit (contacts without friction)
+TANGENTIAL_FIT_POINTS = 4
+#: friction written for a contact without one (stick)
+STICK_MU = 1.0e6
 SPECIES = "HertzianBSHPViscoelasticMindlinSpecies"
 HEADER = "Species/HertzianBSHPViscoelasticMindlinSpecies.h"
+
+
+def mercury_beta(c: Contact, A: float, G: float, c_t: float, mu: float, v, R, m, w0,
+                 steps: int | None = None) -> np.ndarray:
+    """MercuryDPM's ``beta`` (:func:`vimpact.dem.laws.mercury_mindlin_coulomb`) for the
+    contact ``c`` with dissipation time ``A`` (s), effective shear modulus ``G`` (Pa),
+    sliding dissipation ``c_t`` and friction ``mu``, at normal speeds ``v`` (m/s),
+    effective radius ``R`` (m) and mass ``m`` (kg), and ``w0 = v_c0 / v_z0`` (arrays)."""
+    E = c.E_star
+    d = laws.hertz_overlap(E, R, m, v)
+    D = c_t * np.sqrt(8.0 * G * m) * (R * d)**0.25 * v / (4.0 / 3.0 * E * np.sqrt(R) * d**1.5)
+    return laws.mercury_mindlin_coulomb(A * v / d, 4.0 * G / E, D, linear.mass_factor(c), mu, w0,
+                                        steps or laws.FRICTION_STEPS)[1]
+
+
+def _fit_tangential(c: Contact, t: Targets, A: float, G0: float):
+    """``(G, c_t, beta at the fit points, target, basis)``: MercuryDPM's effective shear
+    modulus and sliding dissipation closest to vimpact's ``beta_x`` in RMS, over the oblique
+    impacts with the contact's friction (``t.oblique``), else in full stick at a few
+    nominal speeds."""
+    from scipy.optimize import minimize
+
+    ob = t.oblique
+    if ob is not None:
+        v, R, m, w0, target, mu = ob.v, ob.R, ob.m, ob.w0, ob.beta_x, ob.mu
+    else:
+        nominal = np.flatnonzero(t.nominal)
+        pick = nominal[np.unique(np.linspace(0, nominal.size - 1, TANGENTIAL_FIT_POINTS)
+                                 .round().astype(int))]
+        v, R, m, target, mu = t.v[pick], t.R[pick], t.m[pick], t.beta_x[pick], math.inf
+        w0 = np.ones_like(v)
+
+    def beta(z, steps=None):
+        G = G0 * math.exp(float(np.clip(z[0], -5.0, 5.0)))
+        return mercury_beta(c, A, G, abs(float(z[1])), mu, v, R, m, w0, steps)
+
+    def cost(z) -> float:
+        r = beta(z, 1000) - target
+        return float(np.mean(r * r))
+
+    best = minimize(cost, [0.0, 0.3], method="Nelder-Mead",
+                    options={"xatol": 2e-3, "fatol": 1e-9, "maxiter": 80})
+    G = G0 * math.exp(float(np.clip(best.x[0], -5.0, 5.0)))
+    return G, abs(float(best.x[1])), beta(best.x), target, ob is not None
 
 
 def fit(problem: DemProblem, targets: dict[str, Targets]) -> list[ContactFit]:
@@ -40,11 +96,30 @@ def fit(problem: DemProblem, targets: dict[str, Targets]) -> list[ContactFit]:
         t = targets[c.key]
         A, e = fit_viscoelastic_hertz(t, c.E_star)
         mat = c.material
-        fits.append(ContactFit(c, {"effectiveElasticModulus": c.E_star, "dissipation": A,
-                                   "effectiveShearModulus": mat.G_inf / (2.0 - mat.nu),
-                                   "mu": c.mu}, e, None, Residual.of(e, t.e_z), None,
-                               ["beta_x: not fitted (Mindlin tangential stiffness of the relaxed "
-                                "pair material, MercuryDPM's default tangential dissipation)"]))
+        G0 = mat.G_inf / (2.0 - mat.nu)  # Mindlin: 8 G* a with G* of the pair's half-space
+        params = {"effectiveElasticModulus": c.E_star, "dissipation": A,
+                  "effectiveShearModulus": G0, "slidingDissipation": 0.0, "mu": c.mu}
+        notes = []
+        b = res_b = b_ob = None
+        if t.beta_x is not None or t.oblique is not None:
+            G, c_t, b_fit, target, oblique = _fit_tangential(c, t, A, G0)
+            params["effectiveShearModulus"], params["slidingDissipation"] = G, c_t
+            res_b = Residual.of(b_fit, target)
+            if oblique:
+                b_ob = b_fit
+            elif t.beta_x is not None:
+                R_, m_ = t.R, t.m
+                b = mercury_beta(c, A, G, c_t, math.inf, t.v, R_, m_, np.ones_like(t.v))
+                res_b = Residual.of(b, t.beta_x)
+            notes.append(
+                f"beta_x: effective shear modulus {G:.4g} Pa ({G / G0:.3g} x G/(2 - nu) of the "
+                f"pair) and sliding dissipation {c_t:.4g} fitted "
+                + (f"with the contact's friction mu = {c.mu:g} over the impact angles "
+                   "(residual over those oblique impacts)" if oblique else "in full stick")
+                + "; MercuryDPM's Mindlin law as read from its sources "
+                  "(spring (2/3) 8 G a, dashpot c sqrt(m_eff 8 G a) below the Coulomb "
+                  "limit), not run")
+        fits.append(ContactFit(c, params, e, b, Residual.of(e, t.e_z), res_b, notes, b_ob))
     return fits
 
 
@@ -67,11 +142,13 @@ def render(problem: DemProblem, fits: list[ContactFit]) -> dict[str, str]:
         a, b = ident[f.contact.first.index], ident[f.contact.second.index]
         target = a if a == b else f"speciesHandler.getMixedObject({a}, {b})"
         p = f.params
-        mu = p["mu"] if math.isfinite(p["mu"]) else 1.0e6
+        mu = p["mu"] if math.isfinite(p["mu"]) else STICK_MU
         lines.append(f"// {f.contact.key}")
         lines.append(f"{target}->setEffectiveElasticModulus({p['effectiveElasticModulus']:.10g});  // Pa")
         lines.append(f"{target}->setDissipation({p['dissipation']:.10g});  // A, s")
         lines.append(f"{target}->setEffectiveShearModulus({p['effectiveShearModulus']:.10g});"
                      "  // Pa, Mindlin")
+        lines.append(f"{target}->setSlidingDissipation({p['slidingDissipation']:.10g});"
+                     "  // c in c sqrt(m_eff K_t0)")
         lines.append(f"{target}->setSlidingFrictionCoefficient({mu:.6g});")
     return {"mercurydpm_species.cpp": "\n".join(lines) + "\n"}

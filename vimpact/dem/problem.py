@@ -6,6 +6,9 @@ Read from a TOML file (example: ``sweeps/dem/two_rubbers.toml``)::
     min = 0.1
     max = 5.0
     n = 24                   # points (log-spaced); default 24
+    angles_deg = [10, 30, 60] # optional: impact angles from the normal (no spin) of the
+                             # tangential fits of contacts with friction; default
+                             # 5, 15, 30, 45, 60, 75
 
     [types.soft]             # one table per particle type, in type order
     density = 1100.0         # kg/m^3

@@ -50,6 +50,21 @@ def figure(code: str, problem: DemProblem, targets: dict[str, Targets],
             ax.set_ylabel("e_z")
         if rows == 2:
             ax = axes[1, k]
+            ob = t.oblique
+            if f.beta_oblique is not None and ob is not None:
+                for j, v in enumerate(sorted(set(ob.v.tolist()))):
+                    sel = ob.v == v
+                    ax.plot(ob.angle_deg[sel], ob.beta_x[sel], "-", color=f"C{j}", lw=1,
+                            label=f"v_z0 {v:.2g} m/s")
+                    ax.plot(ob.angle_deg[sel], f.beta_oblique[sel], "o", ms=3, mfc="none",
+                            color=f"C{j}")
+                ax.legend(fontsize=5)
+                ax.set_title(f"beta_x, mu = {ob.mu:g}: max {f.res_beta_x.max_abs:.1e}",
+                             fontsize=8)
+                ax.set_xlabel("impact angle [deg]")
+                if k == 0:
+                    ax.set_ylabel("beta_x")
+                continue
             if f.beta_x is not None and t.beta_x is not None:
                 ax.plot(t.v, t.beta_x, ".", color="C0", ms=3)
                 ax.plot(t.v, f.beta_x, "o", ms=3, mfc="none", color="C3")
@@ -77,16 +92,21 @@ def _fmt(x) -> str:
 
 def markdown(code: str, problem: DemProblem, targets: dict[str, Targets],
              fits: list[ContactFit], files: list[str], png: str,
-             steps_per_contact: int | None = None, step_error=None) -> str:
+             steps_per_contact: int | None = None, step_error=None,
+             beta_step_error: str | None = None) -> str:
     """The report text; ``steps_per_contact`` and ``step_error`` (the code module's
-    ``TIME_STEP_ERROR``) add the exported time step and the code's error at it."""
+    ``TIME_STEP_ERROR``) add the exported time step and the code's error at it,
+    ``beta_step_error`` (``BETA_TIME_STEP_ERROR``) its measured error in ``beta_x``."""
     lines = [f"# vimpact dem: {code}", "",
              f"Input: `{problem.source}`; normal impact speeds {problem.speeds.min():g} to "
              f"{problem.speeds.max():g} m/s ({problem.speeds.size} points, log-spaced)"
              + ("; size levels min/nominal/max where a radius range is given" if any(
                  len(t.radii) > 1 for t in problem.types) else "") + ".",
              f"Written: {', '.join(f'`{x}`' for x in files)}.", "",
-             "Residual = code minus vimpact over all points (max |.|, RMS).", "",
+             "Residual = code minus vimpact over all points (max |.|, RMS). The beta_x "
+             "residual of a contact with friction is over oblique impacts with that friction "
+             "at the impact angles (nominal sizes, speeds as listed in its note); without "
+             "friction, over the full-stick curve.", "",
              "| contact | pair material | exported constants | e_z residual | beta_x residual |",
              "|---|---|---|---|---|"]
     for f in fits:
@@ -105,6 +125,10 @@ def markdown(code: str, problem: DemProblem, targets: dict[str, Targets],
                          f"{C / steps_per_contact:.1e} (first order in the step, "
                          f"{C:g} / steps; measured, largest over the round trip collisions: "
                          f"{measured}). Change it with `--steps-per-contact`.")
+        if beta_step_error is not None and any(f.beta_oblique is not None for f in fits):
+            lines.append(f"Its time-step error in beta_x is larger (measured on oblique wall "
+                         f"impacts: {beta_step_error}); add it to the beta_x residual, or "
+                         "raise `--steps-per-contact`.")
     lines += ["", "## Notes", ""]
     for f in fits:
         for note in f.notes:
@@ -114,19 +138,32 @@ def markdown(code: str, problem: DemProblem, targets: dict[str, Targets],
         if nbad:
             lines.append(f"- {k}: {nbad} point(s) have a contact wider than 0.2 R "
                          "(half-space model stretched; status half_space)")
-    if problem.angles_deg:
-        lines.append("- angles: under full stick beta_x does not depend on the impact angle; "
-                     "the DEM code's Coulomb limit (exported mu) takes over at grazing angles")
+    for k, t in targets.items():
+        ob = t.oblique
+        if ob is not None and any(f.beta_oblique is not None for f in fits
+                                  if f.contact.key == k):
+            lines.append(f"- {k}: beta_x targets: vimpact with mu = {ob.mu:g} at v_z0 = "
+                         + ", ".join(f"{v:.3g}" for v in sorted(set(ob.v.tolist())))
+                         + " m/s and impact angles "
+                         + ", ".join(f"{a:g}" for a in sorted(set(ob.angle_deg.tolist())))
+                         + " deg (from the normal, no spin)")
     lines += ["", f"![vimpact vs {code}]({png})", ""]
     return "\n".join(lines)
 
 
-def round_trip_main(code: str, available, round_trip, steps_per_contact: int) -> None:
+def round_trip_main(code: str, available, round_trip, steps_per_contact: int,
+                    oblique=None) -> None:
     """``python -m vimpact.dem.CODE SETUP.toml [STEPS_PER_CONTACT]``: run the DEM code
     on the exported files at five speeds over the set-up's range and print the
     restitution it gives next to the report's prediction (one row per collision;
     ``round_trip(problem, speeds, steps)`` returns rows with ``contact``, ``v``
-    (m/s), ``predicted``, ``e`` and optionally ``level``)."""
+    (m/s), ``predicted``, ``e`` and optionally ``level``), then the largest difference.
+
+    ``oblique(problem, steps)``, for the codes with a tangential fit: rows of oblique wall
+    impacts with the set-up's friction at the report's speeds and angles, with ``angle``,
+    ``beta``, ``predicted_beta``, ``vimpact_beta`` and ``stated`` (the report's beta_x
+    residual of that contact); printed likewise, with the largest
+    ``|beta - vimpact_beta|`` against the stated residual."""
     import sys
 
     from vimpact.dem.problem import load_problem
@@ -139,6 +176,26 @@ def round_trip_main(code: str, available, round_trip, steps_per_contact: int) ->
     speeds = np.geomspace(prob.speeds.min(), prob.speeds.max(), 5)
     print(f"{'contact':12s} {'level':>5s} {'v [m/s]':>8s} {'predicted e':>12s} "
           f"{code + ' e':>12s} {'diff':>10s}")
-    for r in round_trip(prob, speeds, steps):
+    rows = round_trip(prob, speeds, steps)
+    for r in rows:
         print(f"{r['contact']:12s} {r.get('level', 0):5d} {r['v']:8.3g} {r['predicted']:12.8f} "
               f"{r['e']:12.8f} {r['e'] - r['predicted']:10.2e}")
+    print(f"head-on: {len(rows)} collisions at {steps} steps per contact, largest "
+          f"|e - predicted| = {max(abs(r['e'] - r['predicted']) for r in rows):.2e}")
+    if oblique is None:
+        return
+    rows = oblique(prob, steps)
+    if not rows:
+        print("oblique: no wall contact with friction in this set-up")
+        return
+    print(f"\n{'contact':12s} {'v [m/s]':>8s} {'angle':>6s} {'predicted':>10s} {code + ' beta':>12s} "
+          f"{'diff':>10s} {'vimpact':>10s}")
+    for r in rows:
+        print(f"{r['contact']:12s} {r['v']:8.3g} {r['angle']:6g} {r['predicted_beta']:10.6f} "
+              f"{r['beta']:12.6f} {r['beta'] - r['predicted_beta']:10.2e} {r['vimpact_beta']:10.6f}")
+    worst = max(abs(r["beta"] - r["vimpact_beta"]) for r in rows)
+    stated = max(r["stated"] for r in rows)
+    print(f"oblique: {len(rows)} wall impacts at {steps} steps per contact, largest "
+          f"|beta - predicted| = {max(abs(r['beta'] - r['predicted_beta']) for r in rows):.2e}, "
+          f"|e - predicted| = {max(abs(r['e'] - r['predicted']) for r in rows):.2e}; "
+          f"largest |beta - vimpact| = {worst:.2e} (stated beta_x residual {stated:.2e})")

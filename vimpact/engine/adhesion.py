@@ -10,7 +10,12 @@ module makes its inputs (the adhesion number ``lam``, step and element row of
 - :func:`sticking_velocity`: the impact speed below which the sphere sticks,
   by bisection;
 - :func:`jkr_quasi_static`: the elastic element row under a prescribed
-  indentation (the JKR curves ``F(d)``, ``a(d)`` as the row gives them).
+  indentation (the JKR curves ``F(d)``, ``a(d)`` as the row gives them);
+- :func:`result_columns`: the adhesive rows of :func:`vimpact.simulate_batch`,
+  run in parallel over the rows (:func:`run_kernel`), as its result columns.
+
+Single scene and batch build their kernel inputs with one function
+(:func:`kernel_inputs`), so a batch row equals :func:`vimpact.simulate` of its scene.
 """
 
 from __future__ import annotations

@@ -80,7 +80,9 @@ def run_path(path: Path, cols: SceneColumns, numerics: Numerics, rec: np.ndarray
         g, tau, n_arms = arm_arrays(cols)
         args = (cols.dashpot_time / cols.T, g, tau, n_arms, cols.kappa, cols.contact_mass_factor,
                 cols.computes_tangential)
-        if rec.shape[1] == 0:
+        # one row (a single simulate()): the impact kernel itself, whose cold compile
+        # is about half that of the parallel batch kernel
+        if rec.shape[1] == 0 and len(cols) > 1:
             continuum_maxwell.maxwell_stick_batch(*args, numerics.rtol, CONTINUUM_STICK_MAX_STEPS,
                                                   out)
             return
@@ -92,7 +94,7 @@ def run_path(path: Path, cols: SceneColumns, numerics: Numerics, rec: np.ndarray
         return
     if path.spec is None:
         tau0 = cols.dashpot_time / cols.T
-        if rec.shape[1] == 0:
+        if rec.shape[1] == 0 and len(cols) > 1:  # one row: the impact kernel (as above)
             continuum_kv.kv_normal_batch(tau0, numerics.rtol, CONTINUUM_MAX_STEPS, out)
             return
         for i in range(len(cols)):

@@ -344,7 +344,9 @@ def kv_normal_impact(tau0, rtol, max_steps, rec, rec_every, out):
     (``OUT_T_CONTACT`` its ``t``).
     """
     n_rec = rec.shape[0]
-    i_rec = 0
+    # the counter and the phase flag are int64 and bool from the start, not bare
+    # literals: numba would compile every callee once more per literal type
+    i_rec = np.int64(0)
     out[:] = 0.0  # every column of the row is written (those it does not compute stay 0)
     if not (tau0 >= 0.0 and math.isfinite(tau0)):
         out[OUT_VZ_END] = np.nan
@@ -371,7 +373,7 @@ def kv_normal_impact(tau0, rtol, max_steps, rec, rec_every, out):
     atol_s = atol * s_scale
     atol_v = atol * v_scale
 
-    unloading = False
+    unloading = np.bool_(False)
     s = 0.0
     v = 1.0
     t = 0.0
@@ -432,13 +434,13 @@ def kv_normal_impact(tau0, rtol, max_steps, rec, rec_every, out):
         if event:  # turning point: restart on the unloading branch
             v = 0.0
             u_max = s * s
-            unloading = True
+            unloading = np.bool_(True)
             fs, fv, ft = _rhs(s, v, tau0, unloading)
             # s ends in a tail where 5/4 tau0 s^3 ~ |v| ~ v_scale
             if tau0 > 0.0:
                 atol_s = atol * min(s, (v_scale / (1.25 * tau0)) ** (1.0 / 3.0))
             if n_rec > 0 and steps % rec_every == 0:
-                i_rec = _record(rec, i_rec, t, u_max, 0.0, 0.0, _force(s, v, tau0, True),
+                i_rec = _record(rec, i_rec, t, u_max, 0.0, 0.0, _force(s, v, tau0, unloading),
                                 0.0, s)
             continue
         if not unloading and s * s > u_max:

@@ -705,13 +705,17 @@ def maxwell_stick_impact(tau0, g, tau, kappa, mu_t, tangential, rtol, max_steps,
     Returns the number of trajectory rows written.
     """
     n_rec = rec.shape[0]
-    i_rec = 0
+    # counters and the phase are int64 from the start (np.int64, not a bare literal):
+    # numba types a literal as its own type (Literal[int](0)) and compiles every
+    # jitted callee once per argument type it sees while the types settle, which
+    # compiled the right-hand side eight times
+    i_rec = np.int64(0)
     out[OUT_T_GROSS_SLIP] = 0.0  # no friction on this path
     out[OUT_W_FRICTION] = 0.0
     nin = g.shape[0]
     ok_in = (tau0 >= 0.0 and math.isfinite(tau0) and kappa > 0.0 and math.isfinite(kappa)
              and mu_t > 0.0 and math.isfinite(mu_t) and tau.shape[0] == nin)
-    n = 0
+    n = np.int64(0)
     for i in range(nin):
         if not (g[i] >= 0.0 and math.isfinite(g[i]) and tau[i] >= 0.0):
             ok_in = False
@@ -774,16 +778,16 @@ def maxwell_stick_impact(tau0, g, tau, kappa, mu_t, tangential, rtol, max_steps,
     rc = np.zeros((cap, 5, m_l))
     hs = np.zeros(cap + 1)
     ah = np.zeros((cap, 4 * n))
-    nh = 0
+    nh = np.int64(0)
 
-    phase = 0
+    phase = np.int64(0)
     m = m_l
     n_rk = _rk_mask(phase, n, tang, mask)
     y[1] = 1.0
     if tang:
         y[3 + 3 * n + 1] = 1.0
-    Fz, Fx = _rhs_once(phase, y, y, K, 0, tau0, ga, itau, n, kappa, mu_t, tang, rc, hs, nh, ah,
-                       e_val, kh)
+    Fz, Fx = _rhs_once(phase, y, y, K, np.int64(0), tau0, ga, itau, n, kappa, mu_t, tang, rc, hs,
+                       nh, ah, e_val, kh)
     h = 0.05 * min(1.0, s_scale)
     sig = 0.0
     err_old = 1e-4
@@ -914,7 +918,7 @@ def maxwell_stick_impact(tau0, g, tau, kappa, mu_t, tangential, rtol, max_steps,
                 z[ou + i] = -z[4 + i] * itau[i]  # dD/dt = v - D/tau at v = 0
             for c in range(mm):
                 y[c] = z[c]
-            phase = 1
+            phase = np.int64(1)
             m = m_u
             n_rk = _rk_mask(phase, n, tang, mask)
             kh[0] = nh - 1
@@ -925,8 +929,8 @@ def maxwell_stick_impact(tau0, g, tau, kappa, mu_t, tangential, rtol, max_steps,
             atol[3] = rtol * (s_scale * s_scale)
             if tau0 > 0.0:
                 atol[0] = rtol * min(s_max, (v_scale / (1.25 * tau0)) ** (1.0 / 3.0))
-            Fz, Fx = _rhs_once(phase, y, y, K, 0, tau0, ga, itau, n, kappa, mu_t, tang, rc, hs,
-                               nh, ah, e_val, kh)
+            Fz, Fx = _rhs_once(phase, y, y, K, np.int64(0), tau0, ga, itau, n, kappa, mu_t,
+                               tang, rc, hs, nh, ah, e_val, kh)
             # restart small: the right-hand side is not smooth in the edge state
             # at the turning point, and there the error estimate of a long step
             # misses most of its error (measured: 10-20x the error otherwise)
@@ -973,8 +977,8 @@ def maxwell_stick_impact(tau0, g, tau, kappa, mu_t, tangential, rtol, max_steps,
 def _rec_state(rec, i_rec, phase, y, K, tau0, g, itau, n, kappa, mu_t, tang, rc, hs, nh, ah,
                e_val, kh):
     """Record the current state (forces recomputed at it)."""
-    Fz, Fx = _rhs_once(phase, y, y, K, 6, tau0, g, itau, n, kappa, mu_t, tang, rc, hs, nh, ah,
-                       e_val, kh)
+    Fz, Fx = _rhs_once(phase, y, y, K, np.int64(6), tau0, g, itau, n, kappa, mu_t, tang, rc, hs,
+                       nh, ah, e_val, kh)
     if phase == 0:
         u = y[0] * y[0]
         vc = y[3 + 3 * n + 1] if tang else 0.0

@@ -379,6 +379,7 @@ class RestitutionTable:
         self.data = _kelvin_voigt_rows(self.data, self.model)
         self._grids: dict = {}
         self._hermite: dict = {}
+        self._adaptive = None
 
     @staticmethod
     def _where(path) -> str:
@@ -522,11 +523,23 @@ class RestitutionTable:
             v = ok[p].to_numpy(float) if p in ok.columns else np.array([])
             v = v[~np.isnan(v)] if p == "mu" else v[np.isfinite(v)]  # mu = inf: full stick
             ranges[p] = [float(v.min()), float(v.max())] if len(v) else None
-        try:
-            grid = self._lookup_grid()
-            grid_info, failed, note = grid.shape, grid.failed, None
-        except ValueError as exc:
-            grid_info, failed, note = None, None, str(exc)
+        adaptive = None
+        if self.is_adaptive:
+            grid_info, failed, note = None, None, "adaptive cells (see adaptive)"
+            try:
+                adaptive = self.adaptive_grid().info()
+                adaptive["failed_nodes"] = int(len(self.data) - len(ok))
+            except ValueError as exc:
+                note = str(exc)
+            build = self.meta("build")
+            if isinstance(build, dict):
+                adaptive["build"] = build
+        else:
+            try:
+                grid = self._lookup_grid()
+                grid_info, failed, note = grid.shape, grid.failed, None
+            except ValueError as exc:
+                grid_info, failed, note = None, None, str(exc)
         spec = self.meta("spec")
         return {
             "path": None if self.path is None else str(self.path),
@@ -538,6 +551,7 @@ class RestitutionTable:
             "grid": grid_info,
             "failed_grid_points": failed,
             "grid_note": note,
+            "adaptive": adaptive,
             "numerics": self.numerics,
             "version": self.version,
             "schema_version": self.meta("schema_version"),
@@ -555,10 +569,37 @@ class RestitutionTable:
         where = f" {str(self.path)!r}" if self.path else ""
         return f"<RestitutionTable{where}: {self.model}, {len(self.data)} rows, {len(self.ok)} ok>"
 
+    # ---- adaptive tables --------------------------------------------------
+    @property
+    def is_adaptive(self) -> bool:
+        """The table is adaptive (``vimpact.mode = adaptive``: cells refined locally, its
+        structure in ``vimpact.adaptive``; :mod:`vimpact.lookup.adaptive`), not a grid."""
+        return self.meta("mode") == "adaptive"
+
+    def adaptive_grid(self):
+        """The :class:`vimpact.lookup.adaptive.AdaptiveGrid` of an adaptive table (built
+        once from its node rows and ``vimpact.adaptive``)."""
+        if self._adaptive is None:
+            from vimpact.lookup.adaptive import AdaptiveGrid
+
+            if not self.is_adaptive:
+                raise InputError(f"the table{self._where(self.path)} is not adaptive "
+                                 "(vimpact.mode is not 'adaptive')")
+            raw = self.metadata.get(_META_PREFIX + "adaptive")
+            try:
+                meta = json.loads(raw) if raw is not None else None
+            except ValueError:
+                meta = None
+            self._adaptive = AdaptiveGrid.from_rows(meta, self.data)
+        return self._adaptive
+
     # ---- lookup ----------------------------------------------------------
     def _theta_values(self) -> np.ndarray:
         v = self.data["theta_ratio"].to_numpy(float)
-        return cluster_nodes(v[np.isfinite(v)])[0] if np.isfinite(v).any() else np.array([])
+        # distinct values first: clustering is a Python loop over its values, and a
+        # table's rows (489360 in the adaptive standard-solid table) repeat a few values
+        return cluster_nodes(np.unique(v[np.isfinite(v)]))[0] if np.isfinite(v).any() \
+            else np.array([])
 
     def _resolve_theta(self, theta_ratio) -> float | None:
         """The theta_ratio slice to use (None: the table has one value / no column)."""
@@ -588,7 +629,8 @@ class RestitutionTable:
         if "psi" not in self.data.columns:
             return np.array([])
         v = self.data["psi"].to_numpy(float)
-        return cluster_nodes(v[np.isfinite(v)])[0] if np.isfinite(v).any() else np.array([])
+        return cluster_nodes(np.unique(v[np.isfinite(v)]))[0] if np.isfinite(v).any() \
+            else np.array([])
 
     def _base_axes(self) -> list[str]:
         model = self.model
@@ -821,6 +863,22 @@ class RestitutionTable:
                              + ", ".join(str(a.shape) for a in arrays.values())
                              + " that do not broadcast together") from None
         arrays = dict(zip(arrays, bcast))
+        if self.is_adaptive:
+            if method != "cubic" or extrapolate:
+                raise InputError(f"method = {method!r}, extrapolate = {extrapolate!r} are not "
+                                 "allowed for an adaptive table: its lookup is cubic inside "
+                                 "its range")
+            grid_a = self.adaptive_grid()
+            out = grid_a({a: arrays[a] for a in grid_a.axes
+                          + ([grid_a.tensor_axis] if grid_a.tensor_axis else [])})
+            out["e_x"] = np.abs(out["beta_x"])
+            result = {**arrays, **{k: out[k] for k in OUTPUTS}}
+            if all(a.ndim == 0 for a in bcast):
+                result = {k: float(v) for k, v in result.items()}
+            else:
+                result = {k: np.asarray(v, dtype=float) for k, v in result.items()}
+            result["error_bound"] = self.error_bound(method)
+            return result
         # one theta_ratio node: the slice at it (a table need not be a grid across thetas)
         theta = None
         if theta_axis and np.ndim(theta_ratio) == 0 and same_node(thetas, theta_ratio).any():
@@ -862,11 +920,13 @@ class RestitutionTable:
         try:
             import xarray as xr
         except ImportError:
-            from vimpact.model.validation import InputError
-
             raise InputError("to_xarray = xarray is not allowed here: xarray is not installed "
                              "(pip install xarray); RestitutionTable.data is the same table "
                              "as a pandas DataFrame") from None
+        if self.is_adaptive:
+            raise InputError(f"to_xarray is not allowed for the adaptive table"
+                             f"{self._where(self.path)}: its nodes are cells of different "
+                             "sizes, not a grid; evaluate lookup() on the grid you need")
         theta = self._resolve_theta(theta_ratio)
         grid = self._lookup_grid() if theta is None else self._grid(theta)
         units = self.units
@@ -1020,7 +1080,19 @@ def format_info(info: dict) -> str:
         one = r is not None and (r[0] == r[1] or (np.isfinite(r[1]) and same_node(r[0], r[1])))
         text = "no data" if r is None else (_fmt(r[0]) if one else f"{_fmt(r[0])} .. {_fmt(r[1])}")
         lines.append(f"  {name:<15} {text}")
-    if info["grid"]:
+    ad = info.get("adaptive")
+    if ad:
+        tensor = f" x {ad['tensor_nodes']} {ad['tensor_axis']}" if ad["tensor_axis"] else ""
+        lines.append(f"  adaptive        {ad['leaves']} cells in log "
+                     + " x log ".join(ad["axes"]) + f" (levels {ad['levels'][0]} .. "
+                     f"{ad['levels'][1]}), {ad['adaptive_nodes']} nodes{tensor}")
+        build = ad.get("build")
+        if isinstance(build, dict):
+            lines.append(f"  build           {build.get('seconds', '?')} s, "
+                         f"{build.get('simulated', '?')} impacts simulated, tolerance "
+                         f"{build.get('tolerance', '?')} (met at every cell's check points: "
+                         f"{build.get('met', '?')})")
+    elif info["grid"]:
         shape = " x ".join(f"{n} {a}" for a, n in info["grid"].items())
         failed = info["failed_grid_points"]
         lines.append(f"  grid            {shape}" + (f" ({failed} failed points)" if failed else ""))

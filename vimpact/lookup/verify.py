@@ -33,7 +33,7 @@ from vimpact.lookup.interpolate import LOG_AXES
 from vimpact.model.scene import DEFAULT_THETA_RATIO, REFERENCE_INDENTATION
 from vimpact.model.validation import InputError
 
-__all__ = ["KINDS", "held_out_errors", "held_out_points", "interpolation_error",
+__all__ = ["KINDS", "adaptive_held_out_points", "held_out_errors", "held_out_points", "interpolation_error",
            "numerics_of", "simulate_dimensionless", "write_interpolation_error"]
 
 #: ``bound = BOUND_FACTOR * max``: the held-out mid-points sit at the peak of the
@@ -171,6 +171,46 @@ def held_out_points(axes: list[str], nodes: list[np.ndarray], n_random: int = 20
     return pd.concat(frames, ignore_index=True)
 
 
+def adaptive_held_out_points(grid, n_random: int = 200, seed: int = 0,
+                             kinds=KINDS) -> pd.DataFrame:
+    """Held-out points of an adaptive table (:class:`vimpact.lookup.adaptive.AdaptiveGrid`).
+
+    ``random``: ``n_random`` points uniform in the log of the adaptive axes and in the
+    tensor axis. ``cell``: as many points again, each in a leaf drawn at random (so
+    the small cells where the outputs change fast get their share), at a random
+    position inside it; neither kind is a node or a check point of the refinement
+    (``kinds`` with ``"centre"`` or ``"random"`` selects them; ``"axis"`` has no
+    meaning here). The tensor axis (``nu``) is uniform between its end nodes.
+    """
+    rng = np.random.default_rng(seed)
+    frames = []
+    lb = grid.log_bounds
+    want_random = "random" in kinds
+    want_cell = "centre" in kinds or "random" in kinds
+    t_lo, t_hi = grid.tensor_nodes[0], grid.tensor_nodes[-1]
+    if want_random and n_random > 0:
+        cols = {a: np.exp(rng.uniform(lb[d, 0], lb[d, 1], n_random))
+                for d, a in enumerate(grid.axes)}
+        if grid.tensor_axis:
+            cols[grid.tensor_axis] = rng.uniform(t_lo, t_hi, n_random)
+        frames.append(pd.DataFrame(cols).assign(kind="random", axis=""))
+    if want_cell and n_random > 0:
+        lo, hi = grid.leaf_boxes()
+        pick = rng.integers(0, len(lo), n_random)
+        cols = {}
+        for d, a in enumerate(grid.axes):
+            t = rng.uniform(0.0, 1.0, n_random)
+            cols[a] = np.exp(np.log(lo[pick, d]) + t * (np.log(hi[pick, d])
+                                                        - np.log(lo[pick, d])))
+        if grid.tensor_axis:
+            cols[grid.tensor_axis] = rng.uniform(t_lo, t_hi, n_random)
+        frames.append(pd.DataFrame(cols).assign(kind="cell", axis=""))
+    if not frames:
+        names = grid.axes + ([grid.tensor_axis] if grid.tensor_axis else [])
+        return pd.DataFrame({**{a: [] for a in names}, "kind": [], "axis": []})
+    return pd.concat(frames, ignore_index=True)
+
+
 def _scene_options(table) -> dict:
     return {"tangential": table.meta("tangential", "auto") or "auto",
             "tangential_memory": table.meta("tangential_memory", "incremental") or "incremental",
@@ -214,8 +254,11 @@ def held_out_errors(table, numerics=None, n: int = 200, seed: int = 0, theta_rat
     """
     numerics = numerics_of(table) if numerics is None else numerics
     theta = table._resolve_theta(theta_ratio)
-    grid = table._grid(theta)
-    pts = held_out_points(grid.axes, grid.nodes, n, seed, kinds)
+    if table.is_adaptive:
+        pts = adaptive_held_out_points(table.adaptive_grid(), n, seed, kinds)
+    else:
+        grid = table._grid(theta)
+        pts = held_out_points(grid.axes, grid.nodes, n, seed, kinds)
     if theta is None:
         t = theta_ratio if theta_ratio is not None else (
             float(table._theta_values()[0]) if "theta_ratio" in table.data.columns
@@ -325,7 +368,7 @@ def interpolation_error(table, numerics=None, n: int = 200, seed: int = 0, theta
         "method": method,
         "points": int(len(err)),
         "failed": int(np.sum(~good)),
-        "kinds": {k: int(np.sum(err["kind"] == k)) for k in kinds},
+        "kinds": {k: int(np.sum(err["kind"] == k)) for k in sorted(set(err["kind"]))},
         "seed": int(seed),
         "numerics": dataclasses.asdict(numerics),
         "outputs": outputs,

@@ -305,6 +305,10 @@ def refined_spec(spec: SweepSpec, parts: Path, log: Callable[[str], None] | None
     tol = getattr(spec, "grid_tolerance", None)
     if tol is None or spec.mode != "grid":
         return spec
+    if getattr(spec, "grid_refine", "tensor") == "adaptive":
+        raise InputError(f'grid.refine = "adaptive" is not allowed for a sweep of '
+                         f"{spec.path.name}: an adaptive table is built cell by cell, not in "
+                         f"chunks; build it with `vimpact table build {spec.path}`")
     from vimpact.lookup import refine
 
     if spec.model not in REFINABLE:

@@ -192,6 +192,11 @@ LAYOUTS = ("auto", "file", "dataset")
 FILE_LAYOUT_MAX_ROWS = 1_000_000
 #: Allowed ``[grid] tolerance`` (interpolation error between nodes, dimensionless).
 GRID_TOLERANCE_RANGE = (1e-9, 1e-1)
+#: ``[grid] refine``: how a grid with ``tolerance`` is refined.
+GRID_REFINE = ("tensor", "adaptive")
+#: ``[grid] min_level`` and ``max_level`` defaults of an adaptive grid, and the largest
+#: level allowed (a cell of level L spans 1/2**L of an axis's log range).
+ADAPTIVE_LEVELS = (2, 16, 24)
 #: Points of one grid axis at most (the axes are held in memory, the grid is not).
 MAX_AXIS_POINTS = 10**7
 
@@ -455,6 +460,13 @@ class SweepSpec:
         ``psi > 0`` (``[grid] mu``, default 1); ``None`` without ``psi``
     material_text : the text of the material file ``[random] material`` names ("" without
         one); part of :attr:`sweep_hash`
+    grid_refine : grid mode: ``[grid] refine``, ``"tensor"`` (default: planes of nodes
+        inserted across the grid, :func:`vimpact.lookup.refine.refine_grid`) or
+        ``"adaptive"`` (cells of ``log Q1`` (x ``log Q2``) split where they fail the
+        tolerance, :mod:`vimpact.lookup.adaptive`; built by ``vimpact table build``)
+    grid_levels : grid mode, adaptive: ``([grid] min_level, [grid] max_level)``, the
+        level of the uniform start and of the finest cell (a cell of level ``L`` spans
+        ``1 / 2**L`` of each adaptive axis's range in log)
     """
 
     path: Path
@@ -477,6 +489,8 @@ class SweepSpec:
     grid_tolerance: float | None = None
     grid_mu: float | None = None
     material_text: str = ""
+    grid_refine: str = "tensor"
+    grid_levels: tuple[int, int] = (ADAPTIVE_LEVELS[0], ADAPTIVE_LEVELS[1])
 
     @property
     def n_chunks(self) -> int:
@@ -627,6 +641,8 @@ class SweepSpec:
             "tangential": self.tangential,
             "rotation": self.rotation,
             "grid_tolerance": self.grid_tolerance,
+            **({"grid_refine": self.grid_refine, "grid_levels": list(self.grid_levels)}
+               if self.grid_refine != "tensor" else {}),
             "units": self.units(),
             "columns": {c: _describe(c) for c in self.columns()},
             "statuses": SWEEP_STATUSES,
@@ -690,12 +706,14 @@ def load_spec(path) -> SweepSpec:
         mode = "grid"
         seed = spec.integer("seed", data.get("seed", 0), 0)
         axes, grid_tolerance, grid_mu = _grid(spec, model, data["grid"])
+        grid_refine, grid_levels = _adaptive(spec, model, data["grid"], axes, grid_tolerance)
         rows = math.prod(len(v) for v in axes.values())
         if rows > MAX_ROWS:
             raise spec.error("grid", f"{rows} rows; at most {MAX_ROWS} are allowed")
         draws, arms = {}, ()
     if mode == "random":
         grid_tolerance = grid_mu = None
+        grid_refine, grid_levels = "tensor", ADAPTIVE_LEVELS[:2]
     if chunk_size > MAX_CHUNK_SIZE:
         raise spec.bad("chunk_size", chunk_size, f"at most {MAX_CHUNK_SIZE} rows (a chunk is "
                        "held in memory)")
@@ -719,7 +737,8 @@ def load_spec(path) -> SweepSpec:
                      description=header.description, rows=rows, draws=draws, arms=arms,
                      axes=axes, tangential=header.tangential, rotation=header.rotation,
                      layout=layout, grid_tolerance=grid_tolerance,
-                     grid_mu=grid_mu, material_text=material_text)
+                     grid_mu=grid_mu, material_text=material_text,
+                     grid_refine=grid_refine, grid_levels=(grid_levels[0], grid_levels[1]))
 
 
 def _random(spec: TomlSource, model: str, table) -> tuple[dict, tuple, int]:
@@ -781,6 +800,44 @@ def _random(spec: TomlSource, model: str, table) -> tuple[dict, tuple, int]:
     return draws, arms, rows
 
 
+def _adaptive(spec: TomlSource, model: str, table: dict, axes: dict,
+              tolerance: float | None) -> tuple[str, tuple[int, int]]:
+    """``[grid] refine`` and the adaptive levels (``min_level``, ``max_level``)."""
+    refine = table.get("refine", "tensor")
+    if refine not in GRID_REFINE:
+        raise spec.bad("grid.refine", refine, " or ".join(repr(r) for r in GRID_REFINE))
+    lo, hi, top = ADAPTIVE_LEVELS
+    if refine == "tensor":
+        for key in ("min_level", "max_level"):
+            if key in table:
+                raise spec.error(f"grid.{key}", 'needs refine = "adaptive"')
+        return refine, (lo, hi)
+    if tolerance is None:
+        raise spec.error("grid.tolerance", 'missing: refine = "adaptive" refines cells until '
+                         "their lookup meets it")
+    if model not in ("kelvin_voigt", "standard_solid"):
+        raise spec.error("grid.refine", f'"adaptive" needs a kelvin_voigt or standard_solid '
+                         f"grid, not {model}")
+    if ADHESION_AXIS in axes:
+        raise spec.error(f"grid.{ADHESION_AXIS}", 'is not allowed with refine = "adaptive" '
+                         "(the adaptive axes are Q1 (and Q2), the tensor axis nu)")
+    for key in ("psi", "theta_ratio"):
+        if key in axes and len(axes[key]) > 1:
+            raise spec.error(f"grid.{key}", 'one value only with refine = "adaptive" (the '
+                             "adaptive axes are Q1 (and Q2), the tensor axis nu)")
+    for key in ("Q1", "Q2"):
+        if key in axes and (len(axes[key]) < 2 or axes[key][0] <= 0.0):
+            raise spec.bad(f"grid.{key}", axes[key].tolist()[:3], 'a range with start > 0 '
+                           'and stop > start for refine = "adaptive" (its ends are the '
+                           "table's range)")
+    min_level = spec.integer("grid.min_level", table.get("min_level", lo), 0)
+    max_level = spec.integer("grid.max_level", table.get("max_level", hi), 0)
+    if not min_level <= max_level <= top:
+        raise spec.bad("grid.max_level", max_level, f"an integer from min_level = {min_level} "
+                       f"to {top}")
+    return refine, (min_level, max_level)
+
+
 def _grid(spec: TomlSource, model: str, table) -> tuple[dict[str, np.ndarray], float | None,
                                                        float | None]:
     """The axes (outermost first), the optional ``tolerance`` and the friction coefficient
@@ -790,7 +847,8 @@ def _grid(spec: TomlSource, model: str, table) -> tuple[dict[str, np.ndarray], f
     if not isinstance(table, dict):
         raise spec.bad("grid", table, "a table")
     keys = ((ADHESION_AXIS,) if ADHESION_AXIS in table else ()) + _GRID_KEYS[model]
-    spec.unknown(table, keys + ("tolerance", "mu"), "grid")
+    spec.unknown(table, keys + ("tolerance", "mu", "refine", "min_level", "max_level"),
+                 "grid")
     tolerance = None
     if "tolerance" in table:
         tolerance = spec.number("grid.tolerance", table["tolerance"],

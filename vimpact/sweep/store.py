@@ -60,10 +60,15 @@ from vimpact.model.validation import InputError
 META_PREFIX = "vimpact."
 #: Metadata keys stored as JSON.
 JSON_KEYS = ("numerics", "units", "columns", "statuses", "paths", "rotation", "counts",
-             "grid_tolerance", "grid_refinement", "interpolation_error")
+             "grid_tolerance", "grid_refinement", "interpolation_error", "grid_levels",
+             "adaptive", "build")
 #: Metadata keys stored as integers.
 INT_KEYS = ("schema_version", "seed", "rows", "chunk", "row_start", "row_stop", "n_chunks",
             "chunk_size")
+#: Parquet compression of every table and part written (zstd: the shipped adaptive
+#: standard-solid table is 10.1 MB, 11.8 MB with snappy; the content hash is of the data,
+#: not of the file's bytes, so it does not depend on it).
+COMPRESSION = "zstd"
 #: Name of the dataset file that holds the schema and the sweep metadata.
 COMMON_METADATA = "_common_metadata"
 #: Metadata key (without the prefix) of the content hash (:class:`ContentHash`).
@@ -615,12 +620,13 @@ def write_atomic(table, path: Path, *, schema_only: bool = False, more=(),
             if schema_only:
                 pq.write_metadata(table.schema, f)
             elif more:
-                with pq.ParquetWriter(f, table.schema, write_page_checksum=True) as writer:
+                with pq.ParquetWriter(f, table.schema, write_page_checksum=True,
+                                      compression=COMPRESSION) as writer:
                     writer.write_table(table)
                     for other in more:
                         writer.write_table(other.replace_schema_metadata(table.schema.metadata))
             else:
-                pq.write_table(table, f, write_page_checksum=True)
+                pq.write_table(table, f, write_page_checksum=True, compression=COMPRESSION)
     except OSError as exc:
         raise OSError(exc.errno, f"{exc.strerror or _first_line(exc)} while writing "
                       f"{path}") from exc
@@ -758,7 +764,10 @@ def is_complete(spec, out: Path) -> bool:
         meta = decode_metadata(pq.read_schema(target).metadata)
     except Exception:  # noqa: BLE001
         return False
-    if not (meta.get("sweep_hash") == spec.sweep_hash and "paths" in meta):
+    # a sweep records its kernels' paths; an adaptive table (`vimpact table build`) is
+    # made cell by cell and has none
+    made = "paths" in meta or meta.get("mode") == "adaptive"
+    if not (meta.get("sweep_hash") == spec.sweep_hash and made):
         return False
     try:
         verify_table(out)

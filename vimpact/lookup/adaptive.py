@@ -1,0 +1,480 @@
+"""Adaptive (non-tensor) restitution tables: cells refined where the lookup needs them.
+
+A tensor grid puts a plane of nodes across the whole table for every feature
+it resolves; the restitution of a standard solid changes course along narrow
+ridges in the (``Q1``, ``Q2``) plane, so a tensor grid that resolves them is far
+too large. An adaptive table refines only where it must:
+
+- The **adaptive axes** (the damping parameters ``Q1`` and, for a standard
+  solid, ``Q2``; interpolated in their logarithm) are mapped onto the unit
+  square. The root cell is the whole square, and every cell is either a
+  *leaf* or split into its ``2**k`` halves (a binary tree in ``Q1`` alone, a
+  quadtree in ``log Q1 x log Q2``).
+- A leaf holds ``4**k`` nodes at ``0, 1/3, 2/3, 1`` of its width along every
+  axis and is interpolated by the tensor-product cubic Lagrange polynomial
+  through them (fourth order; the nodes of a cell's halves include all of the
+  cell's own nodes, so a split reuses them).
+- The **tensor axis** (``nu``) is the same short list of nodes at every
+  adaptive node: ``beta_x`` is smooth in ``nu`` and ``e_z`` does not depend on it.
+  Along it the lookup is the cubic Lagrange polynomial through the four nodes
+  around the point.
+
+**Refinement** (:func:`refine_cells`): starting from a uniform level, every cell
+is checked at ``3**k`` held-out points (``1/6, 1/2, 5/6`` of its width along
+every axis: the cell centre, its edge mid-points, and the points where the
+error of a four-node cubic peaks), at every tensor node; a cell whose largest
+error there exceeds the cell tolerance is split. A cell's check points become
+nodes of its halves, so nothing simulated is wasted. Neighbouring leaves of
+different levels agree at their common edge only to within the tolerance (no
+hanging-node constraint): the lookup is continuous to that accuracy.
+
+Storage (:class:`AdaptiveGrid`, :meth:`AdaptiveGrid.to_metadata`): the table's rows
+are the leaves' nodes, one row per adaptive node and tensor node, with the
+integer lattice coordinates ``lattice_Q1`` (``lattice_Q2``) of the node; the
+metadata entry ``vimpact.adaptive`` holds the axes, their ends, the lattice
+and the leaves (level and index per leaf). Evaluation:
+:func:`vimpact.kernels.adaptive_lookup.adaptive_eval` (numba, parallel over
+blocks of points).
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+import time
+from collections.abc import Callable
+
+import numpy as np
+
+from vimpact.lookup.interpolate import LOG_AXES
+from vimpact.model.validation import InputError
+
+__all__ = ["ADAPTIVE_FORMAT", "AdaptiveGrid", "LATTICE_LEVEL", "check_points",
+           "lattice_coordinates", "refine_cells"]
+
+#: Version of the ``vimpact.adaptive`` metadata layout.
+ADAPTIVE_FORMAT = 1
+#: Node coordinates are integers on a lattice of ``3 * 2**LATTICE_LEVEL`` steps per
+#: adaptive axis (exact, shared by neighbouring cells); cells are at most of level
+#: ``LATTICE_LEVEL - 1`` (their check points need half a node step).
+LATTICE_LEVEL = 30
+_TICKS = 3 * 2**LATTICE_LEVEL
+#: Fractions of a leaf's width at its nodes and at its held-out check points.
+NODE_FRACTIONS = (0.0, 1.0 / 3.0, 2.0 / 3.0, 1.0)
+CHECK_FRACTIONS = (1.0 / 6.0, 0.5, 5.0 / 6.0)
+
+
+def _lagrange_thirds(t: np.ndarray) -> np.ndarray:
+    """Cubic Lagrange weights of the nodes 0, 1/3, 2/3, 1 at ``t``: shape ``t.shape + (4,)``."""
+    t = np.asarray(t, dtype=float)
+    a, b, c = t - 1.0 / 3.0, t - 2.0 / 3.0, t - 1.0
+    return np.stack([-4.5 * a * b * c, 13.5 * t * b * c, -13.5 * t * a * c, 4.5 * t * a * b],
+                    axis=-1)
+
+
+def _local(k: int, fractions_index: list[int]) -> np.ndarray:
+    """Multi-indices (``k`` columns) of a cell's local points, axis 0 fastest."""
+    grid = list(itertools.product(fractions_index, repeat=k))
+    return np.array([g[::-1] for g in grid], dtype=np.int64).reshape(-1, k)
+
+
+def _node_keys(level: np.ndarray, index: np.ndarray) -> np.ndarray:
+    """Lattice keys of the ``4**k`` nodes of cells ``(level, index)``: ``(n, 4**k, k)``."""
+    k = index.shape[1]
+    local = _local(k, [0, 1, 2, 3])  # in thirds of the cell
+    step = (2 ** (LATTICE_LEVEL - level)).astype(np.int64)  # a third of the cell
+    return (3 * index[:, None, :] + local[None, :, :]) * step[:, None, None]
+
+
+def _check_keys(level: np.ndarray, index: np.ndarray) -> np.ndarray:
+    """Lattice keys of the ``3**k`` check points of cells ``(level, index)``."""
+    k = index.shape[1]
+    local = _local(k, [1, 3, 5])  # in sixths of the cell
+    half = (2 ** (LATTICE_LEVEL - 1 - level)).astype(np.int64)
+    return (6 * index[:, None, :] + local[None, :, :]) * half[:, None, None]
+
+
+def check_points(k: int) -> tuple[np.ndarray, np.ndarray]:
+    """The check fractions (``3**k`` x ``k``) and the matrix ``W`` (``3**k`` x ``4**k``) with
+    ``W @ node values`` = the leaf's cubic interpolant at them."""
+    frac = np.array(CHECK_FRACTIONS)[_local(k, [0, 1, 2])]
+    w = np.ones((len(frac), 4**k))
+    nodes = _local(k, [0, 1, 2, 3])
+    for d in range(k):
+        lw = _lagrange_thirds(frac[:, d])  # (3**k, 4)
+        w *= lw[:, nodes[:, d]]
+    return frac, w
+
+
+def lattice_coordinates(keys: np.ndarray, bounds) -> np.ndarray:
+    """Raw axis values of lattice keys ``(n, k)`` on axes with raw ends ``bounds`` ``(k, 2)``
+    (log-spaced: the one rule for the build, the stored rows and the lookup)."""
+    lb = np.log(np.asarray(bounds, dtype=float))
+    u = np.asarray(keys, dtype=float) / _TICKS
+    return np.exp(lb[:, 0] + u * (lb[:, 1] - lb[:, 0]))
+
+
+class AdaptiveGrid:
+    """An adaptive table's cells, nodes and values, and its lookup.
+
+    Parameters
+    ----------
+    axes : adaptive axis names (``["Q1"]`` or ``["Q1", "Q2"]``; interpolated in log)
+    bounds : ``(k, 2)`` raw ends of the adaptive axes (> 0)
+    leaves : ``(n_leaves, 1 + k)`` int: level, then the index along each axis
+    keys : ``(n_nodes, k)`` int lattice coordinates of the nodes (every leaf node among them)
+    tensor_axis : name of the tensor axis (``"nu"``) or None
+    tensor_nodes : its increasing nodes (one value: no tensor axis to interpolate)
+    values : output name -> ``(n_nodes, n_tensor)`` node values (NaN: a failed impact)
+    """
+
+    def __init__(self, axes: list[str], bounds, leaves, keys, tensor_axis: str | None,
+                 tensor_nodes, values: dict[str, np.ndarray]):
+        self.axes = list(axes)
+        self.k = len(self.axes)
+        if self.k not in (1, 2):
+            raise InputError(f"adaptive axes = {self.axes} are not allowed: one or two "
+                             "(Q1, and Q2 for a standard solid)")
+        bad = [a for a in self.axes if a not in LOG_AXES]
+        if bad:
+            raise InputError(f"adaptive axis {bad[0]!r} is not allowed: the adaptive axes are "
+                             "log axes (" + ", ".join(LOG_AXES) + ")")
+        self.bounds = np.asarray(bounds, dtype=float).reshape(self.k, 2)
+        if not np.all(self.bounds > 0) or not np.all(self.bounds[:, 1] > self.bounds[:, 0]):
+            raise InputError(f"adaptive bounds = {self.bounds.tolist()} are not allowed: each "
+                             "axis needs 0 < lo < hi")
+        self.leaves = np.asarray(leaves, dtype=np.int64).reshape(-1, 1 + self.k)
+        self.keys = np.asarray(keys, dtype=np.int64).reshape(-1, self.k)
+        self.tensor_axis = tensor_axis
+        self.tensor_nodes = np.atleast_1d(np.asarray(tensor_nodes, dtype=float))
+        self.names = list(values)
+        self.values = np.stack([np.asarray(values[n], dtype=float).reshape(
+            len(self.keys), len(self.tensor_nodes)) for n in self.names], axis=-1)
+        self._kernel = None
+
+    # ---- geometry ---------------------------------------------------------
+    @property
+    def log_bounds(self) -> np.ndarray:
+        """Natural logarithms of the axes' ends, ``(k, 2)``."""
+        return np.log(self.bounds)
+
+    def coordinates(self, keys: np.ndarray) -> np.ndarray:
+        """Raw axis values (``Q1``, ``Q2``) of lattice keys ``(n, k)``."""
+        return lattice_coordinates(keys, self.bounds)
+
+    def leaf_boxes(self) -> tuple[np.ndarray, np.ndarray]:
+        """Raw lower and upper corners of every leaf, each ``(n_leaves, k)``."""
+        level = self.leaves[:, 0]
+        idx = self.leaves[:, 1:]
+        lo = idx * (3 * 2 ** (LATTICE_LEVEL - level))[:, None]
+        hi = (idx + 1) * (3 * 2 ** (LATTICE_LEVEL - level))[:, None]
+        return self.coordinates(lo), self.coordinates(hi)
+
+    def info(self) -> dict:
+        """Leaves, levels and nodes (JSON-serializable)."""
+        levels = self.leaves[:, 0]
+        return {"axes": self.axes, "tensor_axis": self.tensor_axis,
+                "tensor_nodes": len(self.tensor_nodes), "leaves": int(len(self.leaves)),
+                "levels": [int(levels.min()), int(levels.max())] if len(levels) else None,
+                "adaptive_nodes": int(len(self.keys)),
+                "rows": int(len(self.keys) * len(self.tensor_nodes))}
+
+    # ---- kernel arrays ----------------------------------------------------
+    def _kernel_arrays(self) -> tuple:
+        if self._kernel is None:
+            k = self.k
+            cells: dict[tuple, int] = {(0,) + (0,) * k: 0}
+            children: list[list[int]] = [[-1] * (1 << k)]
+            leaf_of = [-1]
+            for n, row in enumerate(self.leaves):
+                level, idx = int(row[0]), [int(x) for x in row[1:]]
+                parent = 0
+                for L in range(1, level + 1):
+                    if leaf_of[parent] != -1:
+                        raise InputError(f"adaptive leaves: leaf {n} at level {level}, index "
+                                         f"{idx} overlaps another leaf")
+                    sub = [i >> (level - L) for i in idx]
+                    key = (L, *sub)
+                    cell = cells.get(key)
+                    if cell is None:
+                        cell = len(children)
+                        cells[key] = cell
+                        children.append([-1] * (1 << k))
+                        leaf_of.append(-1)
+                        c = sum((s & 1) << d for d, s in enumerate(sub))
+                        children[parent][c] = cell
+                    parent = cell
+                if leaf_of[parent] != -1 or any(c >= 0 for c in children[parent]):
+                    raise InputError(f"adaptive leaves: leaf {n} at level {level}, index {idx} "
+                                     "overlaps another leaf")
+                leaf_of[parent] = n
+            # every split cell must have all its children (the leaves tile the square)
+            child = np.array(children, dtype=np.int64)
+            leaf = np.array(leaf_of, dtype=np.int64)
+            split = leaf < 0
+            if np.any(child[split] < 0):
+                raise InputError("adaptive leaves do not cover the table: a split cell lacks "
+                                 "a child")
+            index = {tuple(key): i for i, key in enumerate(self.keys.tolist())}
+            nk = _node_keys(self.leaves[:, 0], self.leaves[:, 1:])
+            try:
+                leaf_nodes = np.array([[index[tuple(key)] for key in cell] for cell in
+                                       nk.tolist()], dtype=np.int64).reshape(-1, 4**k)
+            except KeyError as exc:
+                raise InputError(f"adaptive table: the leaf node at lattice {exc.args[0]} has "
+                                 "no row") from None
+            lb = self.log_bounds
+            self._kernel = (k, np.ascontiguousarray(lb[:, 0]), np.ascontiguousarray(lb[:, 1]),
+                            child, leaf, leaf_nodes, np.ascontiguousarray(self.tensor_nodes),
+                            np.ascontiguousarray(self.values))
+        return self._kernel
+
+    def check_range(self, coords: dict[str, np.ndarray]) -> None:
+        """Raise :class:`InputError` for a point outside the covered box."""
+        for d, a in enumerate(self.axes):
+            x = coords[a]
+            lo, hi = self.bounds[d]
+            tol_lo, tol_hi = 1e-9 * lo, 1e-9 * hi
+            if x.size and (x.min() < lo - tol_lo or x.max() > hi + tol_hi):
+                bad = float(x[(x < lo - tol_lo) | (x > hi + tol_hi)].flat[0])
+                raise InputError(f"{a} = {bad:.6g} is outside the table's range: it covers "
+                                 f"{a} in [{lo:.6g}, {hi:.6g}] (an adaptive table does not "
+                                 "extrapolate)")
+        if self.tensor_axis is not None and len(self.tensor_nodes) > 1:
+            x = coords[self.tensor_axis]
+            lo, hi = self.tensor_nodes[0], self.tensor_nodes[-1]
+            if x.size and (x.min() < lo - 1e-12 or x.max() > hi + 1e-12):
+                bad = float(x[(x < lo - 1e-12) | (x > hi + 1e-12)].flat[0])
+                raise InputError(f"{self.tensor_axis} = {bad:.6g} is outside the table's "
+                                 f"range: it covers {self.tensor_axis} in [{lo:.6g}, {hi:.6g}]")
+
+    def __call__(self, coords: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+        """Interpolated outputs at the points ``coords`` (axis name -> raw values, one shape).
+
+        Raises :class:`InputError` outside the covered range.
+        """
+        from vimpact.kernels.adaptive_lookup import adaptive_eval
+
+        arrays = {a: np.asarray(v, dtype=float) for a, v in coords.items()}
+        shape = np.broadcast_shapes(*(v.shape for v in arrays.values()))
+        arrays = {a: np.broadcast_to(v, shape).ravel() for a, v in arrays.items()}
+        self.check_range(arrays)
+        names = self.axes + ([self.tensor_axis] if self.tensor_axis else [])
+        points = np.empty((math.prod(shape), len(names)))
+        for j, a in enumerate(names):
+            points[:, j] = arrays[a]
+        out = np.empty((len(points), len(self.names)))
+        adaptive_eval(points, *self._kernel_arrays(), out)
+        return {n: out[:, j].reshape(shape) for j, n in enumerate(self.names)}
+
+    # ---- storage ------------------------------------------------------------
+    def to_metadata(self) -> dict:
+        """The ``vimpact.adaptive`` metadata entry (JSON-serializable)."""
+        return {"format": ADAPTIVE_FORMAT, "axes": self.axes,
+                "bounds": self.bounds.tolist(), "lattice_level": LATTICE_LEVEL,
+                "tensor_axis": self.tensor_axis, "tensor_nodes": self.tensor_nodes.tolist(),
+                "leaves": {"level": self.leaves[:, 0].tolist(),
+                           **{f"index_{a}": self.leaves[:, 1 + d].tolist()
+                              for d, a in enumerate(self.axes)}}}
+
+    def rows(self) -> dict[str, np.ndarray]:
+        """Node rows: the axes (raw), the lattice keys and the outputs, one row per
+        adaptive node and tensor node (tensor axis fastest)."""
+        nt = len(self.tensor_nodes)
+        xy = self.coordinates(self.keys)
+        cols: dict[str, np.ndarray] = {}
+        for d, a in enumerate(self.axes):
+            cols[a] = np.repeat(xy[:, d], nt)
+        if self.tensor_axis is not None:
+            cols[self.tensor_axis] = np.tile(self.tensor_nodes, len(self.keys))
+        for d, a in enumerate(self.axes):
+            cols[f"lattice_{a}"] = np.repeat(self.keys[:, d], nt)
+        for j, n in enumerate(self.names):
+            cols[n] = self.values[:, :, j].ravel()
+        return cols
+
+    @classmethod
+    def from_rows(cls, meta: dict, data, names=("e_z", "beta_x")) -> AdaptiveGrid:
+        """Rebuild from the ``vimpact.adaptive`` entry and the node rows (a DataFrame);
+        raises :class:`InputError` for an inconsistent table."""
+        if not isinstance(meta, dict) or meta.get("format") != ADAPTIVE_FORMAT:
+            raise InputError(f"vimpact.adaptive = {str(meta)[:80]!r} is not allowed: an "
+                             f"adaptive table's structure of format {ADAPTIVE_FORMAT}")
+        if meta.get("lattice_level") != LATTICE_LEVEL:
+            raise InputError(f"vimpact.adaptive lattice_level = {meta.get('lattice_level')!r} "
+                             f"is not allowed: {LATTICE_LEVEL}")
+        axes = list(meta["axes"])
+        tensor_axis = meta.get("tensor_axis")
+        tnodes = np.asarray(meta["tensor_nodes"], dtype=float)
+        lv = meta["leaves"]
+        leaves = np.column_stack([np.asarray(lv["level"], dtype=np.int64)]
+                                 + [np.asarray(lv[f"index_{a}"], dtype=np.int64) for a in axes])
+        keys_all = np.column_stack([data[f"lattice_{a}"].to_numpy(np.int64) for a in axes])
+        if tensor_axis is not None:
+            t = data[tensor_axis].to_numpy(float)
+            ti = np.searchsorted(tnodes, t)
+            ti = np.clip(ti, 0, len(tnodes) - 1)
+            if not np.allclose(tnodes[ti], t, rtol=0, atol=1e-12):
+                raise InputError(f"adaptive table: a row's {tensor_axis} is not one of the "
+                                 f"tensor nodes {tnodes.tolist()}")
+        else:
+            ti = np.zeros(len(data), dtype=np.int64)
+        keys, inverse = np.unique(keys_all, axis=0, return_inverse=True)
+        inverse = inverse.ravel()
+        ok = data["status"].astype(str).isin(["ok"]).to_numpy()
+        values = {}
+        count = np.zeros((len(keys), len(tnodes)), dtype=np.int64)
+        np.add.at(count, (inverse, ti), 1)
+        if np.any(count != 1):
+            raise InputError("adaptive table: every adaptive node needs exactly one row per "
+                             f"{tensor_axis or 'node'} (found "
+                             f"{int(count.min())} .. {int(count.max())})")
+        for n in names:
+            v = np.full((len(keys), len(tnodes)), np.nan)
+            v[inverse, ti] = np.where(ok, data[n].to_numpy(float), np.nan)
+            values[n] = v
+        return cls(axes, meta["bounds"], leaves, keys, tensor_axis, tnodes, values)
+
+
+def refine_cells(evaluate: Callable[[np.ndarray], np.ndarray], k: int, n_tensor: int,
+                 tolerance: float, *, check: tuple[int, ...] | None = None,
+                 min_level: int = 2, max_level: int = 16, max_nodes: int = 200_000,
+                 max_seconds: float | None = None,
+                 progress: Callable[[str], None] | None = None):
+    """Split cells until each leaf's cubic lookup meets ``tolerance`` at its check points.
+
+    Parameters
+    ----------
+    evaluate : lattice keys ``(m, k)`` int -> values ``(m, n_tensor, n_out)`` (the true
+        outputs at those adaptive points, at every tensor node; NaN: failed)
+    k : adaptive axes (1 or 2)
+    n_tensor : tensor nodes
+    tolerance : largest absolute error allowed at a leaf's check points (dimensionless, > 0)
+    check : the outputs (indices of the last axis) held to the tolerance (default all)
+    min_level : level of the uniform start (``2**(k min_level)`` cells)
+    max_level : cells of this level are not split (a failing one is reported)
+    max_nodes : adaptive points evaluated at most (a level that would exceed it is not
+        refined: its cells stay leaves and are reported)
+    max_seconds : wall-clock budget; a level that starts after it is not checked (its
+        cells stay leaves and are reported, like ``max_nodes``)
+    progress : called with one line per level
+
+    Returns
+    -------
+    (leaves, keys, values, report)
+        ``leaves`` ``(n, 1 + k)`` int (level, index); ``keys`` ``(m, k)`` and ``values``
+        ``(m, n_tensor, n_out)`` of every leaf node; ``report`` (JSON-serializable):
+        ``tolerance``, ``met`` (every leaf within tolerance at its check points),
+        ``levels`` (per level: cells checked, split, new points, largest check error),
+        ``unmet`` (leaves over tolerance: level, index, error, at most 200),
+        ``max_leaf_error`` (largest check error of a leaf), ``points`` (adaptive points
+        evaluated), ``seconds``.
+    """
+    if k not in (1, 2):
+        raise InputError(f"k = {k!r} is not allowed: 1 or 2 adaptive axes")
+    if not (isinstance(tolerance, (int, float)) and math.isfinite(tolerance) and tolerance > 0):
+        raise InputError(f"tolerance = {tolerance!r} is not allowed: must be a number > 0")
+    if not 0 <= min_level <= max_level <= LATTICE_LEVEL - 1:
+        raise InputError(f"min_level = {min_level}, max_level = {max_level} are not allowed: "
+                         f"0 <= min_level <= max_level <= {LATTICE_LEVEL - 1}")
+    start = time.perf_counter()
+    _, W = check_points(k)
+    known: dict[tuple, int] = {}
+    blocks: list[np.ndarray] = []
+
+    def fetch(keys: np.ndarray) -> np.ndarray:
+        flat = keys.reshape(-1, k)
+        tuples = list(map(tuple, flat.tolist()))
+        new, seen = [], set()
+        for t in tuples:
+            if t not in known and t not in seen:
+                seen.add(t)
+                new.append(t)
+        if new:
+            vals = np.asarray(evaluate(np.array(new, dtype=np.int64).reshape(-1, k)), float)
+            base = sum(len(b) for b in blocks)
+            blocks.append(vals)
+            for j, t in enumerate(new):
+                known[t] = base + j
+        allv = np.concatenate(blocks) if len(blocks) > 1 else blocks[0]
+        if len(blocks) > 1:
+            blocks[:] = [allv]
+        rows = np.array([known[t] for t in tuples], dtype=np.int64)
+        return allv[rows].reshape(keys.shape[:-1] + allv.shape[1:])
+
+    def count_new(keys: np.ndarray) -> int:
+        return len({t for t in map(tuple, keys.reshape(-1, k).tolist()) if t not in known})
+
+    active = _local(k, list(range(2**min_level)))  # index along axis 0 fastest
+    level = min_level
+    leaves, unmet, levels = [], [], []
+    max_leaf = 0.0
+    stopped = "met"
+    while len(active):
+        lv = np.full(len(active), level, dtype=np.int64)
+        nk, ck = _node_keys(lv, active), _check_keys(lv, active)
+        n_new = count_new(np.concatenate([nk.reshape(-1, k), ck.reshape(-1, k)]))
+        late = max_seconds is not None and time.perf_counter() - start > max_seconds
+        if late or len(known) + n_new > max_nodes:
+            stopped = (f"max_seconds ({max_seconds:g} s) at level {level}" if late else
+                       f"max_nodes ({len(known) + n_new} > {max_nodes}) at level {level}")
+            # no room to check these cells: they stay leaves with unknown error
+            fetch(nk)
+            for idx in active:
+                leaves.append([level, *idx])
+                if len(unmet) < 200:
+                    unmet.append({"level": int(level), "index": idx.tolist(), "error": None})
+            levels.append({"level": int(level), "cells": int(len(active)), "split": 0,
+                           "new_points": 0, "max_error": None, "unchecked": int(len(active))})
+            break
+        vn, vc = fetch(nk), fetch(ck)  # (c, 4**k, nt, no), (c, 3**k, nt, no)
+        est = np.einsum("pn,cnto->cpto", W, vn)
+        err = np.abs(est - vc)
+        if check is not None:
+            err = err[..., list(check)]
+        err = np.where(np.isnan(err), np.inf, err).reshape(len(active), -1).max(axis=1)
+        bad = err > tolerance
+        final = level >= max_level
+        for idx, e in zip(active[~bad], err[~bad]):
+            leaves.append([level, *idx])
+            max_leaf = max(max_leaf, float(e))
+        if final and bad.any():
+            stopped = f"max_level ({max_level})"
+            for idx, e in zip(active[bad], err[bad]):
+                leaves.append([level, *idx])
+                max_leaf = max(max_leaf, float(e))
+                if len(unmet) < 200:
+                    unmet.append({"level": int(level), "index": idx.tolist(),
+                                  "error": float(e) if math.isfinite(e) else None})
+        finite = err[np.isfinite(err)]
+        entry = {"level": int(level), "cells": int(len(active)),
+                 "split": 0 if final else int(bad.sum()), "new_points": int(n_new),
+                 "max_error": float(finite.max()) if finite.size else None,
+                 "failed_checks": int(np.sum(~np.isfinite(err)))}
+        levels.append(entry)
+        if progress is not None:
+            progress(f"level {level}: {len(active)} cells, {n_new} new points "
+                     f"({len(known)} in all), {entry['split']} split, largest check error "
+                     + (f"{entry['max_error']:.2g}" if entry["max_error"] is not None else "-")
+                     + f", {time.perf_counter() - start:.0f} s")
+        if final:
+            break
+        parents = active[bad]
+        if not len(parents):
+            break
+        kids = []
+        for c in range(1 << k):
+            bits = np.array([(c >> d) & 1 for d in range(k)], dtype=np.int64)
+            kids.append(2 * parents + bits)
+        active = np.concatenate(kids)
+        level += 1
+    leaves_arr = np.array(leaves, dtype=np.int64).reshape(-1, 1 + k)
+    leaf_keys = np.unique(_node_keys(leaves_arr[:, 0], leaves_arr[:, 1:]).reshape(-1, k), axis=0)
+    values = fetch(leaf_keys)
+    over = [u for u in unmet if u["error"] is None or u["error"] > tolerance]
+    report = {"tolerance": float(tolerance), "met": not over and stopped == "met",
+              "stopped": stopped, "levels": levels, "unmet": over,
+              "max_leaf_error": max_leaf if math.isfinite(max_leaf) else None,
+              "leaves": int(len(leaves_arr)), "points": int(len(known)),
+              "seconds": round(time.perf_counter() - start, 1)}
+    return leaves_arr, leaf_keys, values, report
