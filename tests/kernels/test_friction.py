@@ -30,6 +30,7 @@ from vimpact.kernels.elements import (
     REC_SLIP,
     VERLET,
     KernelSpec,
+    element_impact,
     element_kernel,
 )
 
@@ -304,3 +305,23 @@ def test_flat_punch_is_a_stick_slip_oscillator(mu):
     # 3.8e-6 (mu = 3: the contact slips out of stick in its last steps, and
     # without a dashpot the separation step is not weighted): relative to v_c0
     assert abs(v_c_ref - v_c) < 1e-5 * 0.8, (v_c_ref, v_c)
+
+
+def test_single_scene_kernel_is_the_batch_row_bit_for_bit():
+    """A single scene runs the serial impact kernel of its spec (no parallel launch);
+    it must give exactly the batch kernel's row, trajectory included."""
+    tau0, g, tau = RHEOLOGIES["prony_dashpot"]
+    mu = np.array([0.05, 0.4, math.inf])
+    out, rec = run("prony_dashpot", mu=mu, n_rec=50, rec_every=7)
+    nu, theta_ratio = 0.3, 0.4  # run_rows' defaults
+    kappa, mu_t = 2.0 * (1.0 - nu) / (2.0 - nu), 1.0 + 1.0 / theta_ratio
+    n_elem = int(np.ceil(1.05 / DXI - 1e-9))
+    max_steps = int(np.ceil(20.0 * HERTZ_TIME / H))
+    impact = element_impact(spec_of("prony_dashpot"))
+    for i in range(mu.size):
+        o = np.zeros(out.shape[1])
+        r = np.zeros(rec.shape[1:])
+        impact(tau0, np.array(g), np.array(tau), kappa, mu_t, mu[i], H, n_elem, DXI, max_steps,
+               r, 7, o)
+        np.testing.assert_array_equal(o, out[i])
+        np.testing.assert_array_equal(r, rec[i])

@@ -13,7 +13,7 @@ from vimpact.engine import discretization
 from vimpact.engine.columns import SceneColumns
 from vimpact.engine.routing import CONTINUUM_STICK, Path
 from vimpact.kernels import continuum_kv, continuum_maxwell, layout
-from vimpact.kernels.elements import KernelSpec, element_kernel
+from vimpact.kernels.elements import KernelSpec, element_impact, element_kernel
 from vimpact.model.numerics import Numerics
 
 #: Accepted steps of the adaptive continuum path at most (it needs tens to hundreds).
@@ -102,6 +102,12 @@ def run_path(path: Path, cols: SceneColumns, numerics: Numerics, rec: np.ndarray
                 tau0[i], numerics.rtol, CONTINUUM_MAX_STEPS, rec[i], rec_every, out[i])
         return
     a = arrays if arrays is not None else element_arrays(cols, numerics, path.spec)
+    if len(cols) == 1:  # one row: the serial impact kernel (no parallel launch to compile)
+        k = a["n_arms"][0]
+        element_impact(path.spec)(a["tau0"][0], a["g"][0, :k], a["tau"][0, :k], a["kappa"][0],
+                                  a["mu_t"][0], a["mu"][0], a["h"][0], a["n_elem"][0],
+                                  a["dxi"][0], a["max_steps"][0], rec[0], rec_every, out[0])
+        return
     element_kernel(path.spec)(a["tau0"], a["g"], a["tau"], a["n_arms"], a["kappa"], a["mu_t"],
                               a["mu"], a["h"], a["n_elem"], a["dxi"], a["max_steps"], rec,
                               rec_every, out)

@@ -473,5 +473,6 @@ def kv_normal_batch(tau0, rtol, max_steps, out):
     """
     n = tau0.shape[0]
     no_rec = np.zeros((0, N_REC))
+    # rec_every as int64, not the literal 1 (which would compile the impact once more)
     for i in prange(n):
-        kv_normal_impact(tau0[i], rtol, max_steps, no_rec, 1, out[i])
+        kv_normal_impact(tau0[i], rtol, max_steps, no_rec, np.int64(1), out[i])

@@ -305,7 +305,7 @@ def _arm3(x0, ez, c0, c1, cr, cj, dt, p0, dp0, pr, j):
     return ez * x0 + dt * (c0 * p0 + c1 * dt * dp0 + cr * pr) + cj * j
 
 
-@jit(inline="always")
+@jit()
 def _rhs(phase, y0, x, K, r, advance, tau0, g, itau, n, kappa, mu_t, tang, rc, hs, nh, ah,
          e_val, kh):
     """Right-hand side ``dx/dsigma`` into ``K[r]``; returns ``(F_z, F_x)``.
@@ -492,12 +492,12 @@ def _rhs(phase, y0, x, K, r, advance, tau0, g, itau, n, kappa, mu_t, tang, rc, h
 @jit()
 def _rhs_once(phase, y0, x, K, r, tau0, g, itau, n, kappa, mu_t, tang, rc, hs, nh, ah, e_val,
               kh):
-    """:func:`_rhs` at a state that holds its arm quantities (no advance), as a
-    called function for the few evaluations outside the steps (one inlined copy
-    of the right-hand side, in :func:`_step`, is what the run time needs; every
-    further copy costs compile time)."""
-    return _rhs(phase, y0, x, K, r, False, tau0, g, itau, n, kappa, mu_t, tang, rc, hs, nh, ah,
-                e_val, kh)
+    """:func:`_rhs` at a state that holds its arm quantities (no advance), for the
+    few evaluations outside the steps. The right-hand side is a called function,
+    compiled once (inlined into :func:`_step` and here it was lowered twice) for
+    an ``advance`` typed bool, not a literal (which would compile it once per value)."""
+    return _rhs(phase, y0, x, K, r, np.bool_(False), tau0, g, itau, n, kappa, mu_t, tang, rc, hs,
+                nh, ah, e_val, kh)
 
 
 @jit(inline="always")
@@ -598,8 +598,8 @@ def _step(phase, m, y, h, K, y1, tmp, mask, n_rk, tau0, g, itau, n, kappa, mu_t,
             for c in range(m):
                 tmp[c] = y[c] + h * (_B1 * K[0, c] + _B3 * K[2, c] + _B4 * K[3, c]
                                      + _B5 * K[4, c] + _B6 * K[5, c])
-        _rhs(phase, y, tmp, K, r, True, tau0, g, itau, n, kappa, mu_t, tang, rc, hs, nh, ah,
-             e_val, kh)
+        _rhs(phase, y, tmp, K, r, np.bool_(True), tau0, g, itau, n, kappa, mu_t, tang, rc, hs,
+             nh, ah, e_val, kh)
     for c in range(m):
         y1[c] = tmp[c]
     acc = 0.0
@@ -862,12 +862,19 @@ def maxwell_stick_impact(tau0, g, tau, kappa, mu_t, tangential, rtol, max_steps,
                     K[r, c] = Ks[r, c]
         if phase == 0:
             if nh + 1 >= rc.shape[0]:  # grow the history (rare: doubling)
+                # copied element by element: an array slice assignment compiles
+                # numba's shape-mismatch error message (about 25 string helpers)
                 rc2 = np.empty((2 * rc.shape[0], 5, m_l))
-                rc2[:nh] = rc[:nh]
                 hs2 = np.empty(2 * rc.shape[0] + 1)
-                hs2[:nh + 1] = hs[:nh + 1]
                 ah2 = np.empty((2 * rc.shape[0], 4 * n))
-                ah2[:nh] = ah[:nh]
+                for kc in range(nh):
+                    for p in range(5):
+                        for c in range(m_l):
+                            rc2[kc, p, c] = rc[kc, p, c]
+                    for c in range(4 * n):
+                        ah2[kc, c] = ah[kc, c]
+                for kc in range(nh + 1):
+                    hs2[kc] = hs[kc]
                 rc = rc2
                 hs = hs2
                 ah = ah2
@@ -999,7 +1006,10 @@ def maxwell_stick_batch(tau0, g, tau, n_arms, kappa, mu_t, tangential, rtol, max
     """
     nrow = tau0.shape[0]
     no_rec = np.zeros((0, N_REC))
+    # rec_every as int64, not the literal 1: a literal argument would compile the
+    # impact kernel once more (for Literal[int](1)) instead of calling the one a
+    # single-row run compiled
     for i in prange(nrow):
         k = n_arms[i]
         maxwell_stick_impact(tau0[i], g[i, :k], tau[i, :k], kappa[i], mu_t[i], tangential[i],
-                             rtol, max_steps, no_rec, 1, out[i])
+                             rtol, max_steps, no_rec, np.int64(1), out[i])

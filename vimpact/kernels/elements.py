@@ -58,6 +58,7 @@ from __future__ import annotations
 
 import functools
 import math
+import types
 from typing import NamedTuple
 
 import numpy as np
@@ -246,7 +247,8 @@ def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT, FRICTION,
     u_max = 0.0
     j_outer_max = -1
     n_rec = rec.shape[0]
-    i_rec = 0
+    # int64 from the start: a bare 0 (Literal[int](0)) compiled _record twice
+    i_rec = np.int64(0)
     status = STATUS_TIME_LIMIT
     step = 0
     b_now = 0.0
@@ -647,6 +649,40 @@ class KernelSpec(NamedTuple):
     friction: bool = False
 
 
+def _constants(spec: KernelSpec) -> tuple[int, bool, int, bool, bool, bool]:
+    """The effects of ``spec`` as plain Python constants (checked)."""
+    integrator, tangential, memory = int(spec.integrator), bool(spec.tangential), int(spec.memory)
+    arms, dashpot, friction = bool(spec.arms), bool(spec.dashpot), bool(spec.friction)
+    if friction and tangential and memory != 0:
+        raise ValueError(f"KernelSpec(memory={memory}, friction=True) is not supported: Coulomb "
+                         "friction needs incremental memory (0); the seed memory sets every "
+                         "element to the total contact-point displacement, which slip cannot "
+                         "change")
+    return integrator, tangential, memory, arms, dashpot, friction
+
+
+@functools.cache
+def element_impact(spec: KernelSpec):
+    """The serial one-impact kernel specialized for ``spec`` (compiled on first use, cached).
+
+    Signature: ``impact(tau0, g, tau, kappa, mu_t, mu, h, n_elem, dxi, max_steps,
+    rec, rec_every, out)``, the scalars and arrays of one row of
+    :func:`element_kernel` (``g``, ``tau`` only the row's real arms, ``rec``
+    ``(n_rec, N_REC)``, ``out`` ``(N_OUT,)``); writes exactly what the batch
+    kernel writes for that row. A single scene runs it instead of the parallel
+    batch kernel, whose cold compile costs more (the parallel launch around
+    the same inlined impact).
+    """
+    integrator, tangential, memory, arms, dashpot, friction = _constants(spec)
+
+    @jit()
+    def impact(tau0, g, tau, kappa, mu_t, mu, h, n_elem, dxi, max_steps, rec, rec_every, out):
+        _impact(tangential, memory, integrator, arms, dashpot, friction, tau0, g, tau, kappa,
+                mu_t, mu, h, n_elem, dxi, max_steps, rec, rec_every, out)
+
+    return impact
+
+
 @functools.cache
 def element_kernel(spec: KernelSpec):
     """The batch kernel specialized for ``spec`` (compiled on first use, cached on disk).
@@ -661,21 +697,27 @@ def element_kernel(spec: KernelSpec):
     ``(n, N_OUT)``. ``prange`` runs over the parameter sets; each writes its
     own row.
     """
-    # plain Python constants in the closure: numba freezes them, LLVM folds the branches
-    integrator, tangential, memory = int(spec.integrator), bool(spec.tangential), int(spec.memory)
-    arms, dashpot, friction = bool(spec.arms), bool(spec.dashpot), bool(spec.friction)
-    if friction and tangential and memory != 0:
-        raise ValueError(f"KernelSpec(memory={memory}, friction=True) is not supported: Coulomb "
-                         "friction needs incremental memory (0); the seed memory sets every "
-                         "element to the total contact-point displacement, which slip cannot "
-                         "change")
+    # the prange body calls the serial kernel of the same spec (compiled once, shared
+    # with single scenes) instead of inlining the impact a second time. It is a global
+    # of this copy of the batch function, not a closure cell: numba keys a closure's
+    # cache entry on its pickled cells, and a dispatcher pickles with a random id per
+    # process (the batch would never load from the cache); the spec's constants are
+    # the one cell, so each spec has its own cache entry.
+    template = _batch_template(_constants(spec))
+    run = types.FunctionType(template.__code__, {**globals(), "_spec_impact": element_impact(spec)},
+                             template.__name__, None, template.__closure__)
+    return jit(parallel=True)(run)
 
-    @jit(parallel=True)
+
+def _batch_template(key: tuple):
+    """The batch loop over ``_spec_impact`` (bound by :func:`element_kernel`), keyed by ``key``."""
+
     def run(tau0, g, tau, n_arms, kappa, mu_t, mu, h, n_elem, dxi, max_steps, rec, rec_every, out):
+        if False:  # noqa: SIM108 - keeps key a cell of the function (its cache key), never run
+            key  # noqa: B018
         for i in prange(tau0.shape[0]):
             k = n_arms[i]
-            _impact(tangential, memory, integrator, arms, dashpot, friction, tau0[i], g[i, :k],
-                    tau[i, :k], kappa[i], mu_t[i], mu[i], h[i], n_elem[i], dxi[i], max_steps[i],
-                    rec[i], rec_every, out[i])
+            _spec_impact(tau0[i], g[i, :k], tau[i, :k], kappa[i], mu_t[i], mu[i],  # noqa: F821
+                         h[i], n_elem[i], dxi[i], max_steps[i], rec[i], rec_every, out[i])
 
     return run
