@@ -130,3 +130,24 @@ def test_a_benchmark_is_registered_by_one_line(tmp_path, monkeypatch, capsys):
     monkeypatch.setitem(bench.BENCHMARKS, "gone", "no_such_module_here")
     assert main(["bench", "gone"]) == 2
     assert "not importable here" in capsys.readouterr().err
+
+
+def test_replaced_kernels_cover_every_single_impact_path():
+    """The one-impact overhead is measured with the kernel replaced by a recorded
+    row: a scene of each path (continuum stick, continuum normal, elements) must
+    then give the recorded scene's result, not its own (the kernel never ran)."""
+    import vimpact as v
+    from vimpact.engine import pack
+
+    mat = v.Material.kelvin_voigt(nu=0.5, E=5e10, eta=1e5)
+    other = v.Material.kelvin_voigt(nu=0.5, E=5e10, eta=1e6)
+    fast = v.Numerics.preset("fast")
+    for kw, num in ((dict(v_x0=5.0), None), (dict(tangential="none"), None),
+                    (dict(v_x0=5.0, mu=0.3), fast)):
+        with overhead._KernelsReplaced([pack]) as recorder:
+            recorded = v.simulate(v.Scene(mat, R=0.2, m=10.0, v_z0=10.0, **kw), num)
+        own = v.simulate(v.Scene(other, R=0.2, m=10.0, v_z0=10.0, **kw), num)
+        assert own.e_z != recorded.e_z  # the two scenes differ
+        with overhead._KernelsReplaced([pack], recorder.row, recorder.returned):
+            replaced = v.simulate(v.Scene(other, R=0.2, m=10.0, v_z0=10.0, **kw), num)
+        assert replaced.e_z == recorded.e_z, kw

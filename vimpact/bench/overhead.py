@@ -178,36 +178,42 @@ def _side_by_side(fns: dict, calls: int, repeats: int) -> dict[str, list[float]]
 class _KernelsReplaced:
     """Replace every kernel by a copy of its output row.
 
-    While active, every kernel the engines call (the two continuum batch kernels
-    and each element kernel, in the current and the :data:`BEFORE_COMMIT` engine's
-    ``pack``) only copies ``row`` into its output: what is left of a
-    ``simulate()`` call is the Python around the kernel. With ``row=None`` the
-    real kernel runs once and its one-row output is kept as ``row``.
+    While active, every kernel the engines call (the continuum batch and
+    single-impact kernels and each element batch and single-impact kernel, in
+    the current and the :data:`BEFORE_COMMIT` engine's ``pack``) only copies
+    ``row`` into its output: what is left of a ``simulate()`` call is the Python
+    around the kernel. With ``row=None`` the real kernel runs once and its output
+    row (and return value: the recorded rows of a single-impact kernel) is kept.
     """
 
-    def __init__(self, packs: list, row: np.ndarray | None = None):
-        self.packs, self.row = packs, row
+    def __init__(self, packs: list, row: np.ndarray | None = None, returned=None):
+        self.packs, self.row, self.returned = packs, row, returned
         self.saved: list = []
 
     def _wrap(self, real):
         def kernel(*args):
             if self.row is None:
-                real(*args)
+                self.returned = real(*args)
                 self.row = args[-1].copy()
             else:
-                args[-1][:] = self.row  # every batch kernel takes ``out`` last
+                args[-1][:] = self.row  # every kernel takes ``out`` (its rows) last
+            return self.returned
         return kernel
 
     def __enter__(self):
         from vimpact.kernels import continuum_kv, continuum_maxwell
 
-        for owner, name in ([(continuum_kv, "kv_normal_batch"),
-                             (continuum_maxwell, "maxwell_stick_batch")]
-                            + [(pack, "element_kernel") for pack in self.packs]):
+        factories = ("element_kernel", "element_impact")  # one kernel per KernelSpec
+        targets = ([(continuum_kv, name) for name in ("kv_normal_batch", "kv_normal_impact")]
+                   + [(continuum_maxwell, name)
+                      for name in ("maxwell_stick_batch", "maxwell_stick_impact")]
+                   + [(pack, name) for pack in self.packs for name in factories
+                      if hasattr(pack, name)])  # the older engine has no element_impact
+        for owner, name in targets:
             real = getattr(owner, name)
             self.saved.append((owner, name, real))
             setattr(owner, name, (lambda spec, real=real: self._wrap(real(spec)))
-                    if name == "element_kernel" else self._wrap(real))
+                    if name in factories else self._wrap(real))
         return self
 
     def __exit__(self, *exc):
@@ -276,12 +282,16 @@ def one_impact(quick: bool = False) -> dict:
             if before is not None:
                 fns["before"] = lambda: before(scene, num)
                 old = before(scene, num)
-                rec["same_result_as_before"] = repr(old.to_dict()) == repr(result.to_dict())
+                # on the fields both engines give (outputs added since are not compared)
+                then, now = old.to_dict(), result.to_dict()
+                rec["same_result_as_before"] = all(repr(then[k]) == repr(now[k])
+                                                   for k in then if k in now)
+                rec["fields_new_since_before"] = sorted(set(now) - set(then))
             samples = _side_by_side(fns, calls, repeats)  # with the kernel
             rec["simulate_us"], rec["simulate_us_samples"] = min(samples["now"]), samples["now"]
             with _KernelsReplaced(packs) as recorder:  # the real kernel's row
                 v.simulate(scene, num)
-            with _KernelsReplaced(packs, recorder.row):
+            with _KernelsReplaced(packs, recorder.row, recorder.returned):
                 outside = _side_by_side(fns, calls, repeats)
             rec["outside_kernel_us"] = min(outside["now"])
             rec["outside_kernel_us_samples"] = outside["now"]
