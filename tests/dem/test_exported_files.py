@@ -5,7 +5,7 @@ import re
 
 import pytest
 
-from tests.dem.test_cli_dem import TOML
+from tests.dem.test_cli_dem import WIRING
 from vimpact.dem.export import export
 from vimpact.dem.problem import problem_from_toml
 
@@ -22,7 +22,7 @@ MFIX_KEYS = {"DES_COLL_MODEL", "DES_EN_INPUT", "DES_EN_WALL_INPUT", "KN", "KN_W"
 
 @pytest.fixture(scope="module")
 def problem():
-    return problem_from_toml(TOML, "files")
+    return problem_from_toml(WIRING, "files")
 
 
 def test_mercurydpm_species_compiles_by_name(problem, tmp_path):

@@ -215,7 +215,7 @@ def viscoelastic_hertz_mindlin(alpha: float, kappa: float, x_gamma: float, F: fl
 FRICTION_STEPS = 2000
 
 
-def hertz_mindlin_coulomb(alpha, kappa: float, x_gamma: float, F: float, mu: float, w0,
+def hertz_mindlin_coulomb(alpha, kappa, x_gamma, F: float, mu: float, w0,
                           steps: int = FRICTION_STEPS) -> tuple[np.ndarray, np.ndarray]:
     """Normal and tangential restitution of LAMMPS' ``hertz ... damping viscoelastic
     tangential mindlin k_t x_gamma_t mu limit_damping`` in an oblique impact, with
@@ -233,19 +233,22 @@ def hertz_mindlin_coulomb(alpha, kappa: float, x_gamma: float, F: float, mu: flo
     Parameters
     ----------
     alpha, w0 : arrays (or numbers) of the same shape: ``A v0 / d_H`` and ``v_c0 / v_z0``
-    kappa, x_gamma, F : as in :func:`viscoelastic_hertz_mindlin`; mu : Coulomb
-        coefficient (``inf``: stick)
+    kappa, x_gamma : as in :func:`viscoelastic_hertz_mindlin`; numbers, or arrays that
+        broadcast with ``alpha`` (one candidate per point: a fit runs many at once)
+    F : as in :func:`viscoelastic_hertz_mindlin`; mu : Coulomb coefficient (``inf``: stick)
     steps : steps per elastic Hertz contact time (``2.943 T``)
 
     Returns
     -------
-    (e, beta) : arrays; ``beta = -w_end / w0``
+    (e, beta) : arrays of the broadcast shape; ``beta = -w_end / w0``
     """
-    return _stepped(np.asarray(alpha, dtype=float), np.asarray(w0, dtype=float), mu, steps,
-                    _mindlin_force(float(kappa), float(x_gamma)), float(F))
+    alpha, w0, kappa, x_gamma = np.broadcast_arrays(
+        *(np.asarray(a, dtype=float) for a in (alpha, w0, kappa, x_gamma)))
+    return _stepped(alpha, w0, mu, steps, _mindlin_force(kappa.ravel(), x_gamma.ravel()),
+                    float(F))
 
 
-def _mindlin_force(kappa: float, x_gamma: float):
+def _mindlin_force(kappa: np.ndarray, x_gamma: np.ndarray):
     def force(x, v, s, w, alpha, cap):
         r = np.sqrt(np.maximum(x, 0.0))
         f = np.maximum(x * r + 1.5 * alpha * r * v, 0.0)
@@ -261,7 +264,7 @@ def _mindlin_force(kappa: float, x_gamma: float):
     return force
 
 
-def mercury_mindlin_coulomb(alpha, K: float, D, F: float, mu: float, w0,
+def mercury_mindlin_coulomb(alpha, K, D, F: float, mu: float, w0,
                             steps: int = FRICTION_STEPS) -> tuple[np.ndarray, np.ndarray]:
     """Normal and tangential restitution of MercuryDPM's
     ``HertzianBSHPViscoelasticMindlinSpecies`` in an oblique impact with Coulomb friction,
@@ -277,15 +280,16 @@ def mercury_mindlin_coulomb(alpha, K: float, D, F: float, mu: float, w0,
 
     Parameters
     ----------
-    alpha, D, w0 : arrays (or numbers) of one shape; K, F, mu : numbers
+    alpha, D, w0 : arrays (or numbers) that broadcast; K : number or array like them (one
+        candidate per point: a fit runs many at once); F, mu : numbers
 
     Returns
     -------
-    (e, beta) : arrays; ``beta = -w_end / w0``
+    (e, beta) : arrays of the broadcast shape; ``beta = -w_end / w0``
     """
-    alpha, D, w0 = np.broadcast_arrays(np.asarray(alpha, dtype=float), np.asarray(D, dtype=float),
-                                       np.asarray(w0, dtype=float))
+    alpha, D, w0, Kb = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in (alpha, D, w0, K)))
     Dflat = D.ravel()
+    K = Kb.ravel()
 
     def force(x, v, s, w, a, cap):
         r = np.sqrt(np.maximum(x, 0.0))
