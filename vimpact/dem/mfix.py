@@ -54,14 +54,32 @@ def _beta(en: float, etat_fac: float, F: float) -> float:
 FIT_STEPS = 1000
 
 
-def _oblique_beta(en: float, etat_fac: float, F: float, mu: float, w0,
+def _oblique_beta(en: float, etat_fac, F: float, mu: float, w0,
                   steps: int = laws.FRICTION_STEPS) -> np.ndarray:
     """MFiX's ``beta`` in oblique impacts with friction ``mu`` at ``w0 = v_c0 / v_z0``
     (:func:`vimpact.dem.laws.mfix_coulomb`; the law scales with the speed, so ``beta``
-    depends on the angle only)."""
+    depends on the angle only); ``etat_fac`` a number or an array of candidates that
+    broadcasts with ``w0``."""
     zeta = laws.zeta_of_restitution(en)
     return laws.mfix_coulomb(zeta, math.sqrt(KT_FAC * F),
                              etat_fac * zeta * math.sqrt(F / KT_FAC), F, mu, w0, steps)[1]
+
+
+def _fit_oblique(en: float, F: float, mu: float, w0: np.ndarray, target: np.ndarray,
+                 xatol: float = 5e-4) -> float:
+    """``DES_ETAT_FAC`` in :data:`ETAT_FAC_RANGE` closest (RMS) to ``target`` at ``w0``:
+    grids of 21 values, each stepped in one run, shrunk around the best to one spacing
+    until the spacing is below ``xatol``."""
+    lo, hi = ETAT_FAC_RANGE
+    best = 0.5 * (lo + hi)
+    while True:
+        x = np.linspace(lo, hi, 21)
+        b = _oblique_beta(en, x[:, None], F, mu, w0[None, :], FIT_STEPS)
+        best = float(x[int(np.argmin(np.mean((b - target) ** 2, axis=1)))])
+        step = x[1] - x[0]
+        if step < xatol:
+            return best
+        lo, hi = (max(best - step, ETAT_FAC_RANGE[0]), min(best + step, ETAT_FAC_RANGE[1]))
 
 
 def fit(problem: DemProblem, targets: dict[str, Targets]) -> list[ContactFit]:
@@ -86,9 +104,7 @@ def fit(problem: DemProblem, targets: dict[str, Targets]) -> list[ContactFit]:
         if t.oblique is not None:
             ob = t.oblique
             mu = written_mu[c.is_wall]  # MFiX's one MEW (MEW_W), as written
-            etat, _ = fit_scalar(lambda x: _oblique_beta(en, x, F, mu, ob.w0, FIT_STEPS),
-                                 ob.beta_x, *ETAT_FAC_RANGE)
-            fits[-1].params["etat_fac"] = etat
+            fits[-1].params["etat_fac"] = _fit_oblique(en, F, mu, ob.w0, ob.beta_x)
         elif t.beta_x is not None:
             etat, _ = fit_scalar(lambda x: np.full_like(t.beta_x, _beta(en, x, F)),
                                  t.beta_x, *ETAT_FAC_RANGE)
