@@ -31,6 +31,10 @@ material = "rigid"
 default = 0.5
 """
 
+#: the same set-up with one impact angle: for tests of the wiring (files, names, lines), not of
+#: the fits' quality, so that the tangential searches have 4 oblique targets, not 24
+WIRING = TOML.replace("n = 4\n", "n = 4\nangles_deg = [45.0]\n", 1)
+
 FILES = {"lammps": ["lammps_settings.in", "lammps_pair.in", "lammps_walls.in"],
          "liggghts": ["liggghts_settings.in", "liggghts.in"],
          "mercurydpm": ["mercurydpm_species.cpp"], "yade": ["yade_materials.py"],
@@ -40,7 +44,7 @@ FILES = {"lammps": ["lammps_settings.in", "lammps_pair.in", "lammps_walls.in"],
 @pytest.mark.parametrize("code", CODES)
 def test_writes_input_and_report_for_every_code(code, tmp_path, capsys):
     src = tmp_path / "setup.toml"
-    src.write_text(TOML)
+    src.write_text(WIRING)
     out = tmp_path / code
     assert main(["dem", str(src), "--for", code, "--out", str(out)]) == 0
     for name in FILES[code] + [f"report_{code}.md", f"report_{code}.png"]:
@@ -58,7 +62,7 @@ def test_writes_input_and_report_for_every_code(code, tmp_path, capsys):
 
 def test_lammps_lines_name_every_pair_and_one_wall_fix_per_type(tmp_path):
     src = tmp_path / "setup.toml"
-    src.write_text(TOML)
+    src.write_text(WIRING)
     main(["dem", str(src), "--for", "lammps", "--out", str(tmp_path)])
     text = (tmp_path / "lammps_pair.in").read_text()
     assert [ln.split()[1:3] for ln in text.splitlines() if ln.startswith("pair_coeff")] == \

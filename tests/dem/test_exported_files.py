@@ -3,9 +3,10 @@ values their sources and documentation accept (a read check, see docs/dem.md).""
 
 import re
 
+import numpy as np
 import pytest
 
-from tests.dem.test_cli_dem import TOML
+from tests.dem.test_cli_dem import WIRING
 from vimpact.dem.export import export
 from vimpact.dem.problem import problem_from_toml
 
@@ -22,7 +23,7 @@ MFIX_KEYS = {"DES_COLL_MODEL", "DES_EN_INPUT", "DES_EN_WALL_INPUT", "KN", "KN_W"
 
 @pytest.fixture(scope="module")
 def problem():
-    return problem_from_toml(TOML, "files")
+    return problem_from_toml(WIRING, "files")
 
 
 def test_mercurydpm_species_compiles_by_name(problem, tmp_path):
@@ -48,3 +49,13 @@ def test_mfix_keywords_and_ranges(problem, tmp_path):
     # the reported beta_x residual is that of the value written
     for f in ex.fits:
         assert 0.0 <= f.params["etat_fac"] <= 1.0 and f.res_beta_x is not None
+
+
+def test_mfix_tangential_factor_is_fitted_with_the_friction(problem):
+    """With friction, the reported beta_x residual of MFiX is over the oblique impacts,
+    MFiX's law run with the MEW written (one value)."""
+    ex = export(problem, "mfix")
+    for f in ex.fits:
+        ob = ex.targets[f.contact.key].oblique
+        assert f.beta_oblique is not None and f.beta_oblique.shape == ob.beta_x.shape
+        assert f.res_beta_x.max_abs == pytest.approx(np.max(np.abs(f.beta_oblique - ob.beta_x)))

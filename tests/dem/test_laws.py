@@ -143,3 +143,18 @@ def test_stepped_liggghts_and_mercurydpm_laws_slide_as_rigid_bodies():
 def test_stepped_liggghts_normal_law_is_tsuji_hertz():
     e, _ = laws.liggghts_coulomb(0.7, 1.0, 0.5, 3.5, math.inf, np.array([1.0]))
     assert float(e[0]) == pytest.approx(laws.tsuji_hertz_e(0.7), abs=1e-5)
+
+
+def test_mfix_law_sticks_like_the_ode_and_slides_like_coulomb():
+    """MFiX's stepped LSD law with friction: in stick it converges to the linear
+    spring-dashpot ODE (an independent integrator); sliding through the whole contact of
+    an undamped normal law it gives Coulomb's ``beta = -1 + 2 mu F / w0``."""
+    F, kt = 3.5, 2.0 / 7.0
+    zeta = laws.zeta_of_restitution(0.6)
+    w_t, zeta_t = math.sqrt(kt * F), 0.5 * zeta * math.sqrt(F / kt)
+    ref = laws.linear_spring_dashpot(zeta, "overlap", (w_t, zeta_t))
+    e, b = laws.mfix_coulomb(zeta, w_t, zeta_t, F, math.inf, np.array([0.3, 2.0]))
+    assert e == pytest.approx(ref[0], abs=5e-4) and b == pytest.approx(ref[1], abs=5e-4)
+    mu, w0 = 0.3, np.tan(np.radians([75.0, 85.0]))
+    _, b = laws.mfix_coulomb(0.0, w_t, zeta_t, F, mu, w0)
+    assert b == pytest.approx(-1.0 + 2.0 * mu * F / w0, abs=2e-3)

@@ -46,6 +46,12 @@ def export(problem: DemProblem, code: str, out_dir=None, numerics=None,
     """
     mod = code_module(code)
     say = progress or (lambda _text: None)
+    sticky = [c.key for c in problem.contacts if c.adhesion > 0.0]
+    if sticky and not getattr(mod, "ADHESION", False):
+        from vimpact.model.validation import InputError
+
+        raise InputError(f"[adhesion] of {', '.join(sticky)} is not allowed with --for {code}: "
+                         "only --for lammps has an adhesive law (granular jkr)")
     steps = getattr(mod, "STEPS_PER_CONTACT", None)
     if steps_per_contact is not None:
         if steps is None:

@@ -129,16 +129,48 @@ class Targets:
         return self.level == (int(self.level.max()) + 1) // 2 if self.level.size else self.level
 
 
+def adhesive_scene(contact: Contact, level, v: float = 1.0):
+    """The adhesive normal-impact scene (:class:`vimpact.Scene`, ``adhesion`` the
+    contact's) of ``contact`` at the size level ``level`` and approach speed ``v`` (m/s)."""
+    from vimpact.model.pair import Body, Wall, pair_scene
+    from vimpact.model.scene import Scene
+
+    b1, b2 = level
+    base = pair_scene(Body(b1.material, b1.R, b1.m, b1.Theta, v_z=1.0),
+                      b2 if isinstance(b2, Wall) else Body(b2.material, b2.R, b2.m, b2.Theta),
+                      tangential="none", allow_large_contact=True)
+    return Scene(base.material, R=base.R, m=base.m, v_z0=v, tangential="none",
+                 allow_large_contact=True, adhesion=contact.adhesion)
+
+
+def adhesive_restitution(contact: Contact, level, speeds, numerics):
+    """vimpact's adhesive ``e_z`` (0 where the sphere sticks), contact time and status of
+    ``contact`` at ``level`` over ``speeds`` (:func:`vimpact.engine.adhesion.simulate_adhesive`),
+    as a DataFrame like :func:`vimpact.engine.pairs.pair_restitution`'s."""
+    import pandas as pd
+
+    from vimpact.engine.adhesion import simulate_adhesive
+
+    rows = [simulate_adhesive(adhesive_scene(contact, level, float(v)), numerics)
+            for v in speeds]
+    return pd.DataFrame({"v_z0": speeds, "e_z": [r.e_z for r in rows],
+                         "t_contact": [r.t_contact for r in rows],
+                         "status": [r.status for r in rows]})
+
+
 def compute_targets(problem: DemProblem, contact: Contact, *, tangential: bool = False,
                     numerics=None) -> Targets:
-    """Run vimpact for ``contact`` at every size level and speed of ``problem``."""
+    """Run vimpact for ``contact`` at every size level and speed of ``problem`` (with
+    adhesion, :func:`adhesive_restitution`: ``e_z`` 0 where the sphere sticks)."""
     from vimpact.model.numerics import Numerics
 
     numerics = numerics or Numerics.preset("fast")
     parts = []
     for k, (b1, b2) in enumerate(contact.levels()):
         R, m = contact.effective((b1, b2))
-        df = pair_restitution(b1, b2, problem.speeds, numerics=numerics)
+        df = (adhesive_restitution(contact, (b1, b2), problem.speeds, numerics)
+              if contact.adhesion > 0.0 else
+              pair_restitution(b1, b2, problem.speeds, numerics=numerics))
         beta = (pair_restitution(b1, b2, problem.speeds, tangential=True, numerics=numerics)
                 ["beta_x"].to_numpy(dtype=float) if tangential else None)
         parts.append((k, R, m, df, beta))
@@ -273,3 +305,57 @@ def fit_scalar(predict, target: np.ndarray, lo: float, hi: float) -> tuple[float
     best = minimize_scalar(cost, bounds=(lo, hi), method="bounded",
                            options={"xatol": 1e-10, "maxiter": 500})
     return float(best.x), np.asarray(predict(best.x), dtype=float)
+
+
+def grid_search(cost, start, half_width, lower, upper, xatol: float = 5e-4, n: int = 7,
+                max_rounds: int = 40) -> np.ndarray:
+    """Minimize ``cost`` over two parameters by shrinking grids, each evaluated in one call.
+
+    Each round evaluates an ``n x n`` grid of half-widths ``half_width`` around the
+    centre (clipped to ``[lower, upper]``) in one call of ``cost`` (so that a stepped law
+    runs every candidate at once), moves the centre to the best point and, when that
+    point is inside the grid, shrinks the half-widths to one grid spacing (else doubles
+    them, up to 4 times the first: the minimum lies further out). Stops when the spacing is below ``xatol`` in
+    both parameters.
+
+    Parameters
+    ----------
+    cost : ``(k, 2)`` candidates -> ``(k,)`` costs
+    start, half_width, lower, upper : pairs of numbers (the parameters' units)
+    xatol : spacing at which the search stops, in the parameters' units
+    n : grid points per parameter (odd)
+
+    Returns
+    -------
+    the best candidate, shape ``(2,)``
+    """
+    c = np.asarray(start, dtype=float)
+    h = np.asarray(half_width, dtype=float)
+    lo, hi = np.asarray(lower, dtype=float), np.asarray(upper, dtype=float)
+    u = np.linspace(-1.0, 1.0, n)
+    h_max = 4.0 * h
+    for _ in range(max_rounds):
+        axes = [np.unique(np.clip(c[i] + h[i] * u, lo[i], hi[i])) for i in range(2)]
+        z = np.stack([g.ravel() for g in np.meshgrid(*axes, indexing="ij")], axis=1)
+        f = cost(z)
+
+        def at(p: np.ndarray) -> int:  # the grid point nearest to p
+            return int(np.argmin(np.abs(z - p).sum(axis=1)))
+
+        j = int(np.argmin(f))
+        if f[j] >= f[at(c)] * (1.0 - 1e-12):
+            j = at(c)  # ties keep the centre
+        # an edge in one parameter counts only if it is better than that parameter at the
+        # centre (a flat direction would otherwise move the grid for ever)
+        edge = [(z[j, i] in (axes[i][0], axes[i][-1])) and axes[i].size > 1
+                and lo[i] < z[j, i] < hi[i]
+                and f[j] < f[at(np.where(np.arange(2) == i, c, z[j]))] * (1.0 - 1e-9)
+                for i in range(2)]
+        c = z[j]
+        if any(edge):  # the minimum lies further out: look wider
+            h = np.minimum(h * 2.0, h_max)
+        else:
+            h = h * 2.0 / (n - 1)  # the last spacing: the best point is this close
+            if np.all(h < xatol):
+                break
+    return c

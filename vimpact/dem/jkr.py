@@ -167,18 +167,20 @@ class JkrFit:
                 f"{self.law.cohesion:.12g} damping viscoelastic tangential linear_nohistory 0 0")
 
 
-def fit_jkr(scene: Scene, speeds, numerics=None) -> JkrFit:
+def fit_jkr(scene: Scene, speeds, numerics=None, target=None) -> JkrFit:
     """Fit LAMMPS' ``cohesion`` and ``eta_n0`` to vimpact's adhesive ``e_z`` of ``scene``
     at ``speeds`` (m/s; ``scene.v_z0`` is replaced), least squares, starting from the
     true surface energy times ``exp(0.4)`` and the damping ``2 E* tau / m`` (``tau`` the
-    material's viscous time, at least ``1e-3`` Hertz times)."""
+    material's viscous time, at least ``1e-3`` Hertz times). ``target``: vimpact's
+    ``e_z`` at ``speeds`` when already run (else it is run here)."""
     speeds = np.asarray(speeds, dtype=float)
     if speeds.size < 2 or not np.all(np.isfinite(speeds) & (speeds > 0.0)):
         raise InputError(f"speeds = {speeds!r} is not allowed: must be at least two "
                          "finite speeds > 0 (m/s)")
     positive("adhesion", scene.adhesion)
-    target = np.array([simulate_adhesive(dataclasses.replace(scene, v_z0=float(v)),
-                                         numerics).e_z for v in speeds])
+    target = (np.array([simulate_adhesive(dataclasses.replace(scene, v_z0=float(v)),
+                                          numerics).e_z for v in speeds])
+              if target is None else np.asarray(target, dtype=float))
     E_star, R, m = scene.E_star, scene.R, scene.m
     tau = scene.material.viscous_time()
     t_H = float(scene.hertz.t_H)

@@ -47,17 +47,22 @@ from vimpact.dem.fit import (
     Residual,
     Targets,
     fit_viscoelastic_hertz,
+    grid_search,
     viscoelastic_hertz_prediction,
 )
 from vimpact.dem.problem import Contact, DemProblem
 
 CODE = "lammps"
 TANGENTIAL = True
+#: contacts with a work of adhesion get the ``jkr`` normal model (:mod:`vimpact.dem.jkr`)
+ADHESION = True
 #: speeds (of the nominal level) the tangential damping is fitted at (full stick)
 TANGENTIAL_FIT_POINTS = 3
 #: steps per contact of the stepped friction law inside the tangential search (the
 #: reported prediction uses :data:`vimpact.dem.laws.FRICTION_STEPS`)
 FIT_STEPS = 1000
+#: start and half-widths of the tangential grid search, ``(ln(k_t / k_relaxed), ln x_gamma_t)``
+SEARCH_START, SEARCH_HALF_WIDTH = (-0.3, math.log(0.4)), (1.0, 1.5)
 #: friction written for a contact without one (LAMMPS needs a finite mu_s)
 STICK_MU = 1.0e6
 
@@ -103,14 +108,55 @@ def fit(problem: DemProblem, targets: dict[str, Targets]) -> list[ContactFit]:
                          f"({params['k_t'] / k_relaxed:.3g} x the relaxed 8 G/(2 - nu)) and "
                          f"tangential damping x_gamma_t = {params['x_gamma_t']:.4g} fitted "
                          + basis)
-        if len(set(t.level.tolist())) > 1:
+        res_e = Residual.of(e, t.e_z)
+        if c.adhesion > 0.0:
+            e, res_e = _fit_adhesive(c, t, params, notes)
+        elif len(set(t.level.tolist())) > 1:
             notes.append("size range: A is fitted at the nominal size; LAMMPS multiplies "
                          "eta_n0 by m_eff, so at the other sizes the damping is off by "
                          "m_eff / m_eff,nominal (included in the residual)")
         if not math.isfinite(c.mu):
             notes.append(f"no friction given: mu_s = {STICK_MU:g} (stick)")
-        fits.append(ContactFit(c, params, e, b, Residual.of(e, t.e_z), res_b, notes, b_ob))
+        fits.append(ContactFit(c, params, e, b, res_e, res_b, notes, b_ob))
     return fits
+
+
+#: speeds (log-spaced picks of the set-up's, nominal sizes) the ``jkr`` law is fitted at
+JKR_FIT_POINTS = 4
+
+
+def _fit_adhesive(c: Contact, t: Targets, params: dict, notes: list[str]
+                  ) -> tuple[np.ndarray, Residual]:
+    """Replace the normal law of ``params`` by LAMMPS' ``jkr`` (:mod:`vimpact.dem.jkr`)
+    fitted to vimpact's adhesive ``e_z`` at :data:`JKR_FIT_POINTS` nominal speeds; add the
+    sticking velocities. Returns the law's ``e_z`` at every point of ``t`` (each size
+    level with its own ``R``, ``m``: LAMMPS' damping carries ``m_eff`` as the law does)
+    and its residual."""
+    from vimpact.dem.fit import adhesive_scene
+    from vimpact.dem.jkr import JkrLaw, fit_jkr
+
+    nominal = np.flatnonzero(t.nominal)
+    pick = nominal[np.unique(np.linspace(0, nominal.size - 1, min(JKR_FIT_POINTS, nominal.size))
+                             .round().astype(int))]
+    levels = c.levels()
+    scene = adhesive_scene(c, levels[len(levels) // 2], float(t.v[pick[0]]))
+    jf = fit_jkr(scene, t.v[pick], target=t.e_z[pick])
+    L = jf.law
+    e = np.array([JkrLaw(L.E_star, R, m, L.cohesion, L.eta_n0).restitution(float(v))
+                  for v, R, m in zip(t.v, t.R, t.m)])
+    del params["k_n"]  # the jkr model takes E and nu, not the Hertz stiffness
+    params.update({"E_jkr_Pa": jf.E_lammps, "nu": jf.nu, "cohesion": L.cohesion,
+                   "eta_n0": L.eta_n0, "adhesion_J_m2": c.adhesion,
+                   "v_stick_vimpact_m_s": jf.v_stick_vimpact, "v_stick_lammps_m_s": jf.v_stick_law})
+    notes.append(f"adhesion dgamma = {c.adhesion:g} J/m^2: normal law LAMMPS' jkr, cohesion "
+                 f"{L.cohesion:.4g} J/m^2 ({L.cohesion / (c.adhesion / 2.0):.3g} x dgamma/2) and "
+                 f"eta_n0 {L.eta_n0:.4g} fitted to vimpact's adhesive e_z at "
+                 + ", ".join(f"{v:.3g}" for v in t.v[pick])
+                 + f" m/s (sticking counted as e_z = 0); sticking velocity vimpact "
+                 f"{jf.v_stick_vimpact:.4g} m/s, LAMMPS' law {jf.v_stick_law:.4g} m/s (nominal "
+                 "sizes); the tangential constants are those fitted with the non-adhesive "
+                 "normal law (LAMMPS' jkr raises its Coulomb limit by twice the pull-off force)")
+    return e, Residual.of(e, t.e_z)
 
 
 def _tangential_beta(c: Contact, t: Targets, A: float, params: dict, k_t: float,
@@ -134,10 +180,11 @@ def _angles(ob: Oblique) -> str:
     return ", ".join(f"{a:g}" for a in sorted(set(ob.angle_deg.tolist())))
 
 
-def oblique_beta(c: Contact, ob: Oblique, A: float, params: dict, k_t: float, x_gamma: float,
+def oblique_beta(c: Contact, ob: Oblique, A: float, params: dict, k_t, x_gamma,
                  steps: int | None = None) -> np.ndarray:
     """LAMMPS' ``beta`` at the oblique points ``ob`` (nominal sizes) with Mindlin stiffness
-    ``k_t`` (Pa), tangential damping ``x_gamma`` and the contact's friction (the stepped
+    ``k_t`` (Pa), tangential damping ``x_gamma`` (numbers, or arrays of candidates that
+    broadcast with the points) and the contact's friction (the stepped
     law :func:`vimpact.dem.laws.hertz_mindlin_coulomb`)."""
     from vimpact.dem import laws, linear
 
@@ -153,15 +200,24 @@ def _fit_tangential(c: Contact, t: Targets, A: float, params: dict
     """``k_t`` (Pa) and ``x_gamma_t`` >= 0 closest to vimpact's ``beta_x`` (RMS): over the
     oblique impacts with the contact's friction when it has one (``t.oblique``), else in
     full stick at a few nominal speeds; starting from 0.74 x the relaxed Mindlin stiffness
-    and ``x_gamma_t = 0.4``, near the fits of Kelvin-Voigt pairs. Returns them and the
-    law's full-stick ``beta`` at every point of ``t``."""
+    and ``x_gamma_t = 0.4``, near the fits of Kelvin-Voigt pairs (with friction: shrinking
+    grids in ``(ln(k_t / k_relaxed), ln x_gamma_t)``, :func:`vimpact.dem.fit.grid_search`, every
+    candidate of a grid stepped at once). Returns them and the law's full-stick ``beta`` at
+    every point of ``t``."""
     from scipy.optimize import minimize
 
     k0 = params["k_t"]
     ob = t.oblique
     if ob is not None:
-        def residual(k: float, x: float) -> np.ndarray:
-            return oblique_beta(c, ob, A, params, k, x, steps=FIT_STEPS) - ob.beta_x
+        def costs(z: np.ndarray) -> np.ndarray:  # every candidate in one stepped run
+            b = oblique_beta(c, ob, A, params, k0 * np.exp(z[:, :1]), np.exp(z[:, 1:]),
+                             steps=FIT_STEPS)
+            return np.mean((b - ob.beta_x) ** 2, axis=1)
+
+        z = grid_search(costs, SEARCH_START, SEARCH_HALF_WIDTH, (-5.0, math.log(1e-6)),
+                        (5.0, math.log(1e12)))
+        k, x = k0 * math.exp(float(z[0])), math.exp(float(z[1]))
+        return k, x, _tangential_beta(c, t, A, params, k, x)
     else:
         nominal = np.flatnonzero(t.nominal)
         pick = nominal[np.unique(np.linspace(0, nominal.size - 1, TANGENTIAL_FIT_POINTS)
@@ -180,7 +236,18 @@ def _fit_tangential(c: Contact, t: Targets, A: float, params: dict
     return k, x, _tangential_beta(c, t, A, params, k, x)
 
 
+def _what(p: dict) -> str:
+    if "cohesion" in p:
+        return (f"adhesive (jkr), dgamma = {p['adhesion_J_m2']:.6g} J/m^2, sticking below "
+                f"{p['v_stick_lammps_m_s']:.4g} m/s (vimpact {p['v_stick_vimpact_m_s']:.4g})")
+    return f"A = {p['A_s']:.6g} s"
+
+
 def _coeffs(p: dict) -> str:
+    if "cohesion" in p:  # adhesive: LAMMPS refuses limit_damping with a cohesive model
+        return (f"jkr {p['E_jkr_Pa']:.10g} {p['eta_n0']:.10g} {p['nu']:.10g} "
+                f"{p['cohesion']:.10g} damping viscoelastic "
+                f"tangential mindlin {p['k_t']:.10g} {p['x_gamma_t']:.10g} {p['mu_s']:.10g}")
     return (f"hertz {p['k_n']:.10g} {p['eta_n0']:.10g} damping viscoelastic "
             f"tangential mindlin {p['k_t']:.10g} {p['x_gamma_t']:.10g} {p['mu_s']:.10g} "
             "limit_damping")
@@ -235,7 +302,7 @@ def render(problem: DemProblem, fits: list[ContactFit],
         if not f.contact.is_wall:
             i, j = sorted((f.contact.first.index, f.contact.second.index))
             pair.append(f"pair_coeff {i} {j} {_coeffs(f.params)}"
-                        f"   # {f.contact.key}: A = {f.params['A_s']:.6g} s")
+                        f"   # {f.contact.key}: {_what(f.params)}")
     pair += [f"neighbor {0.25 * r_max:.6g} bin   # skin: a quarter of the largest radius",
              f"timestep {dt:.8g}   # s: shortest contact {t_c:.6g} s (fastest speed, smallest "
              f"sizes) / {steps_per_contact} steps", ""]
@@ -253,7 +320,7 @@ def render(problem: DemProblem, fits: list[ContactFit],
             walls.append(f"group vimpact_type{t.index} type {t.index}")
             grouped.add(t.index)
         walls.append(f"fix wall_{w.name}_{t.name} vimpact_type{t.index} wall/gran granular "
-                     f"{_coeffs(f.params)} zplane 0.0 NULL   # A = {f.params['A_s']:.6g} s")
+                     f"{_coeffs(f.params)} zplane 0.0 NULL   # {_what(f.params)}")
     out = {"lammps_settings.in": "\n".join(settings), "lammps_pair.in": "\n".join(pair)}
     if problem.walls:
         out["lammps_walls.in"] = "\n".join(walls) + "\n"

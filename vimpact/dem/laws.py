@@ -215,7 +215,7 @@ def viscoelastic_hertz_mindlin(alpha: float, kappa: float, x_gamma: float, F: fl
 FRICTION_STEPS = 2000
 
 
-def hertz_mindlin_coulomb(alpha, kappa: float, x_gamma: float, F: float, mu: float, w0,
+def hertz_mindlin_coulomb(alpha, kappa, x_gamma, F: float, mu: float, w0,
                           steps: int = FRICTION_STEPS) -> tuple[np.ndarray, np.ndarray]:
     """Normal and tangential restitution of LAMMPS' ``hertz ... damping viscoelastic
     tangential mindlin k_t x_gamma_t mu limit_damping`` in an oblique impact, with
@@ -233,19 +233,22 @@ def hertz_mindlin_coulomb(alpha, kappa: float, x_gamma: float, F: float, mu: flo
     Parameters
     ----------
     alpha, w0 : arrays (or numbers) of the same shape: ``A v0 / d_H`` and ``v_c0 / v_z0``
-    kappa, x_gamma, F : as in :func:`viscoelastic_hertz_mindlin`; mu : Coulomb
-        coefficient (``inf``: stick)
+    kappa, x_gamma : as in :func:`viscoelastic_hertz_mindlin`; numbers, or arrays that
+        broadcast with ``alpha`` (one candidate per point: a fit runs many at once)
+    F : as in :func:`viscoelastic_hertz_mindlin`; mu : Coulomb coefficient (``inf``: stick)
     steps : steps per elastic Hertz contact time (``2.943 T``)
 
     Returns
     -------
-    (e, beta) : arrays; ``beta = -w_end / w0``
+    (e, beta) : arrays of the broadcast shape; ``beta = -w_end / w0``
     """
-    return _stepped(np.asarray(alpha, dtype=float), np.asarray(w0, dtype=float), mu, steps,
-                    _mindlin_force(float(kappa), float(x_gamma)), float(F))
+    alpha, w0, kappa, x_gamma = np.broadcast_arrays(
+        *(np.asarray(a, dtype=float) for a in (alpha, w0, kappa, x_gamma)))
+    return _stepped(alpha, w0, mu, steps, _mindlin_force(kappa.ravel(), x_gamma.ravel()),
+                    float(F))
 
 
-def _mindlin_force(kappa: float, x_gamma: float):
+def _mindlin_force(kappa: np.ndarray, x_gamma: np.ndarray):
     def force(x, v, s, w, alpha, cap):
         r = np.sqrt(np.maximum(x, 0.0))
         f = np.maximum(x * r + 1.5 * alpha * r * v, 0.0)
@@ -261,7 +264,7 @@ def _mindlin_force(kappa: float, x_gamma: float):
     return force
 
 
-def mercury_mindlin_coulomb(alpha, K: float, D, F: float, mu: float, w0,
+def mercury_mindlin_coulomb(alpha, K, D, F: float, mu: float, w0,
                             steps: int = FRICTION_STEPS) -> tuple[np.ndarray, np.ndarray]:
     """Normal and tangential restitution of MercuryDPM's
     ``HertzianBSHPViscoelasticMindlinSpecies`` in an oblique impact with Coulomb friction,
@@ -277,15 +280,16 @@ def mercury_mindlin_coulomb(alpha, K: float, D, F: float, mu: float, w0,
 
     Parameters
     ----------
-    alpha, D, w0 : arrays (or numbers) of one shape; K, F, mu : numbers
+    alpha, D, w0 : arrays (or numbers) that broadcast; K : number or array like them (one
+        candidate per point: a fit runs many at once); F, mu : numbers
 
     Returns
     -------
-    (e, beta) : arrays; ``beta = -w_end / w0``
+    (e, beta) : arrays of the broadcast shape; ``beta = -w_end / w0``
     """
-    alpha, D, w0 = np.broadcast_arrays(np.asarray(alpha, dtype=float), np.asarray(D, dtype=float),
-                                       np.asarray(w0, dtype=float))
+    alpha, D, w0, Kb = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in (alpha, D, w0, K)))
     Dflat = D.ravel()
+    K = Kb.ravel()
 
     def force(x, v, s, w, a, cap):
         r = np.sqrt(np.maximum(x, 0.0))
@@ -398,6 +402,68 @@ def yade_coulomb(zeta: float, w_t: float, zeta_t: float, F: float, mu: float, w0
         v = v_half - 0.5 * h * an
         ux = ux_half - 0.5 * h * ft
         om = om_half + 0.5 * h * arm * spin * ft
+        ended = live & (x <= 0.0)
+        e[ended] = -v[ended]
+        wend[ended] = (ux - om)[ended]
+        live &= ~ended
+        if not live.any():
+            break
+    if live.any():
+        raise RuntimeError("stepped contact law did not end its contact")
+    return e.reshape(shape), (-wend / w0).reshape(shape)
+
+
+def mfix_coulomb(zeta: float, w_t: float, zeta_t, F: float, mu: float, w0,
+                 steps: int = FRICTION_STEPS) -> tuple[np.ndarray, np.ndarray]:
+    """Normal and tangential restitution of MFiX's linear spring-dashpot (``LSD``) in an
+    oblique impact with Coulomb friction, stepped as MFiX steps it.
+
+    In the units of :func:`linear_spring_dashpot` (time ``1/omega0``, lengths
+    ``v0/omega0``): normal force ``u + 2 zeta u'`` (not clipped; the contact ends at
+    zero overlap); tangential (``calc_force_dem.f``, ``cfslide.f``): the history ``s``
+    grows by ``w dt``, the trial force is ``(w_t^2 s + 2 zeta_t w_t w) / F`` and, when it
+    exceeds ``mu`` times the magnitude of the normal force, the force is ``mu |f|``
+    against the sliding velocity and the history is set to its elastic part. Forces
+    from the current state, then velocities, then positions (MFiX's explicit Euler
+    with the new velocity). ``(w_t, zeta_t)`` as in :func:`yade_coulomb`; ``zeta_t``
+    may be an array broadcasting with ``w0`` (candidates of a fit).
+
+    Returns
+    -------
+    (e, beta) : arrays of the broadcast shape; ``beta = -w_end / w0``
+    """
+    w0, zt = np.broadcast_arrays(np.asarray(w0, dtype=float), np.asarray(zeta_t, dtype=float))
+    shape = w0.shape
+    w0, zt = w0.ravel(), zt.ravel()
+    h = math.pi / steps
+    cap = min(float(mu), 1e300)
+    spin = F - 1.0
+    k, c = w_t * w_t / F, 2.0 * zt * w_t / F
+    x = np.zeros_like(w0)
+    v = np.ones_like(w0)
+    s = np.zeros_like(w0)
+    ux = w0.copy()
+    om = np.zeros_like(w0)
+    live = np.ones(w0.shape, dtype=bool)
+    e = np.full_like(w0, np.nan)
+    wend = np.full_like(w0, np.nan)
+    first = True
+    for _ in range(50 * steps):
+        w = ux - om
+        f = x + 2.0 * zeta * v
+        s = s + h * w
+        ft = k * s + c * w
+        over = np.abs(ft) > cap * np.abs(f)
+        if np.any(over):
+            lim = cap * np.abs(f) * np.sign(w)
+            ft = np.where(over, lim, ft)
+            s = np.where(over, (ft - c * w) / k, s) if k > 0.0 else s
+        if first:  # the first step starts at contact: no force yet
+            f, ft, first = np.zeros_like(f), np.zeros_like(ft), False
+        v = v - h * f
+        ux = ux - h * ft
+        om = om + h * spin * ft
+        x = x + h * v
         ended = live & (x <= 0.0)
         e[ended] = -v[ended]
         wend[ended] = (ux - om)[ended]

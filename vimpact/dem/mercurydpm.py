@@ -33,25 +33,31 @@ import math
 import numpy as np
 
 from vimpact.dem import laws, linear
-from vimpact.dem.fit import ContactFit, Residual, Targets, fit_viscoelastic_hertz
+from vimpact.dem.fit import ContactFit, Residual, Targets, fit_viscoelastic_hertz, grid_search
 from vimpact.dem.problem import Contact, DemProblem
 
 CODE = "mercurydpm"
 TANGENTIAL = True
 #: nominal speeds of the full-stick tangential fit (contacts without friction)
 TANGENTIAL_FIT_POINTS = 4
+#: steps per contact of the stepped law inside the tangential search (the reported
+#: prediction uses :data:`vimpact.dem.laws.FRICTION_STEPS`)
+FIT_STEPS = 1000
+#: start and half-widths of the tangential grid search, ``(ln(G / G_relaxed), ln c_t)``
+SEARCH_START, SEARCH_HALF_WIDTH = (0.0, math.log(0.3)), (1.0, 1.5)
 #: friction written for a contact without one (stick)
 STICK_MU = 1.0e6
 SPECIES = "HertzianBSHPViscoelasticMindlinSpecies"
 HEADER = "Species/HertzianBSHPViscoelasticMindlinSpecies.h"
 
 
-def mercury_beta(c: Contact, A: float, G: float, c_t: float, mu: float, v, R, m, w0,
+def mercury_beta(c: Contact, A: float, G, c_t, mu: float, v, R, m, w0,
                  steps: int | None = None) -> np.ndarray:
     """MercuryDPM's ``beta`` (:func:`vimpact.dem.laws.mercury_mindlin_coulomb`) for the
     contact ``c`` with dissipation time ``A`` (s), effective shear modulus ``G`` (Pa),
     sliding dissipation ``c_t`` and friction ``mu``, at normal speeds ``v`` (m/s),
-    effective radius ``R`` (m) and mass ``m`` (kg), and ``w0 = v_c0 / v_z0`` (arrays)."""
+    effective radius ``R`` (m) and mass ``m`` (kg), and ``w0 = v_c0 / v_z0`` (arrays;
+    ``G`` and ``c_t`` numbers, or arrays of candidates that broadcast with them)."""
     E = c.E_star
     d = laws.hertz_overlap(E, R, m, v)
     D = c_t * np.sqrt(8.0 * G * m) * (R * d)**0.25 * v / (4.0 / 3.0 * E * np.sqrt(R) * d**1.5)
@@ -64,8 +70,6 @@ def _fit_tangential(c: Contact, t: Targets, A: float, G0: float):
     modulus and sliding dissipation closest to vimpact's ``beta_x`` in RMS, over the oblique
     impacts with the contact's friction (``t.oblique``), else in full stick at a few
     nominal speeds."""
-    from scipy.optimize import minimize
-
     ob = t.oblique
     if ob is not None:
         v, R, m, w0, target, mu = ob.v, ob.R, ob.m, ob.w0, ob.beta_x, ob.mu
@@ -76,18 +80,15 @@ def _fit_tangential(c: Contact, t: Targets, A: float, G0: float):
         v, R, m, target, mu = t.v[pick], t.R[pick], t.m[pick], t.beta_x[pick], math.inf
         w0 = np.ones_like(v)
 
-    def beta(z, steps=None):
-        G = G0 * math.exp(float(np.clip(z[0], -5.0, 5.0)))
-        return mercury_beta(c, A, G, abs(float(z[1])), mu, v, R, m, w0, steps)
+    def costs(z: np.ndarray) -> np.ndarray:  # every candidate in one stepped run
+        b = mercury_beta(c, A, G0 * np.exp(z[:, :1]), np.exp(z[:, 1:]), mu, v, R, m, w0,
+                         FIT_STEPS)
+        return np.mean((b - target) ** 2, axis=1)
 
-    def cost(z) -> float:
-        r = beta(z, 1000) - target
-        return float(np.mean(r * r))
-
-    best = minimize(cost, [0.0, 0.3], method="Nelder-Mead",
-                    options={"xatol": 2e-3, "fatol": 1e-9, "maxiter": 80})
-    G = G0 * math.exp(float(np.clip(best.x[0], -5.0, 5.0)))
-    return G, abs(float(best.x[1])), beta(best.x), target, ob is not None
+    z = grid_search(costs, SEARCH_START, SEARCH_HALF_WIDTH, (-5.0, math.log(1e-6)),
+                    (5.0, math.log(1e6)))
+    G, c_t = G0 * math.exp(float(z[0])), math.exp(float(z[1]))
+    return G, c_t, mercury_beta(c, A, G, c_t, mu, v, R, m, w0), target, ob is not None
 
 
 def fit(problem: DemProblem, targets: dict[str, Targets]) -> list[ContactFit]:

@@ -15,9 +15,11 @@ damping, one value for all particle pairs, in [0, 1]: MFiX refuses others)
 and ``DES_ETAT_W_FAC`` (walls), with ``KT_FAC = KT_W_FAC = 2/7`` (tangential
 over normal stiffness); ``DES_ET_INPUT`` belongs to the
 Hertzian model and is not used here. Each contact's ``DES_ETAT_FAC`` is
-fitted to vimpact's full-stick ``beta_x(v)``; the exported single value is
-their mean, and the report's ``beta_x`` residual is that of the exported
-value. Friction is likewise one ``MEW`` and one ``MEW_W``: per-pair
+fitted to vimpact's oblique impacts with the contact's friction over the set-up's
+impact angles (MFiX's law with its Coulomb cap stepped as MFiX steps it,
+:func:`vimpact.dem.laws.mfix_coulomb`), or without friction to the full-stick
+``beta_x(v)``; the exported single value is their mean, and the report's ``beta_x``
+residual is that of the exported value. Friction is likewise one ``MEW`` and one ``MEW_W``: per-pair
 friction is not represented. Not run here (no Debian or PyPI build of MFiX):
 the keywords and their ranges were read from MFiX's documentation, not run.
 """
@@ -47,8 +49,45 @@ def _beta(en: float, etat_fac: float, F: float) -> float:
     return linear.tangential_beta(en, w_t, zeta_t)
 
 
+#: steps per contact of the stepped law inside the fit (the reported prediction uses
+#: :data:`vimpact.dem.laws.FRICTION_STEPS`)
+FIT_STEPS = 1000
+
+
+def _oblique_beta(en: float, etat_fac, F: float, mu: float, w0,
+                  steps: int = laws.FRICTION_STEPS) -> np.ndarray:
+    """MFiX's ``beta`` in oblique impacts with friction ``mu`` at ``w0 = v_c0 / v_z0``
+    (:func:`vimpact.dem.laws.mfix_coulomb`; the law scales with the speed, so ``beta``
+    depends on the angle only); ``etat_fac`` a number or an array of candidates that
+    broadcasts with ``w0``."""
+    zeta = laws.zeta_of_restitution(en)
+    return laws.mfix_coulomb(zeta, math.sqrt(KT_FAC * F),
+                             etat_fac * zeta * math.sqrt(F / KT_FAC), F, mu, w0, steps)[1]
+
+
+def _fit_oblique(en: float, F: float, mu: float, w0: np.ndarray, target: np.ndarray,
+                 xatol: float = 5e-4) -> float:
+    """``DES_ETAT_FAC`` in :data:`ETAT_FAC_RANGE` closest (RMS) to ``target`` at ``w0``:
+    grids of 21 values, each stepped in one run, shrunk around the best to one spacing
+    until the spacing is below ``xatol``."""
+    lo, hi = ETAT_FAC_RANGE
+    best = 0.5 * (lo + hi)
+    while True:
+        x = np.linspace(lo, hi, 21)
+        b = _oblique_beta(en, x[:, None], F, mu, w0[None, :], FIT_STEPS)
+        best = float(x[int(np.argmin(np.mean((b - target) ** 2, axis=1)))])
+        step = x[1] - x[0]
+        if step < xatol:
+            return best
+        lo, hi = (max(best - step, ETAT_FAC_RANGE[0]), min(best + step, ETAT_FAC_RANGE[1]))
+
+
 def fit(problem: DemProblem, targets: dict[str, Targets]) -> list[ContactFit]:
     fits = []
+    # MFiX takes one friction for particle pairs and one for walls: the first contact's
+    written_mu = {}
+    for c in problem.contacts:
+        written_mu.setdefault(c.is_wall, c.mu)
     for c in problem.contacts:
         t = targets[c.key]
         en, _ = fit_constant(t.e_z, 1e-6, 1.0)
@@ -62,7 +101,11 @@ def fit(problem: DemProblem, targets: dict[str, Targets]) -> list[ContactFit]:
         fits.append(ContactFit(c, {"en": en, "etat_fac": math.nan, "kn": kn, "F": F, "mu": c.mu},
                                e, None, Residual.of(e, t.e_z), None,
                                ["speed-independent en: the residual is vimpact's speed dependence"]))
-        if t.beta_x is not None:
+        if t.oblique is not None:
+            ob = t.oblique
+            mu = written_mu[c.is_wall]  # MFiX's one MEW (MEW_W), as written
+            fits[-1].params["etat_fac"] = _fit_oblique(en, F, mu, ob.w0, ob.beta_x)
+        elif t.beta_x is not None:
             etat, _ = fit_scalar(lambda x: np.full_like(t.beta_x, _beta(en, x, F)),
                                  t.beta_x, *ETAT_FAC_RANGE)
             fits[-1].params["etat_fac"] = etat
@@ -77,11 +120,23 @@ def fit(problem: DemProblem, targets: dict[str, Targets]) -> list[ContactFit]:
             t = targets[f.contact.key]
             f.params["etat_fac_fitted"] = f.params["etat_fac"]
             f.params["etat_fac"] = mean
-            f.beta_x = np.full_like(t.beta_x, _beta(f.params["en"], mean, f.params["F"]))
-            f.res_beta_x = Residual.of(f.beta_x, t.beta_x)
+            if t.beta_x is not None:
+                f.beta_x = np.full_like(t.beta_x, _beta(f.params["en"], mean, f.params["F"]))
+                f.res_beta_x = Residual.of(f.beta_x, t.beta_x)
+            basis = "in full stick"
+            if t.oblique is not None:
+                ob = t.oblique
+                f.beta_oblique = _oblique_beta(f.params["en"], mean, f.params["F"],
+                                               written_mu[wall], ob.w0)
+                f.res_beta_x = Residual.of(f.beta_oblique, ob.beta_x)
+                basis = (f"to vimpact's oblique impacts with the contact's friction mu = "
+                         f"{ob.mu:g} over the impact angles, MFiX running with the written "
+                         f"{'MEW_W' if wall else 'MEW'} = {written_mu[wall]:g} (residual over "
+                         "those oblique impacts; MFiX's LSD law with its Coulomb cap as read "
+                         "from its sources, not run)")
             f.notes.append(f"{'DES_ETAT_W_FAC' if wall else 'DES_ETAT_FAC'} is one value: "
                            f"exported mean {mean:.4g}, this contact alone would take "
-                           f"{f.params['etat_fac_fitted']:.4g}")
+                           f"{f.params['etat_fac_fitted']:.4g}, fitted {basis}")
     return fits
 
 

@@ -33,6 +33,10 @@ Read from a TOML file (example: ``sweeps/dem/two_rubbers.toml``)::
     default = 0.5
     "soft-floor" = 0.6
 
+    [adhesion]               # optional: work of adhesion dgamma, J/m^2, by "type-type" or
+    "soft-floor" = 0.05      # "type-wall" (or default); default 0 (no adhesion). Only
+                             # LAMMPS' granular jkr model takes it (--for lammps)
+
 Every pair of types (``i <= j``) and every type with every wall is a contact.
 """
 
@@ -58,7 +62,7 @@ from vimpact.model.scene import DEFAULT_THETA_RATIO
 from vimpact.model.validation import InputError, message
 
 #: top-level keys of a DEM set-up
-_TOP_KEYS = ("speeds", "types", "walls", "friction", "temperature_K")
+_TOP_KEYS = ("speeds", "types", "walls", "friction", "adhesion", "temperature_K")
 #: speed points when ``[speeds] n`` is not given
 DEFAULT_SPEED_POINTS = 24
 
@@ -110,11 +114,13 @@ class WallType:
 
 @dataclass(frozen=True)
 class Contact:
-    """A particle-particle or particle-wall contact and its friction coefficient."""
+    """A particle-particle or particle-wall contact, its friction coefficient and its work
+    of adhesion ``adhesion`` (``dgamma``, J/m^2; 0: none)."""
 
     first: ParticleType
     second: ParticleType | WallType
     mu: float
+    adhesion: float = 0.0
 
     @property
     def key(self) -> str:
@@ -305,32 +311,40 @@ def problem_from_toml(text: str, source: str = "<string>", *, base: Path | None 
         walls.append(WallType(name, k, None if m == "rigid" else
                               material(m, f"{where}.material")))
 
-    fr = data.get("friction", {})
-    if not isinstance(fr, dict):
-        raise _err(source, "[friction]", fr, "a table of coefficients")
     names = [base_of[t.name] for t in types] + [w.name for w in walls]
-    for key in fr:
-        if key != "default" and (key.count("-") < 1 or not any(
-                key == f"{a}-{b}" for a in names for b in names)):
-            raise _err(source, "friction key", key, '"default" or "NAME-NAME" of types/walls')
-    for key, val in fr.items():
-        mu = _num(source, f"friction.{key}", val)
-        if not (mu >= 0.0):
-            raise _err(source, f"friction.{key}", mu, "a number >= 0")
 
-    def mu_of(a: str, b: str) -> float:
-        a, b = base_of.get(a, a), base_of.get(b, b)
-        for key in (f"{a}-{b}", f"{b}-{a}", "default"):
-            if key in fr:
-                return float(fr[key])
-        return math.inf
+    def per_contact(table: str, what: str, absent: float, finite: bool):
+        """The coefficient of a ``[table]`` by contact (``NAME-NAME`` or ``default``)."""
+        fr = data.get(table, {})
+        if not isinstance(fr, dict):
+            raise _err(source, f"[{table}]", fr, f"a table of {what}")
+        for key in fr:
+            if key != "default" and (key.count("-") < 1 or not any(
+                    key == f"{a}-{b}" for a in names for b in names)):
+                raise _err(source, f"{table} key", key, '"default" or "NAME-NAME" of types/walls')
+        for key, val in fr.items():
+            x = _num(source, f"{table}.{key}", val)
+            if not (x >= 0.0 and (math.isfinite(x) or not finite)):
+                raise _err(source, f"{table}.{key}", x,
+                           "a finite number >= 0" if finite else "a number >= 0")
+
+        def of(a: str, b: str) -> float:
+            a, b = base_of.get(a, a), base_of.get(b, b)
+            for key in (f"{a}-{b}", f"{b}-{a}", "default"):
+                if key in fr:
+                    return float(fr[key])
+            return absent
+        return of
+
+    mu_of = per_contact("friction", "coefficients", math.inf, finite=False)
+    adhesion_of = per_contact("adhesion", "works of adhesion (J/m^2)", 0.0, finite=True)
 
     contacts = []
     for i, a in enumerate(types):
         for b in types[i:]:
-            contacts.append(Contact(a, b, mu_of(a.name, b.name)))
+            contacts.append(Contact(a, b, mu_of(a.name, b.name), adhesion_of(a.name, b.name)))
         for w in walls:
-            contacts.append(Contact(a, w, mu_of(a.name, w.name)))
+            contacts.append(Contact(a, w, mu_of(a.name, w.name), adhesion_of(a.name, w.name)))
     for c in contacts:  # refuse unmappable material pairs now, naming the contact
         try:
             _ = c.material  # the property maps the pair (or raises)
