@@ -50,6 +50,7 @@ from vimpact.kernels.status import TABLE as STATUS_TABLE
 from vimpact.lookup.interpolate import LOG_AXES, cluster_nodes, same_node
 from vimpact.model.scene import DEFAULT_THETA_RATIO, HALF_SPACE_LIMIT, Scene
 from vimpact.model.validation import InputError, positive, require
+from vimpact.tableformat.metadata import COMMON_METADATA, META_PREFIX, decode_value
 
 __all__ = ["AXES", "DATA_STATUSES", "LOG_AXES", "LOOKUP_METHODS", "LOOKUP_MODELS",
            "MAX_CURVE_POINTS", "OUTPUTS", "SPEC_HINTS", "RestitutionTable", "format_info",
@@ -87,7 +88,6 @@ MAX_CURVE_POINTS = 100_000
 BOUND_SLACK = 1e-6
 
 _REQUIRED = ("Q1", "nu", "e_z", "e_x", "beta_x", "status")
-_META_PREFIX = "vimpact."  # the sweep's vimpact.sweep.store.META_PREFIX
 
 
 def _axis_is_log(name: str) -> bool:
@@ -233,7 +233,7 @@ def incidence(angle_deg, mu, nu):
     if not np.all((nu >= 0.0) & (nu <= 0.5)):
         raise InputError(f"nu = {float(nu[~((nu >= 0) & (nu <= 0.5))].flat[0])!r} is not "
                          "allowed: must be in [0, 0.5]")
-    from vimpact.sweep.parameters import incidence as psi_of  # the one psi rule
+    from vimpact.tableformat.parameters import incidence as psi_of  # the one psi rule
 
     ratio = np.tan(np.radians(angle))
     psi = psi_of(mu, nu, ratio, np.ones_like(ratio))
@@ -269,7 +269,7 @@ def validate_table(data: pd.DataFrame, metadata: dict, path=None) -> None:
     path : the file, for the messages
     """
     where = f"table = {str(path)!r}" if path is not None else "the table"
-    if _META_PREFIX + "model" not in metadata:
+    if META_PREFIX + "model" not in metadata:
         raise InputError(f"{where} is not allowed: it has no vimpact metadata (no key "
                          "vimpact.model): not a restitution table written by `vimpact sweep`")
     status = data["status"].astype(str).to_numpy()
@@ -371,8 +371,8 @@ class RestitutionTable:
                 value = value.decode()
             elif not isinstance(value, str):
                 value = json.dumps(value)
-            if not key.startswith(_META_PREFIX):
-                key = _META_PREFIX + key
+            if not key.startswith(META_PREFIX):
+                key = META_PREFIX + key
             self.metadata[key] = value
         if self.model == "standard_solid" and "Q2" not in self.data.columns:
             raise InputError(f"the standard_solid table{self._where(path)} lacks the column Q2")
@@ -393,7 +393,7 @@ class RestitutionTable:
         ``_common_metadata``, which holds the metadata).
 
         The table is checked before use: the file's integrity (page checksums and the
-        content hash, :func:`vimpact.sweep.store.verify_table`, where available), then
+        content hash, :func:`vimpact.tableformat.integrity.verify_table`, where available), then
         its rows (:func:`validate_table`: vimpact metadata, known statuses, finite
         outputs within their physical bounds in data rows, axes in their domains, no
         duplicated node). ``validate=False`` skips both (to inspect a damaged file).
@@ -405,8 +405,7 @@ class RestitutionTable:
         """
         import pyarrow.parquet as pq
 
-        from vimpact.sweep import store
-        from vimpact.sweep.store import COMMON_METADATA
+        from vimpact.tableformat.integrity import verify_table
 
         p = Path(path)
         if p.is_dir():
@@ -418,9 +417,8 @@ class RestitutionTable:
         elif not p.is_file():
             raise InputError(f"table = {str(path)!r} is not allowed: no such file "
                              "(a Parquet restitution table written by `vimpact sweep`)")
-        integrity = getattr(store, "verify_table", None)
-        if validate and integrity is not None:
-            integrity(p)
+        if validate:
+            verify_table(p)
         try:
             arrow = pq.read_table(p)
             raw = (pq.read_schema(p / COMMON_METADATA) if p.is_dir() else arrow.schema).metadata
@@ -429,10 +427,10 @@ class RestitutionTable:
             raise InputError(f"table = {str(path)!r} is not allowed: not a readable Parquet "
                              f"file ({type(exc).__name__}: {why})") from None
         meta = {k.decode(): v.decode() for k, v in (raw or {}).items()
-                if k.decode().startswith(_META_PREFIX)}
+                if k.decode().startswith(META_PREFIX)}
         if p.is_dir():  # the parts' schemas carry per-chunk bookkeeping
             arrow = arrow.replace_schema_metadata(None)
-        if validate and _META_PREFIX + "model" not in meta:
+        if validate and META_PREFIX + "model" not in meta:
             validate_table(arrow.slice(0, 0).to_pandas(), meta, p)  # foreign: before the columns
         table = cls(arrow.to_pandas(), meta, path=p)
         if validate:
@@ -454,11 +452,11 @@ class RestitutionTable:
         """Write the table as Parquet with its ``vimpact.*`` metadata (what :meth:`open` reads)."""
         import pyarrow as pa
 
-        from vimpact.sweep.store import write_atomic
+        from vimpact.tableformat.files import write_atomic
 
         arrow = pa.Table.from_pandas(self.data, preserve_index=False)
         meta = dict(arrow.schema.metadata or {})
-        meta[(_META_PREFIX + "model").encode()] = self.model.encode()  # what open() requires
+        meta[(META_PREFIX + "model").encode()] = self.model.encode()  # what open() requires
         meta.update({k.encode(): v.encode() for k, v in self.metadata.items()})
         # atomically, with page checksums and fresh content/metadata hashes (the stored
         # ones describe the file this table was read from, not these columns)
@@ -468,11 +466,9 @@ class RestitutionTable:
     # ---- metadata --------------------------------------------------------
     def meta(self, key: str, default=None):
         """Metadata value ``vimpact.<key>``, decoded by the sweep's metadata codec
-        (:func:`vimpact.sweep.store.decode_value`: JSON keys such as ``units``,
+        (:func:`vimpact.tableformat.metadata.decode_value`: JSON keys such as ``units``,
         ``numerics``, ``paths`` parsed, integer keys such as ``rows`` as ints)."""
-        from vimpact.sweep.store import decode_value
-
-        value = self.metadata.get(_META_PREFIX + key)
+        value = self.metadata.get(META_PREFIX + key)
         if value is None:
             return default
         return decode_value(key, value)
@@ -480,7 +476,7 @@ class RestitutionTable:
     @property
     def model(self) -> str:
         """Rheology of the table (``vimpact.model``; inferred from ``Q2`` if missing)."""
-        model = self.metadata.get(_META_PREFIX + "model")
+        model = self.metadata.get(META_PREFIX + "model")
         if model:
             return model
         if "Q2" in self.data.columns and (self.data["Q2"].to_numpy(float) > 0).any():
@@ -585,7 +581,7 @@ class RestitutionTable:
             if not self.is_adaptive:
                 raise InputError(f"the table{self._where(self.path)} is not adaptive "
                                  "(vimpact.mode is not 'adaptive')")
-            raw = self.metadata.get(_META_PREFIX + "adaptive")
+            raw = self.metadata.get(META_PREFIX + "adaptive")
             try:
                 meta = json.loads(raw) if raw is not None else None
             except ValueError:
@@ -728,7 +724,7 @@ class RestitutionTable:
         """The measured interpolation error (metadata ``vimpact.interpolation_error``,
         written by :func:`vimpact.lookup.verify.interpolation_error` /
         ``vimpact table verify --write``), or None if not measured."""
-        raw = self.metadata.get(_META_PREFIX + "interpolation_error")
+        raw = self.metadata.get(META_PREFIX + "interpolation_error")
         if raw is None:
             return None
         try:
@@ -1052,7 +1048,7 @@ class RestitutionTable:
         p = Path(path)
         require("out", str(path), p.suffix.lower() == ".csv", "a file name ending in .csv")
         require("out", str(path), p.parent.is_dir(), "in an existing directory")
-        from vimpact.sweep.store import atomic_file, refuse_symlink
+        from vimpact.tableformat.files import atomic_file, refuse_symlink
         refuse_symlink(p, "out")  # before the work
         df = self.restitution_curve(material, R, m, v_z0, **options)
         with atomic_file(p, "out", mode="w") as f:  # never through a symbolic link

@@ -87,7 +87,7 @@ def simulate_dimensionless(model: str, Q1, nu, Q2=None, *, numerics=None,
     theta_ratio : Theta / (m R^2)
     tangential, tangential_memory, rotation : as for :class:`vimpact.Scene`
     psi : friction incidence per point (dimensionless, >= 0; None: full stick); the
-        scene is a psi grid sweep's (:func:`vimpact.sweep.parameters.psi_reference`:
+        scene is a psi grid sweep's (:func:`vimpact.tableformat.parameters.psi_reference`:
         friction coefficient ``mu``, ``v_x0`` from psi; psi = 0 is full stick)
     mu : friction coefficient of the points with ``psi > 0``, dimensionless
 
@@ -112,7 +112,7 @@ def simulate_dimensionless(model: str, Q1, nu, Q2=None, *, numerics=None,
             "tangential": np.full(n, tangential), "tangential_memory": np.full(n, tangential_memory),
             "rotation": np.full(n, bool(rotation))}
     if psi is not None:
-        from vimpact.sweep.parameters import psi_reference
+        from vimpact.tableformat.parameters import psi_reference
         cols["v_x0_m_s"], cols["mu"] = psi_reference(np.broadcast_to(psi, (n,)), nu, mu)
     if model == "kelvin_voigt":
         cols["eta0_Pa_s"] = eta
@@ -393,7 +393,8 @@ def write_interpolation_error(table, result: dict, path=None):
 
     import pyarrow.parquet as pq
 
-    from vimpact.sweep import store
+    from vimpact.tableformat.files import write_atomic
+    from vimpact.tableformat.metadata import COMMON_METADATA
 
     text = json.dumps(result)
     key = "vimpact.interpolation_error"
@@ -403,11 +404,11 @@ def write_interpolation_error(table, result: dict, path=None):
         raise InputError("path = None is not allowed for a table held in memory: give the "
                          "file to write")
     if target.is_dir():
-        schema = pq.read_schema(target / store.COMMON_METADATA)
+        schema = pq.read_schema(target / COMMON_METADATA)
         meta = dict(schema.metadata or {})
         meta[key.encode()] = text.encode()
-        store.write_atomic(schema.empty_table().replace_schema_metadata(meta),
-                           target / store.COMMON_METADATA, schema_only=True)
+        write_atomic(schema.empty_table().replace_schema_metadata(meta),
+                           target / COMMON_METADATA, schema_only=True)
         return target
     source = table.path
     if source is not None and source.is_file():
@@ -415,7 +416,7 @@ def write_interpolation_error(table, result: dict, path=None):
         meta = dict(arrow.schema.metadata or {})
         meta[key.encode()] = text.encode()
         target.parent.mkdir(parents=True, exist_ok=True)
-        store.write_atomic(arrow.replace_schema_metadata(meta), target)
+        write_atomic(arrow.replace_schema_metadata(meta), target)
         return target
     table.metadata.pop("vimpact.content_sha256", None)  # not a hash of this data
     return table.save(target)
