@@ -27,7 +27,7 @@ default it interpolates with tensor-product cubic Hermite polynomials in
 ``log Q1`` (and ``log Q2``) and ``nu``, shape-preserving where the data is
 monotone (:mod:`vimpact.lookup.interpolate`); ``method="linear"`` gives the
 multilinear interpolant. The error between the nodes, measured against direct
-simulation (:func:`vimpact.lookup.verify.interpolation_error`), is stored as
+simulation (:func:`vimpact.tablebuild.verify.interpolation_error`), is stored as
 the metadata entry ``vimpact.interpolation_error`` and returned with every
 lookup (``error_bound``). Since ``e_z``, ``e_x`` depend only on these parameters
 (docs/physics.md#dimensionless-parameters), :meth:`RestitutionTable.restitution_curve` turns a
@@ -722,7 +722,7 @@ class RestitutionTable:
     @property
     def interpolation_error(self) -> dict | None:
         """The measured interpolation error (metadata ``vimpact.interpolation_error``,
-        written by :func:`vimpact.lookup.verify.interpolation_error` /
+        written by :func:`vimpact.tablebuild.verify.interpolation_error` /
         ``vimpact table verify --write``), or None if not measured."""
         raw = self.metadata.get(META_PREFIX + "interpolation_error")
         if raw is None:
@@ -737,7 +737,7 @@ class RestitutionTable:
         """Output -> the error bound measured between the nodes for ``method``
         (``{"e_z": ..., "beta_x": ..., "e_x": ...}``: the stored ``bound``, 1.5 times
         the largest error found at the held-out points, see
-        :data:`vimpact.lookup.verify.BOUND_FACTOR`), or None if not measured."""
+        :data:`vimpact.tablebuild.verify.BOUND_FACTOR`), or None if not measured."""
         err = self.interpolation_error
         if not err or err.get("method", "cubic") != method:
             return None

@@ -357,7 +357,7 @@ class SweepSpec:
     material_text : the text of the material file ``[random] material`` names ("" without
         one); part of :attr:`sweep_hash`
     grid_refine : grid mode: ``[grid] refine``, ``"tensor"`` (default: planes of nodes
-        inserted across the grid, :func:`vimpact.lookup.refine.refine_grid`) or
+        inserted across the grid, :func:`vimpact.tablebuild.refine.refine_grid`) or
         ``"adaptive"`` (cells of ``log Q1`` (x ``log Q2``) split where they fail the
         tolerance, :mod:`vimpact.lookup.adaptive`; built by ``vimpact table build``)
     grid_levels : grid mode, adaptive: ``([grid] min_level, [grid] max_level)``, the

@@ -6,7 +6,7 @@ table's own numerics, and compares them with :meth:`RestitutionTable.lookup`:
 
 - ``axis`` points: the mid-point of every cell edge along one axis, at the
   nodes of the other axes (the error of the interpolation along that axis
-  alone; :func:`vimpact.lookup.refine.refine_grid` uses them to decide where
+  alone; :func:`vimpact.tablebuild.refine.refine_grid` uses them to decide where
   to insert nodes);
 - ``centre`` points: the centre of every cell (mid-way along every axis);
 - ``random`` points: uniform in ``log Q1``, ``log Q2`` and ``nu`` inside the
@@ -50,7 +50,7 @@ _OUTPUTS = ("e_z", "beta_x", "e_x")
 
 
 def numerics_of(table):
-    """The table's numerics (metadata ``vimpact.numerics``) as a :class:`vimpact.Numerics`.
+    """Return the table's numerics (metadata ``vimpact.numerics``) as a :class:`vimpact.Numerics`.
 
     Raises
     ------
@@ -218,8 +218,10 @@ def _scene_options(table) -> dict:
 
 
 def _friction(table, psi) -> dict:
-    """Keyword arguments of :func:`simulate_dimensionless` for a psi table: the
-    points' psi and the one friction coefficient its rows with psi > 0 were made with."""
+    """Return the keyword arguments of :func:`simulate_dimensionless` for a psi table.
+
+    They are the points' psi and the one friction coefficient its rows with psi > 0 were made with.
+    """
     if psi is None:
         return {}
     mu = table.data["mu"].to_numpy(float) if "mu" in table.data.columns else np.array([1.0])
@@ -380,15 +382,18 @@ def interpolation_error(table, numerics=None, n: int = 200, seed: int = 0, theta
 
 
 def write_interpolation_error(table, result: dict, path=None):
-    """Store ``result`` as the metadata entry ``vimpact.interpolation_error`` of ``table``
-    and write it to ``path`` (default: where the table was read).
+    """Store ``result`` as the metadata entry ``vimpact.interpolation_error`` and write.
+
+    The entry goes into ``table``, which is written to ``path`` (default: where the
+    table was read).
 
     A table read from a Parquet file is rewritten from that file's own data (read with
     ``pyarrow``, not through pandas), atomically, so its rows, columns and types stay
     exactly as the sweep wrote them and its content hash (``vimpact.content_sha256``)
     stays true; for a partitioned dataset only its ``_common_metadata`` is rewritten. A
     table held in memory is saved with :meth:`RestitutionTable.save` (without a content
-    hash of other data)."""
+    hash of other data).
+    """
     from pathlib import Path
 
     import pyarrow.parquet as pq
