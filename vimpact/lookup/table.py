@@ -118,8 +118,10 @@ class _Grid:
         return {a: len(n) for a, n in zip(self.axes, self.nodes)}
 
     def _weights(self, k: int, x: np.ndarray, extrapolate: bool):
-        """Cell index ``i0``, ``i1`` and weight ``t`` of ``x`` on axis ``k``:
-        ``value = (1 - t) f[i0] + t f[i1]``."""
+        """Return the cell index ``i0``, ``i1`` and weight ``t`` of ``x`` on axis ``k``.
+
+        ``value = (1 - t) f[i0] + t f[i1]``.
+        """
         name, nodes = self.axes[k], self.nodes[k]
         lo, hi = nodes[0], nodes[-1]
         inside = ((x >= lo) | same_node(x, lo)) & ((x <= hi) | same_node(x, hi))
@@ -388,9 +390,11 @@ class RestitutionTable:
     # ---- reading and writing -------------------------------------------
     @classmethod
     def open(cls, path, validate: bool = True) -> RestitutionTable:
-        """Read a restitution table and its ``vimpact.*`` metadata: one Parquet file, or a
-        partitioned dataset written by a large sweep (a directory of part files plus
-        ``_common_metadata``, which holds the metadata).
+        """Read a restitution table and its ``vimpact.*`` metadata.
+
+        The table is one Parquet file, or a partitioned dataset written by a large
+        sweep (a directory of part files plus ``_common_metadata``, which holds the
+        metadata).
 
         The table is checked before use: the file's integrity (page checksums and the
         content hash, :func:`vimpact.tableformat.integrity.verify_table`, where available), then
@@ -465,9 +469,13 @@ class RestitutionTable:
 
     # ---- metadata --------------------------------------------------------
     def meta(self, key: str, default=None):
-        """Metadata value ``vimpact.<key>``, decoded by the sweep's metadata codec
-        (:func:`vimpact.tableformat.metadata.decode_value`: JSON keys such as ``units``,
-        ``numerics``, ``paths`` parsed, integer keys such as ``rows`` as ints)."""
+        """Return the metadata value ``vimpact.<key>``, decoded.
+
+        Decoded by the table format's metadata codec
+        (:func:`vimpact.tableformat.metadata.decode_value`: JSON keys such as
+        ``units``, ``numerics``, ``paths`` parsed, integer keys such as ``rows`` as
+        ints).
+        """
         value = self.metadata.get(META_PREFIX + key)
         if value is None:
             return default
@@ -496,7 +504,7 @@ class RestitutionTable:
 
     @property
     def version(self) -> str | None:
-        """vimpact version that wrote the table."""
+        """Vimpact version that wrote the table."""
         return self.meta("version")
 
     # ---- rows ------------------------------------------------------------
@@ -509,8 +517,11 @@ class RestitutionTable:
         return len(self.data)
 
     def info(self) -> dict:
-        """Summary: model, rows, ok rows, status counts, covered ranges, grid,
-        numerics, version (JSON-serializable; ``str(table)`` is the readable form)."""
+        """Return a summary of the table.
+
+        Model, rows, ok rows, status counts, covered ranges, grid, numerics, version
+        (JSON-serializable; ``str(table)`` is the readable form).
+        """
         ok = self.ok
         params = ["Q1"] + (["Q2"] if self.model == "standard_solid" else []) + ["nu"]
         params += [c for c in ("theta_ratio", "psi", "mu") if c in self.data.columns]
@@ -568,13 +579,18 @@ class RestitutionTable:
     # ---- adaptive tables --------------------------------------------------
     @property
     def is_adaptive(self) -> bool:
-        """The table is adaptive (``vimpact.mode = adaptive``: cells refined locally, its
-        structure in ``vimpact.adaptive``; :mod:`vimpact.lookup.adaptive`), not a grid."""
+        """Whether the table is adaptive, not a grid.
+
+        ``vimpact.mode = adaptive``: cells refined locally, its structure in
+        ``vimpact.adaptive`` (:mod:`vimpact.lookup.adaptive`).
+        """
         return self.meta("mode") == "adaptive"
 
     def adaptive_grid(self):
-        """The :class:`vimpact.lookup.adaptive.AdaptiveGrid` of an adaptive table (built
-        once from its node rows and ``vimpact.adaptive``)."""
+        """Return the :class:`vimpact.lookup.adaptive.AdaptiveGrid` of an adaptive table.
+
+        It is built once from its node rows and ``vimpact.adaptive``.
+        """
         if self._adaptive is None:
             from vimpact.lookup.adaptive import AdaptiveGrid
 
@@ -598,7 +614,7 @@ class RestitutionTable:
             else np.array([])
 
     def _resolve_theta(self, theta_ratio) -> float | None:
-        """The theta_ratio slice to use (None: the table has one value / no column)."""
+        """Return the theta_ratio slice to use (None: the table has one value / no column)."""
         if "theta_ratio" not in self.data.columns:
             if theta_ratio is not None and not same_node(theta_ratio, DEFAULT_THETA_RATIO):
                 raise InputError(
@@ -621,7 +637,7 @@ class RestitutionTable:
         return None if len(values) == 1 else float(match[0])
 
     def _psi_values(self) -> np.ndarray:
-        """The distinct friction incidences ``psi`` of the table (empty: no psi column)."""
+        """Return the distinct friction incidences ``psi`` of the table (empty: no psi column)."""
         if "psi" not in self.data.columns:
             return np.array([])
         v = self.data["psi"].to_numpy(float)
@@ -636,8 +652,10 @@ class RestitutionTable:
         return ["Q1", "Q2", "nu"] if model == "standard_solid" else ["Q1", "nu"]
 
     def _grid(self, theta: float | None) -> _Grid:
-        """The grid at one ``theta_ratio`` (None: the table's only one): axes ``Q1``,
-        (``Q2``), ``nu`` and ``psi`` if the table has a psi column."""
+        """Return the grid at one ``theta_ratio`` (None: the table's only one).
+
+        Axes ``Q1``, (``Q2``), ``nu`` and ``psi`` if the table has a psi column.
+        """
         if theta in self._grids:
             return self._grids[theta]
         axes = self._base_axes() + (["psi"] if len(self._psi_values()) else [])
@@ -649,8 +667,11 @@ class RestitutionTable:
         return grid
 
     def _lookup_grid(self) -> _Grid:
-        """The grid over every lookup axis: ``Q1``, (``Q2``), ``nu``, ``theta_ratio`` (when
-        the table holds several values), ``psi`` (when it has a psi column)."""
+        """Return the grid over every lookup axis.
+
+        ``Q1``, (``Q2``), ``nu``, ``theta_ratio`` (when the table holds several
+        values), ``psi`` (when it has a psi column).
+        """
         key = "all axes"
         if key in self._grids:
             return self._grids[key]
@@ -709,8 +730,10 @@ class RestitutionTable:
         return _Grid(axes, list(nodes), values, failed)
 
     def _hermite_grid(self, theta: float | None, grid: _Grid | None = None):
-        """The cubic interpolant of the grid for ``theta`` (or of ``grid``, cached under
-        ``theta``; slopes computed once)."""
+        """Return the cubic interpolant of the grid for ``theta``.
+
+        Or of ``grid``, cached under ``theta``; slopes computed once.
+        """
         if theta not in self._hermite:
             from vimpact.lookup.interpolate import HermiteGrid
 
@@ -721,9 +744,12 @@ class RestitutionTable:
 
     @property
     def interpolation_error(self) -> dict | None:
-        """The measured interpolation error (metadata ``vimpact.interpolation_error``,
-        written by :func:`vimpact.tablebuild.verify.interpolation_error` /
-        ``vimpact table verify --write``), or None if not measured."""
+        """The measured interpolation error, or None if not measured.
+
+        Metadata ``vimpact.interpolation_error``, written by
+        :func:`vimpact.tablebuild.verify.interpolation_error` / ``vimpact table verify
+        --write``.
+        """
         raw = self.metadata.get(META_PREFIX + "interpolation_error")
         if raw is None:
             return None
@@ -734,10 +760,12 @@ class RestitutionTable:
         return value if isinstance(value, dict) else None
 
     def error_bound(self, method: str = "cubic") -> dict | None:
-        """Output -> the error bound measured between the nodes for ``method``
-        (``{"e_z": ..., "beta_x": ..., "e_x": ...}``: the stored ``bound``, 1.5 times
+        """Return the error bound measured between the nodes for ``method``, per output.
+
+        ``{"e_z": ..., "beta_x": ..., "e_x": ...}`` (the stored ``bound``, 1.5 times
         the largest error found at the held-out points, see
-        :data:`vimpact.tablebuild.verify.BOUND_FACTOR`), or None if not measured."""
+        :data:`vimpact.tablebuild.verify.BOUND_FACTOR`), or None if not measured.
+        """
         err = self.interpolation_error
         if not err or err.get("method", "cubic") != method:
             return None
@@ -749,8 +777,7 @@ class RestitutionTable:
 
     def lookup(self, Q1, nu, Q2=None, extrapolate: bool = False, theta_ratio=None,
                method: str = "cubic", psi=None) -> dict:
-        """Interpolate ``e_z``, ``e_x``, ``beta_x`` at ``Q1``, ``nu`` (``Q2``, ``theta_ratio``,
-        ``psi``).
+        """Interpolate ``e_z``, ``e_x``, ``beta_x`` at ``Q1``, ``nu`` (``Q2``, ``theta_ratio``, ``psi``).
 
         ``method="cubic"`` (default): tensor-product cubic Hermite in ``log Q1``,
         ``log Q2``, ``nu``, ``log theta_ratio`` and ``psi`` (the axes the table has),
@@ -903,10 +930,11 @@ class RestitutionTable:
         return result
 
     def to_xarray(self, theta_ratio=None):
-        """The grid as an :class:`xarray.Dataset`: data variables ``e_z``, ``e_x``,
-        ``beta_x`` (dimensionless) over the labelled axes ``Q1``, (``Q2``), ``nu``,
-        (``theta_ratio`` when the table holds several, ``psi`` when it has a psi
-        column); ``theta_ratio`` (one of the table's values) selects that slice.
+        """Return the grid as an :class:`xarray.Dataset`.
+
+        Data variables ``e_z``, ``e_x``, ``beta_x`` (dimensionless) over the labelled
+        axes ``Q1``, (``Q2``), ``nu``, (``theta_ratio`` when the table holds several,
+        ``psi`` when it has a psi column); ``theta_ratio`` (one of the table's values) selects that slice.
 
         Units and descriptions are attributes of each variable and axis; the
         dataset's attributes hold the model, numerics, interpolation error and

@@ -39,12 +39,12 @@ REFERENCE = {"R_m": 1.0, "m_kg": 1.0, "v_z0_m_s": 1.0, "v_x0_m_s": 1.0, "omega0_
 
 
 def chunk_generator(seed: int, chunk: int) -> np.random.Generator:
-    """The random generator of ``chunk``: ``SeedSequence(seed, spawn_key=(chunk,))``."""
+    """Return the random generator of ``chunk``: ``SeedSequence(seed, spawn_key=(chunk,))``."""
     return np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(chunk,)))
 
 
 def chunk_parameters(spec, chunk: int) -> dict[str, np.ndarray]:
-    """The parameter sets of ``chunk`` of ``spec``: one array per input.
+    """Return the parameter sets of ``chunk`` of ``spec``: one array per input.
 
     Grid mode: the axis values of rows ``chunk_rows(chunk)``. Random mode: the
     drawn physical inputs, ``G_arm<i>_Pa`` and ``tau_arm<i>_s`` for Prony arms.

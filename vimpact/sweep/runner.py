@@ -151,9 +151,12 @@ def _isnull(values: np.ndarray) -> np.ndarray:
 
 def guard_nan(cols: dict, status: np.ndarray, error: np.ndarray, vc0_zero: np.ndarray,
               finished: np.ndarray) -> None:
-    """NaN only with a status that explains it: a finished row with a NaN output that no
+    """Allow NaN only with a status that explains it.
+
+    A finished row with a NaN output that no
     status explains (``e_x``, ``beta_x`` are NaN when ``v_c0 = 0``) becomes
-    ``non_finite`` with all outputs NaN and the columns named in ``error``."""
+    ``non_finite`` with all outputs NaN and the columns named in ``error``.
+    """
     explained = np.broadcast_to(np.asarray(vc0_zero, dtype=bool), finished.shape)
     nothing = np.zeros(finished.shape, dtype=bool)
     bad_cols = {c: np.isnan(cols[c]) & finished
@@ -168,8 +171,10 @@ def guard_nan(cols: dict, status: np.ndarray, error: np.ndarray, vc0_zero: np.nd
 
 
 def chunk_summary(table) -> dict:
-    """The small summary a part stores and a task returns: rows per status (``counts``)
-    and rows and first row per kernel path (``paths``)."""
+    """Return the small summary a part stores and a task returns.
+
+    Rows per status (``counts``) and rows and first row per kernel path (``paths``).
+    """
     status = table.column("status").to_numpy(zero_copy_only=False)
     names, counts = np.unique(status.astype(str), return_counts=True)
     path = np.asarray(table.column("path").to_pylist(), dtype=object)
@@ -223,8 +228,11 @@ def _dask_task(spec: SweepSpec, chunk: int, parts: str) -> dict:
 # ---- stages: what a workflow above the sweep adds -----------------------------------
 
 def _as_is(spec: SweepSpec, parts: Path, log: Callable[[str], None] | None) -> SweepSpec:
-    """The spec to chunk when no workflow prepares it: the spec itself; a grid with a
-    ``tolerance`` is refused (its refinement is the table-build workflow's)."""
+    """Return the spec to chunk when no workflow prepares it: the spec itself.
+
+    A grid with a ``tolerance`` is refused (its refinement is the table-build
+    workflow's).
+    """
     tol = getattr(spec, "grid_tolerance", None)
     if tol is not None and spec.mode == "grid":
         raise InputError(f"grid.tolerance = {tol!r} is not allowed in a plain sweep of "
@@ -416,10 +424,13 @@ def _run(spec, spec_path, out, parts, resume, progress, workers, scheduler, shar
 
 
 def _combine(spec: SweepSpec, parts: Path, out: Path, log, stages: SweepStages) -> None:
-    """:func:`vimpact.sweep.store.combine`, then ``stages.finish``. The stages' own files
+    """Run :func:`vimpact.sweep.store.combine`, then ``stages.finish``.
+
+    The stages' own files
     (``stages.kept``) leave the parts directory first (the directory must hold only
     parts to be removed, a dataset only its parts); they are put back if the
-    combination fails, so that ``--resume`` still finds them."""
+    combination fails, so that ``--resume`` still finds them.
+    """
     saved = {}
     for name in stages.kept:
         kept = Path(parts) / name
@@ -439,8 +450,10 @@ def _combine(spec: SweepSpec, parts: Path, out: Path, log, stages: SweepStages) 
 
 
 def warm_kernels(spec: SweepSpec, rows_per_chunk: int = 2, chunks: int = 4) -> None:
-    """Compile (or load from numba's cache) the kernels the spec needs, in this process:
-    a few rows of a few chunks spread over the sweep, so that workers find them cached."""
+    """Compile (or load from numba's cache) the kernels the spec needs, in this process.
+
+    A few rows of a few chunks spread over the sweep, so that workers find them cached.
+    """
     from vimpact.engine.simulate import simulate_batch
     from vimpact.sweep.parameters import engine_columns
 
@@ -486,9 +499,11 @@ def _available_memory() -> int | None:
 
 
 def max_local_workers() -> tuple[int, str]:
-    """The most local Dask workers this machine takes (``--workers``) and why:
+    """Return the most local Dask workers this machine takes (``--workers``) and why.
+
     :data:`WORKERS_PER_CORE` per usable core, and no more than the available memory
-    holds at :data:`WORKER_MEMORY_BYTES` each (at least 1)."""
+    holds at :data:`WORKER_MEMORY_BYTES` each (at least 1).
+    """
     cores = _usable_cores()
     limit, why = WORKERS_PER_CORE * cores, f"{WORKERS_PER_CORE} per core, {cores} cores"
     memory = _available_memory()
@@ -501,8 +516,10 @@ def max_local_workers() -> tuple[int, str]:
 
 
 def check_workers(workers) -> int:
-    """``--workers`` as an int in ``[1, max_local_workers()]``, or :class:`InputError`
-    before anything starts."""
+    """Return ``--workers`` as an int in ``[1, max_local_workers()]``.
+
+    Raises :class:`InputError` before anything starts otherwise.
+    """
     limit, why = max_local_workers()
     if isinstance(workers, bool) or not isinstance(workers, int) or not 1 <= workers <= limit:
         raise InputError(f"--workers = {workers!r} is not allowed: must be an integer from 1 "
@@ -511,9 +528,11 @@ def check_workers(workers) -> int:
 
 
 def local_cluster(workers: int):
-    """A ``dask.distributed.LocalCluster`` of ``workers`` processes with one thread each
-    and ``NUMBA_NUM_THREADS=1`` in their environment (set by the nanny before the worker
-    process imports anything, so numba starts with one thread)."""
+    """Start a ``dask.distributed.LocalCluster`` of ``workers`` processes.
+
+    One thread each and ``NUMBA_NUM_THREADS=1`` in their environment (set by the nanny before the worker
+    process imports anything, so numba starts with one thread).
+    """
     from distributed import LocalCluster
     return LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
                         env={"NUMBA_NUM_THREADS": "1"}, dashboard_address=None)
@@ -529,9 +548,11 @@ def _scheduler_error(address, why: str) -> InputError:
 
 
 def _probe_scheduler(address: str, timeout: float) -> None:
-    """Refuse ``address`` unless a Dask scheduler answers its handshake within
-    ``timeout`` seconds: a refused port, an unknown host, a service that is not Dask
-    (that sends something else, or nothing) each give one :class:`InputError`."""
+    """Refuse ``address`` unless a Dask scheduler answers its handshake in time.
+
+    Within ``timeout`` seconds: a refused port, an unknown host, a service that is not Dask
+    (that sends something else, or nothing) each give one :class:`InputError`.
+    """
     import asyncio
     import concurrent.futures
 
@@ -582,9 +603,11 @@ def _probe_scheduler(address: str, timeout: float) -> None:
 
 
 def connect_scheduler(address, timeout: float = SCHEDULER_TIMEOUT_S):
-    """A ``distributed.Client`` of the Dask scheduler at ``address``, or
-    :class:`InputError` (one line naming ``--scheduler`` and the address) within about
-    ``timeout`` seconds when none answers there; nothing is written before."""
+    """Return a ``distributed.Client`` of the Dask scheduler at ``address``.
+
+    Or :class:`InputError` (one line naming ``--scheduler`` and the address) within about
+    ``timeout`` seconds when none answers there; nothing is written before.
+    """
     if not isinstance(address, str) or not address.strip():
         raise _scheduler_error(address, "must be a Dask scheduler address such as "
                                         "tcp://host:8786")

@@ -209,13 +209,17 @@ _GRID_CHECKS = {
 
 @dataclasses.dataclass(frozen=True)
 class Draw:
-    """How one random input is drawn: ``kind`` is ``fixed``, ``uniform``,
-    ``log_uniform`` or ``choice``; ``values`` the value, the range or the choices."""
+    """How one random input is drawn.
+
+    ``kind`` is ``fixed``, ``uniform``, ``log_uniform`` or ``choice``; ``values`` the
+    value, the range or the choices.
+    """
 
     kind: str
     values: tuple[float, ...]
 
     def sample(self, rng: np.random.Generator, n: int) -> np.ndarray:
+        """Draw ``n`` values with ``rng``."""
         if self.kind == "fixed":
             return np.full(n, self.values[0])
         if self.kind == "uniform":
@@ -259,8 +263,11 @@ def _draw(spec: TomlSource, key: str, value) -> Draw:
 
 
 def _draw_mu(spec: TomlSource, key: str, value) -> Draw:
-    """A friction coefficient: like :func:`_draw`, every value >= 0; a fixed value or a
-    choice may be ``inf`` (TOML ``inf`` or ``"inf"``: full stick), a range is finite."""
+    """Parse how a friction coefficient is drawn.
+
+    Like :func:`_draw`, every value >= 0; a fixed value or a choice may be ``inf``
+    (TOML ``inf`` or ``"inf"``: full stick), a range is finite.
+    """
     if isinstance(value, str) or (is_number(value) and math.isinf(value)):
         return Draw("fixed", (friction_coefficient(spec, key, value),))
     if isinstance(value, dict) and "choice" in value and isinstance(value["choice"], list) \
@@ -390,12 +397,16 @@ class SweepSpec:
 
     @property
     def n_chunks(self) -> int:
+        """Number of chunks (part files) of the sweep."""
         return -(-self.rows // self.chunk_size)
 
     @property
     def has_friction(self) -> bool:
-        """The spec sets a friction coefficient: a grid with a ``psi`` axis, or a random
-        spec with ``mu``; its table has the columns ``mu`` and ``psi``."""
+        """Whether the spec sets a friction coefficient.
+
+        A grid with a ``psi`` axis, or a random spec with ``mu``; its table has the
+        columns ``mu`` and ``psi``.
+        """
         return "psi" in self.axes or "mu" in self.draws
 
     @property
@@ -412,9 +423,11 @@ class SweepSpec:
 
     @property
     def sweep_hash(self) -> str:
-        """SHA-256 of the spec text, the resolved numerics, the package and schema
-        version (and the material file's text): parts of a run can be resumed only by a
-        run with the same hash."""
+        """SHA-256 of the spec text, the resolved numerics, the package and schema version.
+
+        The material file's text too; parts of a run can be resumed only by a
+        run with the same hash.
+        """
         h = hashlib.sha256()
         pieces = [self.text, json.dumps(dataclasses.asdict(self.numerics), sort_keys=True),
                   __version__, str(SCHEMA_VERSION)]
@@ -427,19 +440,25 @@ class SweepSpec:
 
     # ---- parameter sets ---------------------------------------------------
     def chunk_parameters(self, chunk: int) -> dict[str, np.ndarray]:
-        """The parameter sets of ``chunk`` (:func:`vimpact.sweep.parameters.chunk_parameters`)."""
+        """Return the parameter sets of ``chunk`` (:func:`vimpact.sweep.parameters.chunk_parameters`)."""
         from vimpact.sweep.parameters import chunk_parameters
         return chunk_parameters(self, chunk)
 
     def parameters(self) -> dict[str, np.ndarray]:
-        """All parameter sets, chunk after chunk (memory grows with ``rows``: for
-        small sweeps and tests; the runners use :meth:`chunk_parameters`)."""
+        """Return all parameter sets, chunk after chunk.
+
+        Memory grows with ``rows``: for small sweeps and tests; the runners use
+        :meth:`chunk_parameters`.
+        """
         chunks = [self.chunk_parameters(c) for c in range(self.n_chunks)]
         return {k: np.concatenate([c[k] for c in chunks]) for k in chunks[0]}
 
     def scene(self, params: dict, i: int) -> Scene:
-        """The scene of row ``i`` of ``params`` (one Python object: to explain a
-        row, not to run a sweep); raises ``ValueError`` for an invalid combination."""
+        """Return the scene of row ``i`` of ``params``.
+
+        One Python object: to explain a row, not to run a sweep; raises
+        ``ValueError`` for an invalid combination.
+        """
         p = {k: float(v[i]) for k, v in params.items()}
         if self.mode == "grid":
             scene = Scene.from_dimensionless(p.get("Q1", 0.0), p["nu"], p.get("Q2"),
@@ -490,11 +509,11 @@ class SweepSpec:
                 + list(LABELS))
 
     def units(self) -> dict[str, str]:
-        """Unit of every column (``"1"`` dimensionless, ``""`` for labels)."""
+        """Return the unit of every column (``"1"`` dimensionless, ``""`` for labels)."""
         return {c: _unit(c) for c in self.columns()}
 
     def schema(self):
-        """The ``pyarrow`` schema of the table (``row`` int64, labels string, else float64)."""
+        """Return the ``pyarrow`` schema of the table (``row`` int64, labels string, else float64)."""
         import pyarrow as pa
         fields = []
         for c in self.columns():
@@ -503,8 +522,11 @@ class SweepSpec:
         return pa.schema(fields)
 
     def metadata(self) -> dict:
-        """Metadata of the table (keys without the ``vimpact.`` prefix; values as Python
-        objects, encoded by :func:`vimpact.sweep.store.encode_metadata`)."""
+        """Return the metadata of the table.
+
+        Keys without the ``vimpact.`` prefix; values as Python objects, encoded by
+        :func:`vimpact.tableformat.metadata.encode_metadata`.
+        """
         return {
             "schema_version": SCHEMA_VERSION,
             "version": __version__,
@@ -707,8 +729,11 @@ def _adaptive(spec: TomlSource, model: str, table: dict, axes: dict,
 
 def _grid(spec: TomlSource, model: str, table) -> tuple[dict[str, np.ndarray], float | None,
                                                        float | None]:
-    """The axes (outermost first), the optional ``tolerance`` and the friction coefficient
-    ``mu`` (``None`` without a ``psi`` axis) of a ``[grid]`` table."""
+    """Parse a ``[grid]`` table: its axes, tolerance and friction coefficient.
+
+    The axes (outermost first), the optional ``tolerance`` and the friction coefficient
+    ``mu`` (``None`` without a ``psi`` axis) of a ``[grid]`` table.
+    """
     if model not in _GRID_KEYS:
         raise spec.error("grid", f"model {model!r} has no dimensionless grid; use [random]")
     if not isinstance(table, dict):

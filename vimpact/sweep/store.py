@@ -95,7 +95,7 @@ CORRUPT_DIR = "_corrupt"
 
 
 def summary(path) -> dict[str, int]:
-    """Number of rows per status in the table (file or dataset) at ``path``."""
+    """Return the number of rows per status in the table (file or dataset) at ``path``."""
     import pyarrow.parquet as pq
     status = pq.read_table(path, columns=["status"]).column("status")
     counts = status.value_counts().to_pylist()
@@ -105,8 +105,11 @@ def summary(path) -> dict[str, int]:
 # ---- part verification---------------------------------------------------------------
 
 def _check_part(path: Path, spec, hasher: ContentHash | None = None) -> tuple[str, str | None]:
-    """``("ok", None)``, ``("foreign", why)`` for a part of another sweep (its own
-    vimpact metadata, another sweep hash) or ``("bad", why)``."""
+    """Check a part: ``("ok", None)``, ``("foreign", why)`` or ``("bad", why)``.
+
+    ``"foreign"``: a part of another sweep (its own vimpact metadata, another sweep
+    hash).
+    """
     path = Path(path)
     try:
         pf = open_checked(path)
@@ -166,21 +169,24 @@ def verify_part(path, spec) -> str | None:
 # ---- parts -------------------------------------------------------------------------
 
 def parts_dir(out, layout: str = "file") -> Path:
-    """Directory of the finished chunks of a run writing ``out``: ``OUT.parts`` for the
-    file layout, ``OUT`` itself for a dataset."""
+    """Return the directory of the finished chunks of a run writing ``out``.
+
+    ``OUT.parts`` for the file layout, ``OUT`` itself for a dataset.
+    """
     out = Path(out)
     return out if layout == "dataset" else out.with_name(out.name + ".parts")
 
 
 def part_path(parts: Path, chunk: int, n_chunks: int) -> Path:
-    """The part file of ``chunk`` (zero-padded so that name order is chunk order)."""
+    """Return the part file of ``chunk`` (zero-padded so that name order is chunk order)."""
     width = max(5, len(str(n_chunks - 1)))
     return Path(parts) / f"part-{chunk:0{width}d}.parquet"
 
 
 def existing_parts(spec, parts: Path) -> dict[int, Path]:
-    """Finished chunks in ``parts``, each verified (:func:`verify_part`), after removing
-    temporaries of writes cut short.
+    """Return the finished chunks in ``parts``, each verified (:func:`verify_part`).
+
+    Temporaries of writes cut short are removed first.
 
     A part that fails (damaged, truncated, not a vimpact part, the wrong chunk) is
     treated as missing: it is moved to ``<parts>/_corrupt/`` (never deleted) with
@@ -194,8 +200,11 @@ def existing_parts(spec, parts: Path) -> dict[int, Path]:
 
 
 def _existing_parts(spec, parts: Path, hasher: ContentHash | None = None) -> dict[int, Path]:
-    """:func:`existing_parts`; ``hasher`` receives the rows of the good parts in chunk
-    order (the content hash of the table when no chunk is missing)."""
+    """Return :func:`existing_parts`, the good parts' rows fed to ``hasher``.
+
+    ``hasher`` receives the rows of the good parts in chunk order (the content hash
+    of the table when no chunk is missing).
+    """
     found: dict[int, Path] = {}
     if not parts.is_dir():
         return found
@@ -225,15 +234,19 @@ def _existing_parts(spec, parts: Path, hasher: ContentHash | None = None) -> dic
 
 
 def _as_phrase(why: str) -> str:
-    """``"is truncated (...)"``, ``"fails: content hash mismatch (...)"``: a reason as the
-    rest of a sentence whose subject is the file."""
+    """Return a reason as the rest of a sentence whose subject is the file.
+
+    E.g. ``"is truncated (...)"``, ``"fails: content hash mismatch (...)"``.
+    """
     starts = ("truncated", "empty", "not ", "unreadable")
     return ("is " if why.startswith(starts) else "fails: ") + why
 
 
 def move_aside(path: Path) -> Path:
-    """Move a damaged file to ``<its directory>/_corrupt/`` (a new name if one is there
-    already) and return where it went; nothing is deleted."""
+    """Move a damaged file to ``<its directory>/_corrupt/`` and return where it went.
+
+    It gets a new name if one is there already; nothing is deleted.
+    """
     path = Path(path)
     target_dir = path.parent / CORRUPT_DIR
     target_dir.mkdir(exist_ok=True)
@@ -248,11 +261,14 @@ def move_aside(path: Path) -> Path:
 
 
 def write_part(spec, table, parts: Path, chunk: int, summary_: dict) -> Path:
-    """Write the table of ``chunk`` atomically with the sweep metadata, its row range,
-    its summary (``counts``, ``paths``), page checksums and its content hash.
+    """Write the table of ``chunk`` atomically.
+
+    With the sweep metadata, its row range, its summary (``counts``, ``paths``),
+    page checksums and its content hash.
 
     A failed write (e.g. disk full) raises ``OSError`` saying that the finished
-    parts are kept and how to continue."""
+    parts are kept and how to continue.
+    """
     start, stop = spec.chunk_rows(chunk)
     meta = {**spec.metadata(), "chunk": chunk, "row_start": start, "row_stop": stop,
             "n_chunks": spec.n_chunks, **summary_}
@@ -265,19 +281,23 @@ def write_part(spec, table, parts: Path, chunk: int, summary_: dict) -> Path:
 
 
 def _kept(exc: OSError, parts: Path) -> OSError:
-    """The error of a failed write, saying that the finished parts are kept; "make
-    room" only when the disk (or a quota) is full."""
+    """Return the error of a failed write, saying that the finished parts are kept.
+
+    "make room" only when the disk (or a quota) is full.
+    """
     full = exc.errno in (errno.ENOSPC, errno.EDQUOT)
     return OSError(exc.errno, f"{exc.strerror or first_line(exc)}; the finished chunks are "
                    f"kept in {parts}: {'make room and ' if full else ''}continue with --resume")
 
 
 def is_complete(spec, out: Path) -> bool:
-    """``out`` is the finished table of ``spec`` (same sweep hash) and passes
-    :func:`verify_table`. A finished table that fails is not complete: one line on
-    stderr says why; a file is moved to ``<out>.corrupt`` (a dataset keeps its
+    """Tell whether ``out`` is the finished table of ``spec``.
+
+    Same sweep hash, and it passes :func:`verify_table`. A finished table that fails
+    is not complete: one line on stderr says why; a file is moved to ``<out>.corrupt`` (a dataset keeps its
     place: :func:`existing_parts` moves its damaged parts aside), so that the run
-    writes it again."""
+    writes it again.
+    """
     import pyarrow.parquet as pq
     target = schema_path(out)
     if not target.is_file():
@@ -305,7 +325,9 @@ def is_complete(spec, out: Path) -> bool:
 
 
 def combine(spec, parts: Path, out: Path, explain_paths) -> None:
-    """Finish the table from the parts: verify every part (:func:`existing_parts`:
+    """Finish the table from the parts.
+
+    Verify every part (:func:`existing_parts`:
     a damaged one is moved aside and reported missing), check that every chunk is
     there and that they add up to rows ``0 .. rows-1``; merge the part summaries
     into the ``paths`` metadata (``explain_paths(first_rows) -> {path: reasons}``);
@@ -313,7 +335,8 @@ def combine(spec, parts: Path, out: Path, explain_paths) -> None:
     content hash of all rows) or ``OUT/_common_metadata`` (dataset, with the
     content hash over its parts), verify what was written (:func:`verify_table`)
     and only then remove the parts (file layout; damaged parts moved aside stay
-    in ``<parts>/_corrupt``)."""
+    in ``<parts>/_corrupt``).
+    """
     import pyarrow.parquet as pq
 
     whole = ContentHash()
@@ -375,10 +398,12 @@ COMBINE_MARGIN_BYTES = 2**20
 
 
 def check_room(out: Path, parts: Path, parts_bytes: int) -> None:
-    """Refuse to combine a file-layout table when its folder lacks the room: the table
-    (about the size of its parts) is written while the parts still exist, and they are
+    """Refuse to combine a file-layout table when its folder lacks the room.
+
+    The table (about the size of its parts) is written while the parts still exist, and they are
     removed only after it is verified, so the end of a sweep needs about twice the
-    table's size. ``OSError`` (``ENOSPC``) saying how much, before anything is written."""
+    table's size. ``OSError`` (``ENOSPC``) saying how much, before anything is written.
+    """
     need = parts_bytes + COMBINE_MARGIN_BYTES
     free = shutil.disk_usage(out.parent).free
     if free < need:
@@ -401,10 +426,12 @@ def _verify_written(out: Path, parts: Path) -> None:
 # ---- the output: checks and lock ----------------------------------------------------
 
 def check_output(out: Path, layout: str, name: str = "--out") -> None:
-    """Refuse an output that cannot be written, before any work: not ``.parquet``, a
-    directory where a file is to go (or a file where a dataset is to go), or a place
+    """Refuse an output that cannot be written, before any work.
+
+    Not ``.parquet``, a directory where a file is to go (or a file where a dataset is to go), or a place
     without write permission. ``name``: how the user gave the output (``--out``, or
-    the spec's ``output`` key), for the message."""
+    the spec's ``output`` key), for the message.
+    """
     out = Path(out)
     for path in (out, out.with_name(out.name + ".parts"), out.with_name(out.name + ".lock")):
         refuse_symlink(path, name, out)

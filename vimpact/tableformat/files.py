@@ -32,7 +32,7 @@ COMPRESSION = "zstd"
 
 
 def fsync_dir(path: Path) -> None:
-    """fsync a directory (its entries survive a crash); a no-op where not possible."""
+    """Fsync a directory (its entries survive a crash); a no-op where not possible."""
     try:
         fd = os.open(path, os.O_RDONLY)
     except OSError:  # pragma: no cover - not possible on every platform
@@ -46,9 +46,11 @@ def fsync_dir(path: Path) -> None:
 
 
 def refuse_symlink(path, name: str = "--out", value=None) -> None:
-    """:class:`InputError` if ``path`` is a symbolic link: a file vimpact creates or
-    replaces is never reached through one (its target would be overwritten). The
-    message names ``name = value`` (default: ``path``), as the user gave it."""
+    """Raise :class:`InputError` if ``path`` is a symbolic link.
+
+    A file vimpact creates or replaces is never reached through one (its target would be overwritten). The
+    message names ``name = value`` (default: ``path``), as the user gave it.
+    """
     if os.path.islink(path):
         it = "it is" if value is None else f"{path} is"
         raise InputError(f"{name} = {str(path if value is None else value)!r} is not allowed: "
@@ -69,7 +71,8 @@ def atomic_file(path, name: str = "--out", mode: str = "wb"):
     symbolic link); it is fsynced and renamed onto ``path`` (``os.replace``), then
     the directory is fsynced. ``path`` itself must not be a symbolic link
     (:func:`refuse_symlink`, ``name`` is how the user gave it). On an error the
-    temporary file is removed and an earlier ``path`` stays as it was."""
+    temporary file is removed and an earlier ``path`` stays as it was.
+    """
     path = Path(path)
     refuse_symlink(path, name)
     tmp = _temporary(path)
@@ -94,8 +97,9 @@ def atomic_file(path, name: str = "--out", mode: str = "wb"):
 
 def write_atomic(table, path: Path, *, schema_only: bool = False, more=(),
                  content_sha256: str | None = None) -> None:
-    """Write the ``pyarrow`` ``table`` (or only its schema) to ``path``: a temporary
-    file in the same directory, fsync, ``os.replace``, fsync of the directory.
+    """Write the ``pyarrow`` ``table`` (or only its schema) to ``path`` atomically.
+
+    A temporary file in the same directory, fsync, ``os.replace``, fsync of the directory.
 
     Data is written with Parquet page checksums and the metadata
     ``vimpact.metadata_sha256`` (:func:`metadata_hash`, also for ``schema_only``,
@@ -151,8 +155,9 @@ def remove_temporaries(directory: Path, name: str = "") -> None:
 
 
 class OutputLock:
-    """A lock on ``OUT.lock`` (``fcntl.flock``, released by the kernel when the process
-    dies, even by kill -9).
+    """A lock on ``OUT.lock``.
+
+    ``fcntl.flock``, released by the kernel when the process dies, even by kill -9.
 
     A plain run, ``--resume`` and ``--combine`` take it exclusively: a second sweep
     into the same output is refused. Shards (``shared=True``) take it shared: any
@@ -160,7 +165,8 @@ class OutputLock:
     comes second is refused). A lock file left by a killed sweep does not block
     (nobody holds its lock); a lock taken on a file its holder removed meanwhile is
     taken again on the new one. The lock file is opened with ``O_NOFOLLOW`` (a
-    symbolic link there is refused, never followed)."""
+    symbolic link there is refused, never followed).
+    """
 
     #: Seconds a shard waits for a shared lock that another shard briefly holds
     #: exclusively (while it removes the lock file on its way out).

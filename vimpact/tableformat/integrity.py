@@ -28,9 +28,11 @@ CONTENT_HASH_VERSION = "vimpact content sha256 v1"
 
 
 class ContentHash:
-    """SHA-256 of a table's values in a canonical form, independent of the Parquet
-    encoding (compression, dictionary or plain pages, row groups, Arrow chunks,
-    ``string`` or ``large_string``, nullability flags).
+    r"""SHA-256 of a table's values in a canonical form.
+
+    The hash is independent of the Parquet encoding (compression, dictionary or
+    plain pages, row groups, Arrow chunks, ``string`` or ``large_string``,
+    nullability flags).
 
     Definition (version :data:`CONTENT_HASH_VERSION`). Every column has three byte
     streams over its rows in row order:
@@ -44,8 +46,8 @@ class ContentHash:
     - data: strings and binaries the concatenated bytes of the values (UTF-8);
       empty for the other types.
 
-    The hash is SHA-256 over the UTF-8 text ``"vimpact content sha256 v1\\n"``,
-    ``"rows <n>\\n"``, then for each column in table order ``"column <name>\\n"``
+    The hash is SHA-256 over the UTF-8 text ``"vimpact content sha256 v1\n"``,
+    ``"rows <n>\n"``, then for each column in table order ``"column <name>\n"``
     followed by the three 32-byte SHA-256 digests of its streams. Feeding the
     rows in pieces (:meth:`update` once per part or row group) gives the hash of
     the whole, so a table is hashed with memory bounded by its largest piece.
@@ -58,8 +60,10 @@ class ContentHash:
         self._streams: list[tuple] = []
 
     def update(self, table) -> ContentHash:
-        """Add the rows of the ``pyarrow`` table (or record batch) ``table``: same
-        column names, in the same order, as the rows before."""
+        """Add the rows of the ``pyarrow`` table (or record batch) ``table``.
+
+        Same column names, in the same order, as the rows before.
+        """
         names = list(table.column_names)
         if self.names is None:
             self.names = names
@@ -75,7 +79,7 @@ class ContentHash:
         return self
 
     def hexdigest(self) -> str:
-        """The hash (64 hex digits) of the rows added so far."""
+        """Return the hash (64 hex digits) of the rows added so far."""
         h = hashlib.sha256(f"{CONTENT_HASH_VERSION}\nrows {self.rows}\n".encode())
         names = self.names or []
         streams = self._streams or [(hashlib.sha256(),) * 3 for _ in names]
@@ -87,18 +91,20 @@ class ContentHash:
 
 
 def content_hash(table) -> str:
-    """The :class:`ContentHash` of one ``pyarrow`` table (64 hex digits)."""
+    """Return the :class:`ContentHash` of one ``pyarrow`` table (64 hex digits)."""
     return ContentHash().update(table).hexdigest()
 
 
 def metadata_hash(raw: dict | None) -> str:
-    """SHA-256 (64 hex digits) of the ``vimpact.*`` entries of Parquet key-value
-    metadata ``raw`` (bytes or str keys and values) other than
+    """Return the SHA-256 (64 hex digits) of the ``vimpact.*`` metadata entries.
+
+    The entries of Parquet key-value metadata ``raw`` (bytes or str keys and values) other than
     ``vimpact.metadata_sha256`` itself: over the entries sorted by key, each as the
     little-endian ``uint64`` byte length of the key, the key, the length of the
     value, the value (UTF-8). Stored as ``vimpact.metadata_sha256``, it makes a
     changed metadata entry (the sweep hash, the spec, units, the content hash)
-    detectable: the page checksums do not cover the footer."""
+    detectable: the page checksums do not cover the footer.
+    """
     def as_bytes(x) -> bytes:
         return x if isinstance(x, bytes) else str(x).encode()
     own = (META_PREFIX + METADATA_HASH_KEY).encode()
@@ -113,8 +119,10 @@ def metadata_hash(raw: dict | None) -> str:
 
 
 def with_metadata_hash(schema_or_table):
-    """``schema_or_table`` with ``vimpact.metadata_sha256`` set to :func:`metadata_hash`
-    of its metadata."""
+    """Return ``schema_or_table`` with ``vimpact.metadata_sha256`` set.
+
+    The value is :func:`metadata_hash` of its metadata.
+    """
     meta = dict(schema_or_table.schema.metadata or {}) if hasattr(schema_or_table, "schema") \
         else dict(schema_or_table.metadata or {})
     meta[(META_PREFIX + METADATA_HASH_KEY).encode()] = metadata_hash(meta).encode()
@@ -133,7 +141,7 @@ def check_metadata_hash(raw: dict | None) -> None:
 
 
 def _canonical(column) -> tuple[bytes, bytes, bytes]:
-    """The validity, values and data bytes of one column (see :class:`ContentHash`)."""
+    """Return the validity, values and data bytes of one column (see :class:`ContentHash`)."""
     import numpy as np
     import pyarrow as pa
     import pyarrow.compute as pc
@@ -184,8 +192,10 @@ def first_line(exc: BaseException) -> str:
 
 
 def open_checked(path: Path):
-    """``pyarrow.parquet.ParquetFile`` of ``path`` with page checksum verification,
-    or :class:`Damaged` (missing, truncated, not Parquet, footer unreadable)."""
+    """Open ``path`` as a ``pyarrow.parquet.ParquetFile`` with page checksums verified.
+
+    Raises :class:`Damaged` (missing, truncated, not Parquet, footer unreadable).
+    """
     import pyarrow.parquet as pq
     path = Path(path)
     try:
@@ -214,7 +224,8 @@ def scan(path: Path, hasher: ContentHash | None = None) -> tuple[dict, str, int]
     Returns the decoded ``vimpact.*`` metadata, the :class:`ContentHash` of the
     data and the number of rows; ``hasher`` (optional) receives the rows too.
     Raises :class:`Damaged` for a file that cannot be read back or whose stored
-    hash (if any) differs from its data."""
+    hash (if any) differs from its data.
+    """
     pf = open_checked(path)
     try:
         meta = decode_metadata(pf.schema_arrow.metadata)
@@ -242,16 +253,18 @@ def scan(path: Path, hasher: ContentHash | None = None) -> tuple[dict, str, int]
 
 
 def rows_in_footer(pf) -> int:
-    """Number of rows a ``pyarrow.parquet.ParquetFile``'s footer declares."""
+    """Return the number of rows a ``pyarrow.parquet.ParquetFile``'s footer declares."""
     return int(pf.metadata.num_rows)
 
 
 
 
 def verify_table(path) -> str:
-    """Check that the table at ``path`` (a Parquet file, or a dataset directory) reads
-    back as it was written; raise :class:`~vimpact.model.validation.InputError` naming
-    the file and what failed otherwise.
+    """Check that the table at ``path`` reads back as it was written.
+
+    ``path`` is a Parquet file or a dataset directory; raise
+    :class:`~vimpact.model.validation.InputError` naming the file and what failed
+    otherwise.
 
     Checks: the file exists, is Parquet and not truncated (footer present); it has
     ``vimpact.*`` metadata (else: foreign), equal to its ``vimpact.metadata_sha256``

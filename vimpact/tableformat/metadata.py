@@ -29,7 +29,7 @@ COMMON_METADATA = "_common_metadata"
 
 
 def encode_value(key: str, value) -> str:
-    """The stored text of metadata ``key``: JSON for :data:`JSON_KEYS`, else ``str``."""
+    """Return the stored text of metadata ``key``: JSON for :data:`JSON_KEYS`, else ``str``."""
     if key in JSON_KEYS:
         return value if isinstance(value, str) else json.dumps(value)
     if isinstance(value, bool):
@@ -38,8 +38,11 @@ def encode_value(key: str, value) -> str:
 
 
 def decode_value(key: str, text: str):
-    """The value of metadata ``key`` from its stored text (inverse of :func:`encode_value`;
-    a text that does not decode is returned as it is)."""
+    """Return the value of metadata ``key`` from its stored text.
+
+    The inverse of :func:`encode_value`; a text that does not decode is returned as it
+    is.
+    """
     if key in JSON_KEYS:
         try:
             return json.loads(text)
@@ -59,8 +62,11 @@ def encode_metadata(values: dict) -> dict[bytes, bytes]:
 
 
 def decode_metadata(raw: dict | None) -> dict:
-    """The ``vimpact.*`` entries of Parquet key-value metadata (bytes or str keys),
-    without the prefix, decoded by :func:`decode_value`."""
+    """Return the ``vimpact.*`` entries of Parquet key-value metadata, decoded.
+
+    Keys may be bytes or str; they are returned without the prefix, each value
+    decoded by :func:`decode_value`.
+    """
     out = {}
     for k, v in (raw or {}).items():
         k = k.decode() if isinstance(k, bytes) else str(k)
@@ -72,17 +78,21 @@ def decode_metadata(raw: dict | None) -> dict:
 
 
 def schema_path(path) -> Path:
-    """The file whose schema holds the metadata of a table at ``path``: the file itself,
-    or ``_common_metadata`` of a dataset directory."""
+    """Return the file whose schema holds the metadata of a table at ``path``.
+
+    The file itself, or ``_common_metadata`` of a dataset directory.
+    """
     path = Path(path)
     return path / COMMON_METADATA if path.is_dir() else path
 
 
 def read_metadata(path) -> dict:
-    """The sweep metadata of a table (file or dataset directory) or a part at ``path``:
-    keys without the ``vimpact.`` prefix, decoded (``numerics``, ``units``, ``columns``,
+    """Return the sweep metadata of a table (file or dataset directory) or a part.
+
+    Keys without the ``vimpact.`` prefix, decoded (``numerics``, ``units``, ``columns``,
     ``statuses``, ``paths``, ``rotation`` from JSON; ``schema_version``, ``seed``,
-    ``rows`` ... as ints)."""
+    ``rows`` ... as ints).
+    """
     import pyarrow.parquet as pq
     target = schema_path(path)
     if Path(path).is_dir() and not target.exists():

@@ -40,9 +40,11 @@ def psi_reference(psi: np.ndarray, nu: np.ndarray, mu: float,
 
 
 def incidence(mu: np.ndarray, nu: np.ndarray, v_c0: np.ndarray, v_z0: np.ndarray) -> np.ndarray:
-    """``psi = 2 (1 - nu) / (mu (2 - nu)) v_c0 / v_z0`` (dimensionless) of physical rows:
-    0 for full stick (``mu = inf``) and for ``v_c0 = 0``; ``inf`` (signed) for ``mu = 0``
-    with ``v_c0 != 0`` (frictionless)."""
+    """Return the incidence ``psi = 2 (1 - nu) / (mu (2 - nu)) v_c0 / v_z0`` of rows.
+
+    Dimensionless: 0 for full stick (``mu = inf``) and for ``v_c0 = 0``; ``inf`` (signed) for ``mu = 0``
+    with ``v_c0 != 0`` (frictionless).
+    """
     with np.errstate(divide="ignore", invalid="ignore"):
         psi = 2.0 * (1.0 - nu) / (mu * (2.0 - nu)) * v_c0 / v_z0
         frictionless = np.sign(v_c0) * np.inf

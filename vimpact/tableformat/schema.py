@@ -1,5 +1,6 @@
-"""The schema of a vimpact table: its columns with their units and meaning, the row
-statuses and the schema version.
+"""The schema of a vimpact table.
+
+Its columns with their units and meaning, the row statuses and the schema version.
 
 The sweep writes these columns (:meth:`vimpact.sweep.spec.SweepSpec.columns` picks
 those of a spec) and stores :data:`COLUMNS`' units and meanings in the table's
