@@ -10,7 +10,12 @@ module makes its inputs (the adhesion number ``lam``, step and element row of
 - :func:`sticking_velocity`: the impact speed below which the sphere sticks,
   by bisection;
 - :func:`jkr_quasi_static`: the elastic element row under a prescribed
-  indentation (the JKR curves ``F(d)``, ``a(d)`` as the row gives them).
+  indentation (the JKR curves ``F(d)``, ``a(d)`` as the row gives them);
+- :func:`result_columns`: the adhesive rows of :func:`vimpact.simulate_batch`,
+  run in parallel over the rows (:func:`run_kernel`), as its result columns.
+
+Single scene and batch build their kernel inputs with one function
+(:func:`kernel_inputs`), so a batch row equals :func:`vimpact.simulate` of its scene.
 """
 
 from __future__ import annotations
@@ -24,12 +29,13 @@ import numpy as np
 from vimpact.engine import discretization
 from vimpact.engine.columns import SceneColumns
 from vimpact.engine.pack import arm_arrays
-from vimpact.engine.result import FINISHED, STATUSES, ImpactResult
+from vimpact.engine.result import FINISHED, RESULT_FIELDS, STATUSES, ImpactResult
 from vimpact.kernels import adhesion as kernel
-from vimpact.kernels.layout import VERLET
+from vimpact.kernels.layout import STATUS_ROW_EXCEEDED, VERLET
 from vimpact.kernels.status import BY_CODE
+from vimpact.model.hertz import effective_modulus, hertz_scales
 from vimpact.model.numerics import Numerics
-from vimpact.model.scene import HALF_SPACE_LIMIT, Scene
+from vimpact.model.scene import HALF_SPACE_LIMIT, TANGENTIAL_EFFECTS, Scene
 from vimpact.model.validation import InputError, message, positive, require
 
 #: Path name of the adhesive kernel (``ImpactResult.path``, ``vimpact simulate --explain``).
@@ -104,20 +110,76 @@ def adhesion_for_number(scene: Scene, lam: float) -> float:
     return lam**2 * float(hz.d) ** 2 * scene.E_star / (2.0 * math.pi * float(hz.a_H))
 
 
-def _inputs(scene: Scene, numerics: Numerics, widen: float) -> dict:
-    cols = SceneColumns.from_scenes([dataclasses.replace(scene, adhesion=0.0)])
+def adhesion_numbers(cols: SceneColumns) -> np.ndarray:
+    """Return :func:`adhesion_number` of every row of ``cols``, dimensionless."""
+    E_star = 2.0 * cols.G_inf / (1.0 - cols.nu)
+    with np.errstate(all="ignore"):  # nu = 1 cannot occur in a valid row
+        return np.sqrt(2.0 * np.pi * cols.a_H * cols.adhesion / E_star) / cols.d
+
+
+def work_of_adhesion(lam, G_inf, nu, R, m, v_z0) -> np.ndarray:
+    """Return the work of adhesion (J/m^2) that gives each row the adhesion number ``lam``.
+
+    :func:`adhesion_for_number` on arrays (relaxed shear modulus ``G_inf``, Pa;
+    Poisson ratio ``nu``; sphere radius ``R``, m, and mass ``m``, kg; impact speed
+    ``v_z0``, m/s): ``dgamma = lam^2 d^2 E* / (2 pi a_H)``.
+    """
+    hz = hertz_scales(G_inf, nu, R, m, v_z0)
+    E_star = effective_modulus(G_inf, nu)
+    return np.asarray(lam, dtype=float) ** 2 * hz.d**2 * E_star / (2.0 * np.pi * hz.a_H)
+
+
+def adhesion_number_of(dgamma, G_inf, nu, R, m, v_z0) -> np.ndarray:
+    """Return the adhesion number ``lam`` of each row (inputs as :func:`work_of_adhesion`).
+
+    :func:`adhesion_number` on arrays; ``dgamma`` the work of adhesion, J/m^2.
+    """
+    hz = hertz_scales(G_inf, nu, R, m, v_z0)
+    E_star = effective_modulus(G_inf, nu)
+    with np.errstate(all="ignore"):  # a bad row gives NaN, marked by the engine
+        return np.sqrt(2.0 * np.pi * hz.a_H * np.asarray(dgamma, dtype=float) / E_star) / hz.d
+
+
+def kernel_inputs(cols: SceneColumns, numerics: Numerics, widen: float = 1.0
+                  ) -> dict[str, np.ndarray]:
+    """Return the inputs of :func:`vimpact.kernels.adhesion.adhesive_batch`, one per row.
+
+    The element row and step of :mod:`vimpact.engine.discretization` (Verlet, no
+    tangential problem) with the half row ``widen`` times as wide, refined for a
+    strong adhesion: the contact radius at zero load is ``lam^(2/3) a_H``, so the row
+    grows by ``max(1, lam)^(2/3)`` and the stiffness with it, the step shrinking by
+    ``max(1, lam)^(1/3)``.
+    """
     num = numerics.with_(row_width=numerics.row_width * widen)
-    row = discretization.element_row(cols, num, np.array([False]), VERLET)
+    row = discretization.element_row(cols, num, np.zeros(len(cols), dtype=bool), VERLET)
     g, tau, n_arms = arm_arrays(cols)
-    lam = adhesion_number(scene)
-    # a strong adhesion (large lam) makes the contact wider and stiffer than Hertz's:
-    # the contact radius at zero load is lam^(2/3) a_H, the stiffness grows with it
-    stiffer = max(1.0, lam) ** (1.0 / 3.0)
-    return {"tau0": float(cols.dashpot_time[0] / cols.T[0]), "g": g[0, :n_arms[0]].copy(),
-            "tau": tau[0, :n_arms[0]].copy(), "lam": lam, "h": float(row["h"][0]) / stiffer,
-            "n_elem": int(row["n_elem"][0] * max(1.0, lam) ** (2.0 / 3.0)) + 1,
-            "dxi": float(row["dxi"][0]),
-            "max_steps": int(row["max_steps"][0] * stiffer)}
+    lam = adhesion_numbers(cols)
+    stiffer = np.maximum(1.0, lam) ** (1.0 / 3.0)
+    return {"tau0": cols.dashpot_time / cols.T, "g": g, "tau": tau, "n_arms": n_arms,
+            "lam": lam, "h": row["h"] / stiffer,
+            "n_elem": (row["n_elem"] * np.maximum(1.0, lam) ** (2.0 / 3.0)).astype(np.int64) + 1,
+            "dxi": np.asarray(row["dxi"], dtype=float) * np.ones(len(cols)),
+            "max_steps": (row["max_steps"] * stiffer).astype(np.int64)}
+
+
+def run_kernel(cols: SceneColumns, numerics: Numerics) -> np.ndarray:
+    """Run every row of ``cols`` on the adhesive kernel; return ``(n, N_ADH_OUT)`` rows.
+
+    Rows whose contact reached the end of the half row run again on a row twice as
+    wide, up to :data:`MAX_ROW_WIDENINGS` times.
+    """
+    out = np.zeros((len(cols), kernel.N_ADH_OUT))
+    todo = np.arange(len(cols))
+    for k in range(MAX_ROW_WIDENINGS + 1):
+        a = kernel_inputs(cols if k == 0 else cols.take(todo), numerics, 2.0**k)
+        sub = np.zeros((len(todo), kernel.N_ADH_OUT))
+        kernel.adhesive_batch(a["tau0"], a["g"], a["tau"], a["n_arms"], a["lam"], a["h"],
+                              a["n_elem"], a["dxi"], a["max_steps"], sub)
+        out[todo] = sub
+        todo = todo[sub[:, kernel.ADH_STATUS] == STATUS_ROW_EXCEEDED]
+        if len(todo) == 0:
+            break
+    return out
 
 
 def simulate_adhesive(scene: Scene, numerics: Numerics | None = None) -> AdhesiveResult:
@@ -138,13 +200,17 @@ def simulate_adhesive(scene: Scene, numerics: Numerics | None = None) -> Adhesiv
     numerics = Numerics() if numerics is None else numerics
     require("numerics", numerics, isinstance(numerics, Numerics), "a vimpact.Numerics")
     out = np.zeros(kernel.N_ADH_OUT)
+    cols = SceneColumns.from_scenes([scene])
     for k in range(MAX_ROW_WIDENINGS + 1):
-        a = _inputs(scene, numerics, 2.0**k)
-        kernel.adhesive_impact(a["tau0"], a["g"], a["tau"], a["lam"], a["h"], a["n_elem"],
-                               a["dxi"], a["max_steps"], out)
+        a = kernel_inputs(cols, numerics, 2.0**k)
+        n = int(a["n_arms"][0])
+        kernel.adhesive_impact(float(a["tau0"][0]), a["g"][0, :n].copy(),
+                               a["tau"][0, :n].copy(), float(a["lam"][0]), float(a["h"][0]),
+                               int(a["n_elem"][0]), float(a["dxi"][0]),
+                               int(a["max_steps"][0]), out)
         if BY_CODE[int(out[kernel.ADH_STATUS])] != "row_exceeded":
             break
-    return _result(scene, out, a["lam"])
+    return _result(scene, out, float(a["lam"][0]))
 
 
 def _result(scene: Scene, out: np.ndarray, lam: float) -> AdhesiveResult:
@@ -274,8 +340,9 @@ def jkr_quasi_static(E_star: float, R: float, dgamma: float, d_path: np.ndarray,
 def impact_result(scene: Scene, numerics: Numerics | None = None) -> ImpactResult:
     """Return :func:`simulate_adhesive` as the :class:`~vimpact.ImpactResult` of simulate.
 
-    Normal impact only: e_x, beta_x NaN; status ``stuck`` when the sphere did not
-    separate, else ``normal_only``/``vc0_zero``.
+    Normal impact only: e_x, beta_x, mu_eff, gross_slip_fraction NaN, friction_energy
+    0 (no slip); status ``stuck`` when the sphere did not separate, else
+    ``normal_only``/``vc0_zero``.
     """
     res = simulate_adhesive(scene, numerics)
     hz = scene.hertz
@@ -287,5 +354,63 @@ def impact_result(scene: Scene, numerics: Numerics | None = None) -> ImpactResul
         a_max=res.a_max, t_hertz=float(hz.t_H), d_hertz=float(hz.d), a_hertz=float(hz.a_H),
         energy_ratio=res.energy_ratio, Q1=scene.Q1, Q2=scene.Q2, nu=scene.material.nu,
         v_z_end=res.v_z_end, v_x_end=scene.v_x0, omega_end=scene.omega0, status=status,
-        n_steps=res.n_steps, path=PATH_NAME,
+        n_steps=res.n_steps, path=PATH_NAME, F_tensile_max=res.F_tensile_max,
+        rebound_angle=float(rebound_angle(np.float64(scene.v_x0), np.float64(res.v_z_end))),
+        friction_energy=0.0 if math.isfinite(res.e_z) else math.nan,
         error=None if status in FINISHED else STATUSES.get(status, status))
+
+
+def rebound_angle(v_x_end, v_z_end):
+    """Angle of the end velocity to the normal, ``atan2(v_x_end, -v_z_end)``, degrees.
+
+    A sphere that stuck (``v_z_end = 0``) has 0 (90 if it slides on with ``v_x0``), not
+    the 180 of the signed zero ``-0.0``.
+    """
+    return np.degrees(np.arctan2(v_x_end, -v_z_end + 0.0))
+
+
+def result_columns(cols: SceneColumns, numerics: Numerics) -> dict[str, np.ndarray]:
+    """Run the adhesive rows ``cols`` (all valid, ``adhesion > 0``); return their result columns.
+
+    The columns of :func:`vimpact.simulate_batch` (:data:`RESULT_FIELDS`), row by row
+    what :func:`impact_result` gives for the same scene: normal impact only (``e_x``,
+    ``beta_x`` and the friction outputs NaN), status ``stuck`` when the sphere did
+    not separate, ``F_tensile_max`` the largest pulling force, N.
+    """
+    n = len(cols)
+    out = run_kernel(cols, numerics)
+    status = np.array([BY_CODE[int(c)] for c in out[:, kernel.ADH_STATUS]], dtype=object)
+    stuck = out[:, kernel.ADH_STUCK] > 0.5
+    with np.errstate(all="ignore"):
+        v_end = out[:, kernel.ADH_VZ_END] * cols.v_z0
+        vals = {"e_z": np.abs(v_end) / cols.v_z0,
+                "F_tensile_max": out[:, kernel.ADH_F_TENSILE] * cols.m * cols.v_z0 / cols.T,
+                "t_contact": out[:, kernel.ADH_T_CONTACT] * cols.T,
+                "u_max": out[:, kernel.ADH_U_MAX] * cols.d,
+                "a_max": out[:, kernel.ADH_A_MAX] * cols.a_H, "v_z_end": v_end}
+    ok = status == "ok"
+    status[ok & stuck] = "stuck"
+    status[ok & (vals["a_max"] > HALF_SPACE_LIMIT * cols.R) & ~cols.allow_large_contact] = \
+        "half_space"
+    finite = np.all([np.isfinite(v) for v in vals.values()], axis=0)
+    status[ok & ~finite] = "non_finite"
+    dead = ~np.isin(status, ("ok", "stuck", "half_space"))
+    for v in vals.values():
+        v[dead] = np.nan
+    status[status == "ok"] = np.where(
+        cols.tangential[status == "ok"] == TANGENTIAL_EFFECTS.index("none"),
+        "normal_only", "vc0_zero")
+    error = np.array([None if s in FINISHED else STATUSES.get(s, s) for s in status],
+                     dtype=object)
+    nan = np.full(n, np.nan)
+    result = {**vals, "e_x": nan, "beta_x": nan.copy(), "t_hertz": cols.t_H,
+              "d_hertz": cols.d, "a_hertz": cols.a_H, "energy_ratio": vals["e_z"] ** 2,
+              "Q1": cols.Q1, "Q2": cols.Q2, "nu": cols.nu, "v_x_end": cols.v_x0,
+              "omega_end": cols.omega0, "status": status,
+              "n_steps": out[:, kernel.ADH_STEPS].astype(np.int64),
+              "path": np.full(n, PATH_NAME, dtype=object), "mu_eff": nan.copy(),
+              "rebound_angle": rebound_angle(cols.v_x0, vals["v_z_end"]),
+              "gross_slip_fraction": nan.copy(),
+              "friction_energy": np.where(np.isfinite(vals["e_z"]), 0.0, np.nan),
+              "error": error}
+    return {name: result[name] for name in RESULT_FIELDS}

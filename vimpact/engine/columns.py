@@ -26,6 +26,8 @@ column                 default   meaning
 ``tangential_memory``  "incr."   "incremental" or "seed"
 ``rotation``           True      the sphere may spin
 ``mu``                 inf       Coulomb friction coefficient (inf: full stick)
+``adhesion_J_m2``      0         work of adhesion, J/m^2, >= 0 (> 0: the adhesive
+                                 normal impact, docs/physics.md#adhesion)
 ``model``              inferred  "elastic", "kelvin_voigt", "standard_solid",
                                  "prony": only how Q1, Q2 are reported
 =====================  ========  ==============================================
@@ -48,6 +50,7 @@ import numpy as np
 from vimpact.model.hertz import Q1_PER_TAU, hertz_scales
 from vimpact.model.material import MODELS
 from vimpact.model.scene import (
+    ADHESION_OBLIQUE,
     DEFAULT_THETA_RATIO,
     MAX_DASHPOT_TIME,
     SEED_FRICTION_ALLOWED,
@@ -68,6 +71,7 @@ NUMERIC = {
     "v_x0_m_s": ("finite", 0.0),
     "omega0_rad_s": ("finite", 0.0),
     "mu": ("friction", math.inf),
+    "adhesion_J_m2": ("non_negative", 0.0),
 }
 #: text input columns: name -> (choices, default)
 CHOICES = {
@@ -114,6 +118,7 @@ class SceneColumns:
         ``TANGENTIAL_MEMORY``, ``MODELS``)
     rotation, allow_large_contact : flags
     reasons : object array, ``None`` for a valid row, else why it is invalid
+    adhesion : work of adhesion, J/m^2 (0: none; > 0 runs the adhesive kernel)
     d, a_H, T, t_H : Hertz scales of the relaxed modulus (m, m, s, s)
     """
 
@@ -135,12 +140,15 @@ class SceneColumns:
     rotation: np.ndarray
     allow_large_contact: np.ndarray
     reasons: np.ndarray
+    adhesion: np.ndarray = None  # type: ignore[assignment]  # zeros if not given
     d: np.ndarray = None  # type: ignore[assignment]  # set by __post_init__
     a_H: np.ndarray = None  # type: ignore[assignment]  # set by __post_init__
     T: np.ndarray = None  # type: ignore[assignment]  # set by __post_init__
     t_H: np.ndarray = None  # type: ignore[assignment]  # set by __post_init__
 
     def __post_init__(self):
+        if self.adhesion is None:
+            self.adhesion = np.zeros(self.nu.shape[0])
         with np.errstate(all="ignore"):  # out-of-range rows are marked by check_scales
             self.d, self.a_H, self.T, self.t_H = (np.asarray(x, dtype=float) for x in hertz_scales(
                 self.G_inf, self.nu, self.R, self.m, self.v_z0))
@@ -160,6 +168,11 @@ class SceneColumns:
         :meth:`check_scales` gives a row a reason).
         """
         return is_none(self.reasons)
+
+    @_once
+    def adhesive(self) -> np.ndarray:
+        """Valid rows with a work of adhesion > 0 (the adhesive kernel runs them), bool."""
+        return self.valid & (self.adhesion > 0.0)
 
     @_once
     def v_c0(self) -> np.ndarray:
@@ -234,16 +247,12 @@ class SceneColumns:
                 continue
             mat = s.material
             numbers.append((mat.nu, mat.G_inf, mat.eta0, s.R, s.m, s.v_z0, s.v_x0, s.omega0,
-                            s.Theta, s.mu))
+                            s.Theta, s.mu, s.adhesion))
             for j, (G, tau) in enumerate(mat.arms):
                 G_arm[i, j], tau_arm[i, j] = G, tau
             codes.append((TANGENTIAL_EFFECTS.index(s.tangential),
                           TANGENTIAL_MEMORY.index(s.tangential_memory), MODELS.index(mat.model)))
             flags.append((s.rotation, s.allow_large_contact))
-            if s.adhesion > 0.0:  # not a batch effect: never run it as if without adhesion
-                reasons[i] = (f"scenes[{i}]: adhesion = {s.adhesion!r} J/m^2 is simulated one "
-                              "scene at a time (vimpact.simulate); the batch path has no "
-                              "adhesion")
         # (fields, n) copies: every column a contiguous row of one array
         number = np.array(numbers, dtype=float).reshape(n, len(_SCENE_NUMBERS)).T.copy()
         code = np.array(codes, dtype=np.int8).reshape(n, 3).T.copy()
@@ -324,7 +333,13 @@ class SceneColumns:
                     omega0=num["omega0_rad_s"], Theta=Theta, mu=num["mu"],
                     tangential=codes["tangential"], memory=codes["tangential_memory"],
                     model=model, rotation=rotation, allow_large_contact=np.ones(n, dtype=bool),
-                    reasons=reasons)
+                    reasons=reasons, adhesion=num["adhesion_J_m2"])
+        # the adhesive impact is normal only (the rule of vimpact.Scene)
+        oblique = ((num["adhesion_J_m2"] > 0.0) & (codes["tangential"] != TANGENTIAL_EFFECTS.index(
+            "none")) & (num["v_x0_m_s"] + R * num["omega0_rad_s"] != 0.0))
+        for row in np.flatnonzero(oblique & is_none(reasons)):
+            reasons[row] = message("adhesion_J_m2", float(num["adhesion_J_m2"][row]),
+                                   ADHESION_OBLIQUE)
         _neutralize(cols)
         out = cls(**cols)
         out.check_scales()
@@ -375,15 +390,16 @@ class SceneColumns:
 
 _FIELDS = ("nu", "G_inf", "eta0", "G_arm", "tau_arm", "R", "m", "v_z0", "v_x0", "omega0",
            "Theta", "mu", "tangential", "memory", "model", "rotation", "allow_large_contact",
-           "reasons")
+           "reasons", "adhesion")
 #: the numeric fields of :meth:`SceneColumns.from_scenes`, in the order it reads them
-_SCENE_NUMBERS = ("nu", "G_inf", "eta0", "R", "m", "v_z0", "v_x0", "omega0", "Theta", "mu")
+_SCENE_NUMBERS = ("nu", "G_inf", "eta0", "R", "m", "v_z0", "v_x0", "omega0", "Theta", "mu",
+                  "adhesion")
 #: derived columns computed once per batch (:class:`_once`)
-_DERIVED = ("valid", "v_c0", "theta_ratio", "contact_mass_factor", "kappa", "computes_tangential",
+_DERIVED = ("valid", "adhesive", "v_c0", "theta_ratio", "contact_mass_factor", "kappa", "computes_tangential",
             "has_arms", "dashpot_time")
 #: harmless values written into invalid rows, so that no arithmetic on them warns
 _NEUTRAL = {"nu": 0.5, "G_inf": 1.0, "eta0": 0.0, "R": 1.0, "m": 1.0, "v_z0": 1.0, "v_x0": 0.0,
-            "omega0": 0.0, "Theta": 0.4, "mu": math.inf}
+            "omega0": 0.0, "Theta": 0.4, "mu": math.inf, "adhesion": 0.0}
 
 #: a row that is not a Scene, in the order of :data:`_SCENE_NUMBERS`
 _NEUTRAL_ROW = tuple(_NEUTRAL[name] for name in _SCENE_NUMBERS)

@@ -33,6 +33,7 @@ UNITS = {
     "rebound_angle": "deg",
     "gross_slip_fraction": "1",
     "friction_energy": "J",
+    "F_tensile_max": "N",
     "status": "",
     "n_steps": "1",
     "path": "",
@@ -74,6 +75,8 @@ class ImpactResult:
     gross_slip_fraction : fraction of the contact time in which every element in
         contact slips (Coulomb friction; 0 in full stick, NaN without tangential problem)
     friction_energy : energy dissipated by slip, J (0 in full stick)
+    F_tensile_max : largest pulling (tensile) normal force on the sphere, N, >= 0
+        (docs/physics.md#adhesion); 0 without adhesion, where the contact never pulls
     n_steps : time steps taken (element path) or accepted ODE steps (continuum path)
     path : the kernel that ran (:mod:`vimpact.engine.routing`), e.g. ``elements[verlet,dashpot]``
     trajectory : time series of the impact if asked for (``None`` otherwise)
@@ -102,6 +105,7 @@ class ImpactResult:
     rebound_angle: float = math.nan
     gross_slip_fraction: float = math.nan
     friction_energy: float = math.nan
+    F_tensile_max: float = math.nan
     error: str | None = None
     trajectory: pd.DataFrame | None = field(default=None, repr=False, compare=False)
 

@@ -60,7 +60,27 @@ def run_columns(cols: SceneColumns, numerics: Numerics, n_rec: int = 0, rec_ever
 
     Rows the full-stick continuum kernel hands back (its assumptions broke, or
     its step limit) run again on the element kernel their effects call for.
+    Rows with a work of adhesion run on the adhesive kernel
+    (:func:`vimpact.engine.adhesion.result_columns`; no trajectory: none written).
     """
+    adhesive = cols.adhesive
+    if adhesive.any():
+        from vimpact.engine.adhesion import result_columns
+
+        rest, adh = np.flatnonzero(~adhesive), np.flatnonzero(adhesive)
+        t0 = time.perf_counter()
+        parts = [result_columns(cols.take(adh), numerics)]
+        if timings is not None:  # (the conversion to SI is included: it is small)
+            timings["kernel_s"] = timings.get("kernel_s", 0.0) + time.perf_counter() - t0
+        rec = np.zeros((len(cols), n_rec, layout.N_REC))
+        written = np.zeros(len(cols), dtype=np.int64)
+        if len(rest):
+            result, rec[rest], written[rest] = run_columns(cols.take(rest), numerics, n_rec,
+                                                           rec_every, timings)
+            parts.append(result)
+        order = np.argsort(np.concatenate([adh, rest]), kind="stable")
+        return ({name: np.concatenate([p[name] for p in parts])[order] for name in parts[0]},
+                rec, written)
     out, rec, path_names, explicit_euler, steps_per_T, refused = _run(
         cols, numerics, n_rec, rec_every, timings)
     written = out[:, layout.OUT_N_REC].astype(np.int64)
@@ -172,7 +192,10 @@ def simulate_batch(scenes, numerics: Numerics | str | None = None, *,
         ``G_inf_Pa``, ``R_m``, ``m_kg``, ``v_z0_m_s`` required; ``eta0_Pa_s``,
         ``G_arm<i>_Pa``, ``tau_arm<i>_s``, ``v_x0_m_s``, ``omega0_rad_s``,
         ``Theta_kg_m2`` or ``theta_ratio``, ``tangential``, ``tangential_memory``,
-        ``rotation``, ``mu``, ``model`` optional).
+        ``rotation``, ``mu``, ``model``, ``adhesion_J_m2`` optional). A row with a
+        work of adhesion > 0 runs on the adhesive normal-impact kernel
+        (docs/physics.md#adhesion): status ``stuck`` if the sphere did not separate,
+        ``F_tensile_max`` the largest pulling force (0 in rows without adhesion).
     numerics : Numerics or str, optional
         Discretization (default ``Numerics()``) or a preset name.
     timings : dict, optional

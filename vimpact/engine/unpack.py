@@ -29,7 +29,7 @@ PASSIVITY_SLACK = 1e-6
 #: Outputs that are numbers only with a status in ``FINISHED``.
 OUTPUTS = ("e_z", "e_x", "beta_x", "t_contact", "u_max", "a_max", "energy_ratio", "v_z_end",
            "v_x_end", "omega_end", "mu_eff", "rebound_angle", "gross_slip_fraction",
-           "friction_energy")
+           "friction_energy", "F_tensile_max")
 #: Outputs that are NaN (by definition) without a tangential problem.
 TANGENTIAL_OUTPUTS = ("e_x", "beta_x", "mu_eff", "gross_slip_fraction")
 
@@ -98,6 +98,8 @@ def unpack(cols: SceneColumns, out: np.ndarray, path_names: np.ndarray, explicit
                 tangential, out[:, layout.OUT_T_GROSS_SLIP] / out[:, layout.OUT_T_CONTACT], np.nan),
             "friction_energy": np.where(
                 tangential, out[:, layout.OUT_W_FRICTION] * cols.m * v_c0**2, 0.0),
+            # without adhesion an element leaves before it would pull: no tensile force
+            "F_tensile_max": np.zeros(n),
         }
         # the contact point's tangential speed cannot grow either (|beta_x| <= 1): the
         # normal energy is far larger when v_c0 << v_z0, so the sum above misses it
@@ -215,6 +217,7 @@ def unpack_row(cols: SceneColumns, out: np.ndarray, path_name: str, explicit_eul
                                     else nan),
             "friction_energy": (out[layout.OUT_W_FRICTION] * m * v_c0**2 if tangential
                                 else 0.0),
+            "F_tensile_max": 0.0,
         }
         gain = ((contact1 > contact0 * (1.0 + PASSIVITY_SLACK))
                 or (abs(vz_end) > 1.0 + PASSIVITY_SLACK)

@@ -31,6 +31,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from numba import prange
 
 from vimpact.kernels.arms import _arm_stress, _follow, _relax, arm_coefficients
 from vimpact.kernels.jit import jit
@@ -223,6 +224,20 @@ def adhesive_impact(tau0, g, tau, lam, h, n_elem, dxi, max_steps, out):
     out[ADH_STATUS] = status
     out[ADH_STEPS] = step
     out[ADH_CONTACTS] = contacts
+
+
+@jit(parallel=True)
+def adhesive_batch(tau0, g, tau, n_arms, lam, h, n_elem, dxi, max_steps, out):
+    """Run :func:`adhesive_impact` for every row, in parallel over the rows.
+
+    Row ``i`` of each input is one scene, in the units of :func:`adhesive_impact`
+    (``g[i, :n_arms[i]]``, ``tau[i, :n_arms[i]]`` its arms); its results go to
+    ``out[i]`` (``(n, N_ADH_OUT)``), which only that row writes.
+    """
+    for i in prange(tau0.shape[0]):
+        k = n_arms[i]
+        adhesive_impact(tau0[i], g[i, :k], tau[i, :k], lam[i], h[i], n_elem[i], dxi[i],
+                        max_steps[i], out[i])
 
 
 @jit()

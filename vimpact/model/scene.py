@@ -22,6 +22,9 @@ from vimpact.model.validation import (
 )
 
 TANGENTIAL_MEMORY = ("incremental", "seed")
+#: What the work of adhesion may be on an oblique impact (the adhesive impact is normal only).
+ADHESION_OBLIQUE = ("0 for an oblique impact (v_c0 != 0 with tangential 'auto' or 'stick'): "
+                    "the adhesive impact is normal only (tangential='none')")
 #: What a friction coefficient may be with the seed memory: the seed memory sets every
 #: element to the total contact-point displacement, which slip cannot change, so
 #: Coulomb friction needs the incremental memory.
@@ -134,8 +137,7 @@ class Scene:
         require("adhesion", self.adhesion, self.adhesion >= 0.0,
                 ">= 0 (work of adhesion, J/m^2; 0: no adhesion)")
         require("adhesion", self.adhesion, self.adhesion == 0.0 or self.tangential == "none"
-                or self.v_c0 == 0.0, "0 for an oblique impact (v_c0 != 0 with tangential "
-                "'auto' or 'stick'): the adhesive impact is normal only (tangential='none')")
+                or self.v_c0 == 0.0, ADHESION_OBLIQUE)
         require("mu", self.mu, self.tangential_memory != "seed" or math.isinf(self.mu),
                 SEED_FRICTION_ALLOWED)
         mat = self.material

@@ -18,7 +18,9 @@ row at incidence ``psi`` is the reference scene with ``v_x0`` and ``mu`` from
 :func:`psi_reference`; a random row with ``mu`` gets its ``psi`` from
 :func:`incidence`. Kelvin-Voigt and elastic grid rows get ``Q2 = NaN`` (no
 ``G2``: the limit ``G2 -> inf``), and ``inputs["model"]`` holds each row's
-rheology (a string, for the table's ``model`` column).
+rheology (a string, for the table's ``model`` column). Adhesion: a grid row at
+adhesion number ``lam`` gets the work of adhesion that gives its reference scene
+this number (and ``v_x0 = 0``: normal impact); a random row with ``adhesion_J_m2`` gets its ``lam``.
 """
 
 from __future__ import annotations
@@ -95,6 +97,8 @@ def engine_columns(spec, p: dict[str, np.ndarray]) -> tuple[list[tuple[np.ndarra
         tau = Q1 / Q1_PER_TAU * REFERENCE_INDENTATION / v_z0
         eta = tau * G
         sphere = {k: np.full(n, v) for k, v in REFERENCE.items()}
+        if "lam" in p:  # the adhesive impact is normal only: v_x0 = 0
+            sphere["v_x0_m_s"] = np.zeros(n)
         if "psi" in p:
             sphere["v_x0_m_s"], mu = psi_reference(p["psi"], nu, spec.grid_mu, v_z0)
             common["mu"] = inputs["mu"] = mu
@@ -144,6 +148,14 @@ def engine_columns(spec, p: dict[str, np.ndarray]) -> tuple[list[tuple[np.ndarra
             for i in range(1, len(spec.arms) + 1):
                 for key in (f"G_arm{i}_Pa", f"tau_arm{i}_s"):
                     cols[key] = inputs[key] = p[key]
+    if spec.has_adhesion:  # docs/physics.md#adhesion: lam <-> dgamma on the row's scales
+        from vimpact.engine.adhesion import adhesion_number_of, work_of_adhesion
+        scales = (cols["G_inf_Pa"], nu, cols["R_m"], cols["m_kg"], cols["v_z0_m_s"])
+        if "lam" in p:
+            cols["adhesion_J_m2"] = inputs["adhesion_J_m2"] = work_of_adhesion(p["lam"], *scales)
+        else:
+            cols["adhesion_J_m2"] = inputs["adhesion_J_m2"] = p["adhesion_J_m2"]
+            inputs["lam"] = adhesion_number_of(p["adhesion_J_m2"], *scales)
     batches = [(np.arange(n), cols)]
     if spec.model == "standard_solid":
         # eta = 0: Material.standard_solid has no arm (a bad G2 stays in the arm batch,

@@ -47,6 +47,7 @@ from vimpact.model.validation import InputError
 from vimpact.sweep import store
 from vimpact.sweep.progress import Progress
 from vimpact.sweep.spec import (
+    ADHESION_RESULTS,
     LABELS,
     OUTPUTS,
     RELATIVE,
@@ -115,7 +116,7 @@ def compute_chunk(spec: SweepSpec, chunk: int, timings: dict | None = None):
             error[rows] = np.where(_isnull(err), None, err)
         pth = frame["path"].to_numpy(dtype=object)
         path[rows] = np.where(_isnull(pth), None, pth)
-        for name, source in RESULTS.items():
+        for name, source in (RESULTS | (ADHESION_RESULTS if spec.has_adhesion else {})).items():
             cols[name][rows] = frame[source].to_numpy(dtype=float)
         valid = st != "invalid"
         if spec.mode == "random" and spec.model != "prony":
@@ -133,8 +134,8 @@ def compute_chunk(spec: SweepSpec, chunk: int, timings: dict | None = None):
             cols[name] = cols[num] / cols[den]
     if spec.mode == "random":
         vc0 = params["v_x0_m_s"] + params["R_m"] * params["omega0_rad_s"]
-    else:
-        vc0 = np.ones(n)
+    else:  # the reference scene's v_x0 (1, or psi's; 0 on a lam axis), omega0 = 0
+        vc0 = inputs["v_x0_m_s"]
     guard_nan(cols, status, error, (vc0 == 0.0) | (spec.tangential == "none"),
               np.isin(status, list(FINISHED)))
     labels = {"model": inputs["model"], "path": path, "status": status, "error": error}

@@ -37,7 +37,10 @@ interpolation error the grid should meet between its nodes, a number in [1e-9,
 ``grid_tolerance``, for a refinement of the grid to read), ``Q1``
 (kelvin_voigt, standard_solid; >= 0), ``Q2`` (standard_solid; > 0), ``nu``
 (required; in [0, 0.5]), ``theta_ratio`` (Theta / (m R^2), default 0.4),
-``psi`` (optional, >= 0: the incidence ``2 (1 - nu) / (mu (2 - nu)) v_c0 /
+``lam`` (optional, >= 0, not with ``psi``: the adhesion number
+``sqrt(2 pi a_H dgamma / E*) / d`` of docs/physics.md#adhesion; a row is the
+reference scene with ``v_x0 = 0`` and the work of adhesion that gives it this
+number; the outermost axis), ``psi`` (optional, >= 0: the incidence ``2 (1 - nu) / (mu (2 - nu)) v_c0 /
 v_z0`` of docs/physics.md#coulomb-friction) with ``mu`` (not an axis: the
 friction coefficient, a number > 0, default 1; only with ``psi``). With
 friction the results depend on ``psi`` (with ``nu`` and ``theta_ratio``) and
@@ -73,6 +76,10 @@ column, with its unit as suffix:
   prony: ``G_Pa`` (relaxed modulus), ``eta_Pa_s`` (parallel dashpot,
   default 0) and one ``[[random.arms]]`` table per Maxwell arm with
   ``G_Pa`` and ``tau_s``
+- adhesion, all models: ``adhesion_J_m2`` (work of adhesion, J/m^2, >= 0; drawn
+  after every other key, so a spec without it draws as before). A row with
+  ``v_c0 != 0`` and a tangential problem is ``invalid`` (the adhesive impact is
+  normal only: give ``tangential = "none"``)
 - or, instead of the material keys and ``nu``, a material file
   (:mod:`vimpact.model.material_file`, e.g. written by ``vimpact material
   fit``): ``material = "rubber.toml"`` (relative to the spec's directory) and
@@ -106,7 +113,9 @@ runner), ``nu``, ``theta_ratio`` (``psi`` with friction), the outputs
 (:data:`OUTPUTS`, in every table, the friction outputs ``mu_eff``,
 ``rebound_angle_deg``, ``gross_slip_fraction``, ``friction_energy_J``
 included: in full stick they are the impulse ratio, the rebound angle, 0 and 0),
-then ``path``, ``status``, ``error``.
+then ``path``, ``status``, ``error``. A spec with adhesion (a ``lam`` axis, or
+``adhesion_J_m2`` drawn) has the input ``adhesion_J_m2``, the dimensionless
+``lam`` and the output ``F_tensile_max_N`` (after the other outputs) too.
 
 Output paths: ``output`` in the spec is relative to the spec file's
 directory and stays inside it (no ``..``, not absolute: a spec someone sends
@@ -155,6 +164,8 @@ from vimpact.model.toml_input import (
     scene_from_values,
 )
 from vimpact.tableformat.schema import (  # noqa: F401 - the table's schema, found here too
+    ADHESION_OUTPUTS,
+    ADHESION_RESULTS,
     COLUMNS,
     LABELS,
     OUTPUTS,
@@ -204,7 +215,13 @@ _GRID_CHECKS = {
     "Q2": (lambda x: x > 0.0, "a finite number > 0"),
     "nu": (lambda x: 0.0 <= x <= 0.5, "in [0, 0.5]"),
     "theta_ratio": (lambda x: x > 0.0, "a finite number > 0"),
+    "lam": (lambda x: x >= 0.0, "a finite number >= 0"),
 }
+#: The adhesion axis of a grid (optional, outermost): the adhesion number, on which
+#: (with Q1, Q2, nu) the normal impact alone depends (docs/physics.md#adhesion).
+ADHESION_AXIS = "lam"
+#: The drawn input of a random spec with adhesion, J/m^2.
+ADHESION_KEY = "adhesion_J_m2"
 
 
 @dataclasses.dataclass(frozen=True)
@@ -410,6 +427,15 @@ class SweepSpec:
         return "psi" in self.axes or "mu" in self.draws
 
     @property
+    def has_adhesion(self) -> bool:
+        """Whether the spec has adhesion.
+
+        A grid with a ``lam`` axis or a random spec drawing ``adhesion_J_m2``: its table
+        has the columns ``adhesion_J_m2``, ``lam`` and ``F_tensile_max_N``.
+        """
+        return ADHESION_AXIS in self.axes or ADHESION_KEY in self.draws
+
+    @property
     def table_layout(self) -> str:
         """``"file"`` (one Parquet file) or ``"dataset"`` (a directory of part files)."""
         if self.layout != "auto":
@@ -469,6 +495,12 @@ class SweepSpec:
                 from vimpact.model.material import Material
                 scene = dataclasses.replace(
                     scene, material=Material.elastic(nu=p["nu"], G=scene.material.G_inf))
+            if ADHESION_AXIS in p:
+                from vimpact.engine.adhesion import adhesion_for_number
+                scene = dataclasses.replace(scene, v_x0=0.0)  # normal impact
+                if p[ADHESION_AXIS] > 0.0:
+                    scene = dataclasses.replace(
+                        scene, adhesion=adhesion_for_number(scene, p[ADHESION_AXIS]))
             if "psi" in p:
                 from vimpact.sweep.parameters import psi_reference
                 v_x0, mu = psi_reference(np.array([p["psi"]]), np.array([p["nu"]]),
@@ -479,10 +511,12 @@ class SweepSpec:
         values = {k: v for k, v in p.items() if "_arm" not in k}
         if "angle_deg" in values:
             values.pop("v_x0_m_s", None)  # made from the angle (chunk_parameters)
-        return scene_from_values(self.model, values, arms,
-                                 tangential_memory=self.tangential_memory,
-                                 tangential=self.tangential, rotation=self.rotation,
-                                 allow_large_contact=True)
+        adhesion = values.pop(ADHESION_KEY, 0.0)
+        scene = scene_from_values(self.model, values, arms,
+                                  tangential_memory=self.tangential_memory,
+                                  tangential=self.tangential, rotation=self.rotation,
+                                  allow_large_contact=True)
+        return dataclasses.replace(scene, adhesion=adhesion) if adhesion else scene
 
     # ---- table layout -------------------------------------------------------
     def input_columns(self) -> list[str]:
@@ -497,7 +531,8 @@ class SweepSpec:
             for i in range(1, len(self.arms) + 1):
                 material += [f"G_arm{i}_Pa", f"tau_arm{i}_s"]
         extra = ["angle_deg"] if "angle_deg" in self.draws else []
-        return material + list(SPHERE_KEYS) + extra + (["mu"] if self.has_friction else [])
+        return (material + list(SPHERE_KEYS) + extra + (["mu"] if self.has_friction else [])
+                + ([ADHESION_KEY] if self.has_adhesion else []))
 
     def columns(self) -> list[str]:
         """All columns of the table, in order."""
@@ -505,7 +540,10 @@ class SweepSpec:
             ["Q1", "Q2", "nu", "theta_ratio"]
         if self.has_friction:
             dimensionless.append("psi")
-        return (["row"] + self.input_columns() + dimensionless + list(OUTPUTS)
+        adhesion = list(ADHESION_OUTPUTS) if self.has_adhesion else []
+        if self.has_adhesion:
+            dimensionless.append(ADHESION_AXIS)
+        return (["row"] + self.input_columns() + dimensionless + list(OUTPUTS) + adhesion
                 + list(LABELS))
 
     def units(self) -> dict[str, str]:
@@ -621,6 +659,9 @@ def load_spec(path) -> SweepSpec:
         raise spec.bad("chunk_size", chunk_size,
                        f"at least {-(-rows // MAX_CHUNKS)} for {rows} rows: at most "
                        f"{MAX_CHUNKS} chunks (part files) per sweep")
+    if ADHESION_AXIS in axes and "psi" in axes:
+        raise spec.error(f"grid.{ADHESION_AXIS}", "is not allowed with a psi axis: the "
+                         "adhesive impact is normal only (a lam grid has v_x0 = 0)")
     finite_mu = "mu" in draws and any(math.isfinite(x) for x in draws["mu"].values)
     if header.tangential_memory == "seed" and ("psi" in axes or finite_mu):
         key = "grid.psi" if "psi" in axes else "random.mu"
@@ -643,7 +684,7 @@ def _random(spec: TomlSource, model: str, table) -> tuple[dict, tuple, int]:
         raise spec.bad("random", table, "a table")
     material = MATERIAL_KEYS[model]
     allowed = ("rows",) + material + SPHERE_KEYS + ("nu", "theta_ratio") + FRICTION_KEYS + \
-        (("arms",) if model == "prony" else ())
+        (("arms",) if model == "prony" else ()) + (ADHESION_KEY,)
     spec.unknown(table, allowed, "random")
     if "rows" not in table:
         raise spec.error("random.rows", "missing: the number of parameter sets to draw")
@@ -675,6 +716,11 @@ def _random(spec: TomlSource, model: str, table) -> tuple[dict, tuple, int]:
             continue  # v_x0 = v_z0 tan(angle), made per chunk
         elif key in PHYSICAL_DEFAULTS or key == "eta_Pa_s":
             draws[key] = Draw("fixed", (PHYSICAL_DEFAULTS.get(key, 0.0),))
+    if ADHESION_KEY in table:  # drawn last: a spec without it draws as before
+        draws[ADHESION_KEY] = _draw(spec, f"random.{ADHESION_KEY}", table[ADHESION_KEY])
+        if any(not x >= 0.0 for x in draws[ADHESION_KEY].values):
+            raise spec.bad(f"random.{ADHESION_KEY}", table[ADHESION_KEY],
+                           "works of adhesion >= 0, J/m^2")
     arms = ()
     if model == "prony":
         listed = table.get("arms", [])
@@ -710,6 +756,9 @@ def _adaptive(spec: TomlSource, model: str, table: dict, axes: dict,
     if model not in ("kelvin_voigt", "standard_solid"):
         raise spec.error("grid.refine", f'"adaptive" needs a kelvin_voigt or standard_solid '
                          f"grid, not {model}")
+    if ADHESION_AXIS in axes:
+        raise spec.error(f"grid.{ADHESION_AXIS}", 'is not allowed with refine = "adaptive" '
+                         "(the adaptive axes are Q1 (and Q2), the tensor axis nu)")
     for key in ("psi", "theta_ratio"):
         if key in axes and len(axes[key]) > 1:
             raise spec.error(f"grid.{key}", 'one value only with refine = "adaptive" (the '
@@ -738,7 +787,7 @@ def _grid(spec: TomlSource, model: str, table) -> tuple[dict[str, np.ndarray], f
         raise spec.error("grid", f"model {model!r} has no dimensionless grid; use [random]")
     if not isinstance(table, dict):
         raise spec.bad("grid", table, "a table")
-    keys = _GRID_KEYS[model]
+    keys = ((ADHESION_AXIS,) if ADHESION_AXIS in table else ()) + _GRID_KEYS[model]
     spec.unknown(table, keys + ("tolerance", "mu", "refine", "min_level", "max_level"),
                  "grid")
     tolerance = None

@@ -73,6 +73,10 @@ COLUMNS = {
     "gross_slip_fraction": ("1", "fraction of the contact time in gross slip (every element "
                                  "in contact slipping; 0 in full stick; NaN when v_c0 = 0)"),
     "friction_energy_J": ("J", "energy dissipated by slip (0 in full stick)"),
+    "adhesion_J_m2": ("J/m^2", "work of adhesion dgamma (docs/physics.md#adhesion)"),
+    "lam": ("1", "adhesion number sqrt(2 pi a_H dgamma / E*) / d (Hertz scales of the "
+                 "relaxed modulus)"),
+    "F_tensile_max_N": ("N", "largest pulling force on the sphere (0 without adhesion)"),
     "model": ("", "rheology of the row: elastic, kelvin_voigt, standard_solid or prony "
                   "(a Kelvin-Voigt row has Q2 = NaN)"),
     "path": ("", "the kernel that ran the row (vimpact.engine.routing; why: the paths metadata)"),
@@ -95,6 +99,11 @@ OUTPUTS = ("e_z", "e_x", "beta_x", "energy_ratio", "t_contact_s", "u_max_m", "a_
             "t_hertz_s", "d_hertz_m", "a_hertz_m", "t_contact_rel", "u_max_rel", "a_max_rel",
             "v_z_end_m_s", "v_x_end_m_s", "omega_end_rad_s", "mu_eff", "rebound_angle_deg",
             "gross_slip_fraction", "friction_energy_J")
+#: Outputs of a table with adhesion (a ``lam`` axis or ``adhesion_J_m2`` drawn), after
+#: :data:`OUTPUTS`.
+ADHESION_OUTPUTS = ("F_tensile_max_N",)
+#: Their columns of :func:`vimpact.simulate_batch`.
+ADHESION_RESULTS = {"F_tensile_max_N": "F_tensile_max"}
 #: Outputs that are NaN when v_c0 = 0 (no tangential force).
 TANGENTIAL_OUTPUTS = ("e_x", "beta_x", "mu_eff", "gross_slip_fraction")
 #: String columns: the row's rheology (``model``: elastic, kelvin_voigt, standard_solid or
@@ -103,5 +112,5 @@ TANGENTIAL_OUTPUTS = ("e_x", "beta_x", "mu_eff", "gross_slip_fraction")
 LABELS = ("model", "path", "status", "error")
 
 
-__all__ = ["COLUMNS", "LABELS", "OUTPUTS", "RELATIVE", "RESULTS", "SCHEMA_VERSION",
-           "SWEEP_STATUSES", "TANGENTIAL_OUTPUTS"]
+__all__ = ["ADHESION_OUTPUTS", "ADHESION_RESULTS", "COLUMNS", "LABELS", "OUTPUTS", "RELATIVE",
+           "RESULTS", "SCHEMA_VERSION", "SWEEP_STATUSES", "TANGENTIAL_OUTPUTS"]
