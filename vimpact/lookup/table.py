@@ -50,7 +50,7 @@ from vimpact.kernels.status import TABLE as STATUS_TABLE
 from vimpact.lookup.interpolate import LOG_AXES, cluster_nodes, same_node
 from vimpact.model.scene import DEFAULT_THETA_RATIO, HALF_SPACE_LIMIT, Scene
 from vimpact.model.validation import InputError, positive, require
-from vimpact.tableformat.metadata import COMMON_METADATA, META_PREFIX, decode_value
+from vimpact.tableformat.metadata import COMMON_METADATA, META_PREFIX, decode_value, encode_value
 
 __all__ = ["AXES", "DATA_STATUSES", "LOG_AXES", "LOOKUP_METHODS", "LOOKUP_MODELS",
            "MAX_CURVE_POINTS", "OUTPUTS", "SPEC_HINTS", "RestitutionTable", "format_info",
@@ -369,12 +369,12 @@ class RestitutionTable:
         self.metadata: dict[str, str] = {}
         for key, value in (metadata or {}).items():
             key = key.decode() if isinstance(key, bytes) else str(key)
-            if isinstance(value, bytes):
-                value = value.decode()
-            elif not isinstance(value, str):
-                value = json.dumps(value)
             if not key.startswith(META_PREFIX):
                 key = META_PREFIX + key
+            if isinstance(value, bytes):
+                value = value.decode()
+            elif not isinstance(value, str):  # stored as the writer stores it
+                value = encode_value(key[len(META_PREFIX):], value)
             self.metadata[key] = value
         if self.model == "standard_solid" and "Q2" not in self.data.columns:
             raise InputError(f"the standard_solid table{self._where(path)} lacks the column Q2")
@@ -597,12 +597,7 @@ class RestitutionTable:
             if not self.is_adaptive:
                 raise InputError(f"the table{self._where(self.path)} is not adaptive "
                                  "(vimpact.mode is not 'adaptive')")
-            raw = self.metadata.get(META_PREFIX + "adaptive")
-            try:
-                meta = json.loads(raw) if raw is not None else None
-            except ValueError:
-                meta = None
-            self._adaptive = AdaptiveGrid.from_rows(meta, self.data)
+            self._adaptive = AdaptiveGrid.from_rows(self.meta("adaptive"), self.data)
         return self._adaptive
 
     # ---- lookup ----------------------------------------------------------
@@ -750,13 +745,7 @@ class RestitutionTable:
         :func:`vimpact.tablebuild.verify.interpolation_error` / ``vimpact table verify
         --write``.
         """
-        raw = self.metadata.get(META_PREFIX + "interpolation_error")
-        if raw is None:
-            return None
-        try:
-            value = json.loads(raw)
-        except ValueError:
-            return None
+        value = self.meta("interpolation_error")
         return value if isinstance(value, dict) else None
 
     def error_bound(self, method: str = "cubic") -> dict | None:
