@@ -179,7 +179,8 @@ def test_lock_file_is_not_followed_even_past_the_check(tmp_path, monkeypatch):
     target = victim(tmp_path)
     lock = store.OutputLock(tmp_path / "out.parquet")
     lock.path.symlink_to(target)
-    monkeypatch.setattr(store, "refuse_symlink", lambda *a, **k: None)
+    from vimpact.tableformat import files
+    monkeypatch.setattr(files, "refuse_symlink", lambda *a, **k: None)
     with pytest.raises(OSError) as info:
         lock._open()
     assert info.value.errno == errno.ELOOP and target.read_text() == "keep me"
@@ -188,13 +189,14 @@ def test_lock_file_is_not_followed_even_past_the_check(tmp_path, monkeypatch):
 def test_atomic_file_never_writes_through_a_planted_temporary(tmp_path):
     """A symbolic link planted at the temporary name is replaced, not written through."""
     from vimpact.sweep import store
+    from vimpact.tableformat import files
     target = victim(tmp_path)
     out = tmp_path / "t.csv"
-    store._temporary(out).symlink_to(target)
+    files._temporary(out).symlink_to(target)
     with store.atomic_file(out, "out", mode="w") as f:
         f.write("new")
     assert out.read_text() == "new" and target.read_text() == "keep me"
-    assert not out.is_symlink() and not store._temporary(out).exists()
+    assert not out.is_symlink() and not files._temporary(out).exists()
 
 
 @pytest.mark.parametrize("output", ["../escaped.parquet", "sub/../../escaped.parquet",

@@ -191,8 +191,8 @@ def test_adaptive_spec_keys(tmp_path):
 def test_kelvin_voigt_build_against_direct_simulation(tmp_path):
     """The real kernel: an adaptive Kelvin-Voigt table built to 1e-4, then looked up at
     random off-node points and compared with fresh direct simulations."""
-    from vimpact.lookup.verify import numerics_of, simulate_dimensionless
     from vimpact.tablebuild.adaptive import build_adaptive
+    from vimpact.tablebuild.verify import numerics_of, simulate_dimensionless
 
     spec = tmp_path / "kv.toml"
     spec.write_text('model = "kelvin_voigt"\noutput = "kv.parquet"\n[grid]\n'
@@ -222,8 +222,8 @@ def test_grid_only_views_are_refused_with_a_reason(analytic):
 def test_standard_solid_refinement_on_a_ridge_meets_its_tolerance(tmp_path):
     """The real kernel where the standard solid changes course (Q2 = 0.01, Q1 near 4.4):
     a small adaptive table held to 1e-4 is within it at fresh random points."""
-    from vimpact.lookup.verify import numerics_of, simulate_dimensionless
     from vimpact.tablebuild.adaptive import build_adaptive
+    from vimpact.tablebuild.verify import numerics_of, simulate_dimensionless
 
     spec = tmp_path / "ss.toml"
     spec.write_text('model = "standard_solid"\noutput = "ss.parquet"\n[grid]\n'

@@ -20,7 +20,7 @@ def test_closed_form_matches_simulation_above_the_onset_only():
     """Kelvin-Voigt impacts at incidences around psi_g: above it the simulation's
     beta_x is the closed form and the contact slips throughout; below it, it is not,
     and beta_x is below the closed form (the Coulomb bound)."""
-    from vimpact.lookup.verify import simulate_dimensionless
+    from vimpact.tablebuild.verify import simulate_dimensionless
 
     q1, nu = 0.1, np.array([0.3, 0.5])
     normal = simulate_dimensionless("kelvin_voigt", np.full(2, q1), nu)
@@ -46,8 +46,8 @@ def test_gross_slip_starts_below_psi_g_and_the_closed_form_holds_from_there():
     """The kink where microslip meets gross slip (found by bisection on the simulated
     gross-slip fraction) is below psi_g; just above it the simulation is the closed
     form, just below it beta_x is under the closed form (the Coulomb bound)."""
-    from vimpact.lookup.verify import simulate_dimensionless
     from vimpact.tablebuild.friction import gross_slip_start
+    from vimpact.tablebuild.verify import simulate_dimensionless
 
     q1, nu = np.array([0.01, 0.1, 1.0]), np.array([0.3, 0.3, 0.5])
     found = gross_slip_start("kelvin_voigt", q1, nu, rel_tol=1e-3)

@@ -4,7 +4,7 @@ mid-points are geometric means too (the verification checks the cell's worst poi
 import numpy as np
 
 from vimpact.lookup.interpolate import LOG_AXES
-from vimpact.lookup.verify import held_out_points
+from vimpact.tablebuild.verify import held_out_points
 
 
 def test_theta_ratio_mid_points_are_geometric():

@@ -38,7 +38,7 @@ def test_figures_5_4_and_5_5_from_the_table_alone(table):
     lookup, compared with direct simulation at points off the table's nodes; the
     difference stays within the table's stated bound (1.5 x the largest error measured
     at its held-out points) and, where the build met its tolerance, within 1e-5."""
-    from vimpact.lookup.verify import numerics_of, simulate_dimensionless
+    from vimpact.tablebuild.verify import numerics_of, simulate_dimensionless
 
     q1 = np.logspace(-3, 1.5, 23) * 1.0371  # off the lattice's nodes
     q2 = np.array([0.01, 0.03, 0.1, 0.3, 1.0]) * 1.013

@@ -10,17 +10,17 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from vimpact.lookup.refine import grid_table, refine_grid
 from vimpact.lookup.table import RestitutionTable
-from vimpact.lookup.verify import (
+from vimpact.model.numerics import Numerics
+from vimpact.model.validation import InputError
+from vimpact.tablebuild.refine import grid_table, refine_grid
+from vimpact.tablebuild.verify import (
     held_out_errors,
     held_out_points,
     interpolation_error,
     simulate_dimensionless,
     write_interpolation_error,
 )
-from vimpact.model.numerics import Numerics
-from vimpact.model.validation import InputError
 
 NUM = Numerics()  # continuum path, rtol 1e-8
 Q1_NODES = np.geomspace(0.01, 10.0, 10)  # 3.3 per decade

@@ -136,11 +136,11 @@ def write_foreign_parquet(path: Path, rows: int = 3) -> None:
 
 
 class FullDisk:
-    """``open`` for :mod:`vimpact.sweep.store` on a disk that fills up: the first
+    """``open`` for :mod:`vimpact.tableformat.files` (every atomic write) on a disk that fills up: the first
     ``files_ok`` files opened for writing are written in full, the next one gets
     ``bytes_into_next`` bytes and then ``OSError(ENOSPC)`` from ``write`` (midway
     through the file), and every later write fails at once (the disk stays full).
-    Use ``monkeypatch.setattr(store, "open", FullDisk(...), raising=False)``; reads
+    Use ``monkeypatch.setattr(files, "open", FullDisk(...), raising=False)``; reads
     go to the real ``open``. ``failures`` counts the ``ENOSPC`` raised."""
 
     def __init__(self, files_ok: int, bytes_into_next: int = 100):

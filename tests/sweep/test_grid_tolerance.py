@@ -12,11 +12,13 @@ import json
 import numpy as np
 import pytest
 
-from vimpact.lookup import refine
 from vimpact.lookup.table import RestitutionTable
-from vimpact.lookup.verify import held_out_errors
 from vimpact.model.validation import InputError
-from vimpact.sweep import SweepInterrupted, load_spec, parts_dir, read_metadata, run_sweep, runner
+from vimpact.sweep import SweepInterrupted, load_spec, parts_dir, read_metadata
+from vimpact.tablebuild import refine
+from vimpact.tablebuild import sweep as build
+from vimpact.tablebuild.sweep import run_sweep
+from vimpact.tablebuild.verify import held_out_errors
 
 TOL = 1e-4
 KV = """
@@ -58,7 +60,7 @@ def swept(tmp_path_factory):
         mp.setattr(refine, "refine_grid", counted)
         with pytest.raises(SweepInterrupted):
             run_sweep(spec_path, progress=stop_after_first_chunk)
-        cache = json.loads((parts_dir(out) / runner.GRID_CACHE).read_text())
+        cache = json.loads((parts_dir(out) / build.GRID_CACHE).read_text())
         run_sweep(spec_path, resume=True, progress=False)
     return spec_path, out, cache, len(calls)
 
@@ -102,7 +104,7 @@ def test_unreachable_tolerance_is_refused_and_nothing_is_written(tmp_path, monke
                                          r"reached.*e_z [0-9.e-]+, beta_x [0-9.e-]+"):
         run_sweep(spec_path, progress=False)
     assert not (tmp_path / "kv.parquet").exists()
-    assert not (parts_dir(tmp_path / "kv.parquet") / runner.GRID_CACHE).exists()
+    assert not (parts_dir(tmp_path / "kv.parquet") / build.GRID_CACHE).exists()
 
 
 def test_grid_tolerance_on_an_elastic_grid_is_refused(tmp_path):
@@ -128,9 +130,9 @@ def test_refined_dataset_keeps_only_its_parts(tmp_path):
 
     with pytest.raises(SweepInterrupted):
         run_sweep(path, progress=stop_after_first_chunk)
-    assert (tmp_path / "kv.parquet" / runner.GRID_CACHE).is_file()
+    assert (tmp_path / "kv.parquet" / build.GRID_CACHE).is_file()
     out = run_sweep(path, resume=True, progress=False)
-    assert not (out / runner.GRID_CACHE).exists()
+    assert not (out / build.GRID_CACHE).exists()
     assert "content hash verified" in verify_table(out)
     table = RestitutionTable.open(out)
     assert table.meta("grid_refinement")["met"]

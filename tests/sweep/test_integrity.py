@@ -27,6 +27,7 @@ from vimpact import cli
 from vimpact.model.validation import InputError
 from vimpact.sweep import parts_dir, run_sweep, store
 from vimpact.sweep.spec import load_spec
+from vimpact.tableformat import files
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -370,7 +371,7 @@ def test_full_disk_one_clear_error_then_resume(tmp_path, clean, monkeypatch, cap
     spec, clean_bytes = clean
     out = tmp_path / "t.parquet"
     disk = faults.FullDisk(files_ok=files_ok, bytes_into_next=100)
-    monkeypatch.setattr(store, "open", disk, raising=False)
+    monkeypatch.setattr(files, "open", disk, raising=False)
     assert cli.main(["sweep", str(spec), "--out", str(out)]) == 2
     err = [line for line in capsys.readouterr().err.splitlines() if "rows/s" not in line]
     assert len(err) == 1 and "No space left on device" in err[0] and "--resume" in err[0]

@@ -20,7 +20,7 @@ and the grid of the shipped Kelvin-Voigt spec, it simulates every node directly
 (the spec's numerics), builds the table in memory, and measures the lookup error
 against direct simulation at held-out points (mid-points of every cell edge along
 each axis, cell centres, random interior points;
-:func:`vimpact.lookup.verify.interpolation_error`), multilinear and cubic.
+:func:`vimpact.tablebuild.verify.interpolation_error`), multilinear and cubic.
 """
 
 from __future__ import annotations
@@ -70,9 +70,9 @@ def grid_axes(spec_path: Path) -> tuple[str, dict, float | None, str]:
 
 def measure_grid(name: str, spec_path: Path, n_random: int) -> tuple[dict, object]:
     """Build the table of grid ``name`` and measure its interpolation error."""
-    from vimpact.lookup.refine import grid_table
-    from vimpact.lookup.verify import interpolation_error
     from vimpact.model.numerics import Numerics
+    from vimpact.tablebuild.refine import grid_table
+    from vimpact.tablebuild.verify import interpolation_error
 
     model, axes, tolerance, preset = grid_axes(spec_path)
     numerics = Numerics.preset(preset)
@@ -193,8 +193,8 @@ def run(quick: bool) -> dict:
             print(f"{name}: {path.relative_to(ROOT)}", flush=True)
             data["timing"][name] = time_lookups(table, 1 if quick else 3)
     if not data["timing"]:  # installed: no shipped table here, build a small one
-        from vimpact.lookup.refine import grid_table
         from vimpact.model.numerics import Numerics
+        from vimpact.tablebuild.refine import grid_table
 
         table = grid_table("kelvin_voigt", BUILT_AXES, Numerics.preset("fast"))
         print(f"kelvin_voigt_2_axes_built: {len(table)} nodes simulated", flush=True)

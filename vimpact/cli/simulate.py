@@ -291,7 +291,7 @@ def _check_output(flag: str, path: str, suffixes: tuple[str, ...]) -> Path:
 
     Wrong extension, a directory, a missing or unwritable folder.
     """
-    from vimpact.sweep.store import refuse_symlink  # the one rule for files vimpact writes
+    from vimpact.tableformat.files import refuse_symlink  # the one rule for files vimpact writes
 
     out = Path(path)
     if out.suffix.lower() not in suffixes:
@@ -333,7 +333,7 @@ def run(a) -> int:
     except InputError as exc:  # half-space exceeded, tolerance unreachable
         raise _as_flags(exc) from None
     if a.trajectory:
-        from vimpact.sweep.store import atomic_file
+        from vimpact.tableformat.files import atomic_file
 
         out = Path(a.trajectory)
         csv = out.suffix.lower() == ".csv"

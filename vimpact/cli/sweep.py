@@ -64,7 +64,8 @@ def add_parser(subparsers):
 
 def cmd_sweep(args) -> int:
     """Run ``vimpact sweep`` and return the exit code (0, or 130 on Ctrl-C)."""
-    from vimpact.sweep import SweepInterrupted, run_sweep, summary
+    from vimpact.sweep import SweepInterrupted, summary
+    from vimpact.tablebuild.sweep import run_sweep  # the grid refined to a tolerance
 
     t0 = time.perf_counter()
     try:

@@ -212,8 +212,8 @@ def _plain(x):
 def _cmd_build(a) -> int:
     import sys
 
-    from vimpact.lookup.verify import MAX_POINTS
     from vimpact.tablebuild.adaptive import build_adaptive
+    from vimpact.tablebuild.verify import MAX_POINTS
 
     if not 0 <= a.n <= MAX_POINTS:
         raise ValueError(f"--n = {a.n} is not allowed: must be an integer from 0 to "
@@ -271,7 +271,7 @@ def _cmd_lookup(a) -> int:
             print("  ".join(f"{'nan' if row[k] is None else format(row[k], '.6g'):>12}"
                             for k in names))
         if bound:
-            from vimpact.lookup.verify import BOUND_FACTOR
+            from vimpact.tablebuild.verify import BOUND_FACTOR
 
             print(f"interpolation error bound ({BOUND_FACTOR:g} x the max measured between "
                   "nodes): " + ", ".join(f"{k} {v:.2g}" for k, v in bound.items()))
@@ -282,7 +282,7 @@ def _cmd_lookup(a) -> int:
 
 
 def _cmd_verify(a) -> int:
-    from vimpact.lookup.verify import MAX_POINTS, interpolation_error, write_interpolation_error
+    from vimpact.tablebuild.verify import MAX_POINTS, interpolation_error, write_interpolation_error
     if a.seed < 0:
         raise ValueError(f"--seed = {a.seed} is not allowed: must be an integer >= 0")
     if not 0 <= a.n <= MAX_POINTS:

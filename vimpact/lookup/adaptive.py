@@ -95,8 +95,11 @@ def _check_keys(level: np.ndarray, index: np.ndarray) -> np.ndarray:
 
 
 def check_points(k: int) -> tuple[np.ndarray, np.ndarray]:
-    """The check fractions (``3**k`` x ``k``) and the matrix ``W`` (``3**k`` x ``4**k``) with
-    ``W @ node values`` = the leaf's cubic interpolant at them."""
+    """Return the check fractions and the matrix of the cubic interpolant at them.
+
+    The fractions are ``3**k`` x ``k``, the matrix ``W`` is ``3**k`` x ``4**k``, with
+    ``W @ node values`` = the leaf's cubic interpolant at them.
+    """
     frac = np.array(CHECK_FRACTIONS)[_local(k, [0, 1, 2])]
     w = np.ones((len(frac), 4**k))
     nodes = _local(k, [0, 1, 2, 3])
@@ -107,8 +110,11 @@ def check_points(k: int) -> tuple[np.ndarray, np.ndarray]:
 
 
 def lattice_coordinates(keys: np.ndarray, bounds) -> np.ndarray:
-    """Raw axis values of lattice keys ``(n, k)`` on axes with raw ends ``bounds`` ``(k, 2)``
-    (log-spaced: the one rule for the build, the stored rows and the lookup)."""
+    """Return the raw axis values of lattice keys ``(n, k)``.
+
+    The axes have raw ends ``bounds`` ``(k, 2)`` and are log-spaced: the one rule for
+    the build, the stored rows and the lookup.
+    """
     lb = np.log(np.asarray(bounds, dtype=float))
     u = np.asarray(keys, dtype=float) / _TICKS
     return np.exp(lb[:, 0] + u * (lb[:, 1] - lb[:, 0]))
@@ -269,7 +275,7 @@ class AdaptiveGrid:
 
     # ---- storage ------------------------------------------------------------
     def to_metadata(self) -> dict:
-        """The ``vimpact.adaptive`` metadata entry (JSON-serializable)."""
+        """Return the ``vimpact.adaptive`` metadata entry (JSON-serializable)."""
         return {"format": ADAPTIVE_FORMAT, "axes": self.axes,
                 "bounds": self.bounds.tolist(), "lattice_level": LATTICE_LEVEL,
                 "tensor_axis": self.tensor_axis, "tensor_nodes": self.tensor_nodes.tolist(),
@@ -278,8 +284,10 @@ class AdaptiveGrid:
                               for d, a in enumerate(self.axes)}}}
 
     def rows(self) -> dict[str, np.ndarray]:
-        """Node rows: the axes (raw), the lattice keys and the outputs, one row per
-        adaptive node and tensor node (tensor axis fastest)."""
+        """Return the node rows: the axes (raw), the lattice keys and the outputs.
+
+        One row per adaptive node and tensor node (tensor axis fastest).
+        """
         nt = len(self.tensor_nodes)
         xy = self.coordinates(self.keys)
         cols: dict[str, np.ndarray] = {}
@@ -295,8 +303,10 @@ class AdaptiveGrid:
 
     @classmethod
     def from_rows(cls, meta: dict, data, names=("e_z", "beta_x")) -> AdaptiveGrid:
-        """Rebuild from the ``vimpact.adaptive`` entry and the node rows (a DataFrame);
-        raises :class:`InputError` for an inconsistent table."""
+        """Rebuild from the ``vimpact.adaptive`` entry and the node rows (a DataFrame).
+
+        Raises :class:`InputError` for an inconsistent table.
+        """
         if not isinstance(meta, dict) or meta.get("format") != ADAPTIVE_FORMAT:
             raise InputError(f"vimpact.adaptive = {str(meta)[:80]!r} is not allowed: an "
                              f"adaptive table's structure of format {ADAPTIVE_FORMAT}")

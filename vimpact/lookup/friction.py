@@ -42,8 +42,10 @@ def chi(nu, theta_ratio=0.4, rotation: bool = True):
 
 
 def gross_slip_onset(e_z, nu, theta_ratio=0.4, rotation: bool = True):
-    """Incidence ``psi_g = 2 chi (1 + e_z)`` where the gross-slip closed form gives
-    ``beta_x = 0``; the contact slips throughout at every ``psi >= psi_g``.
+    """Return the incidence ``psi_g = 2 chi (1 + e_z)`` of the gross-slip onset.
+
+    There the gross-slip closed form gives ``beta_x = 0``; the contact slips
+    throughout at every ``psi >= psi_g``.
 
     Parameters
     ----------

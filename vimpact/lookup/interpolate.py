@@ -95,7 +95,9 @@ def _fmt(x: float) -> str:
 
 
 def derivative_matrix(x: np.ndarray, stencil: int = _STENCIL) -> np.ndarray:
-    """``D`` with ``(D @ f)[i]`` the derivative at ``x[i]`` of the polynomial through
+    """Return the derivative matrix ``D`` of the nodes ``x``.
+
+    ``(D @ f)[i]`` is the derivative at ``x[i]`` of the polynomial through
     ``stencil`` nodes around ``i`` (centred where possible; all nodes if fewer).
 
     Parameters
@@ -130,9 +132,12 @@ def derivative_matrix(x: np.ndarray, stencil: int = _STENCIL) -> np.ndarray:
 
 
 def _limit(x: np.ndarray, f: np.ndarray, s: np.ndarray, axis: int) -> np.ndarray:
-    """Hyman's monotonicity filter along ``axis``: where both secants adjacent to a node
-    have one sign, clip the slope into ``[0, 3 min(|secants|)]`` with that sign; a zero
-    secant on either side gives slope 0; the end nodes use their one secant."""
+    """Apply Hyman's monotonicity filter along ``axis``.
+
+    Where both secants adjacent to a node have one sign, clip the slope into
+    ``[0, 3 min(|secants|)]`` with that sign; a zero secant on either side gives
+    slope 0; the end nodes use their one secant.
+    """
     f = np.moveaxis(f, axis, -1)
     s = np.moveaxis(s, axis, -1).copy()
     n = f.shape[-1]
@@ -156,9 +161,12 @@ def _limit(x: np.ndarray, f: np.ndarray, s: np.ndarray, axis: int) -> np.ndarray
 
 
 def _derivative(x: np.ndarray, f: np.ndarray, axis: int, D: np.ndarray) -> np.ndarray:
-    """``D`` applied along ``axis``; where a stencil meets a failed (NaN) node but the
-    node itself is finite, the mean of its finite adjacent secants instead (so a failed
-    impact spoils only the cells that touch it)."""
+    """Apply ``D`` along ``axis``.
+
+    Where a stencil meets a failed (NaN) node but the node itself is finite, the
+    mean of its finite adjacent secants instead (so a failed impact spoils only the
+    cells that touch it).
+    """
     s = np.moveaxis(np.tensordot(D, np.moveaxis(f, axis, 0), axes=(1, 0)), 0, axis)
     patch = np.isnan(s) & np.isfinite(f)
     if np.any(patch) and f.shape[axis] > 1:
@@ -239,8 +247,10 @@ class HermiteGrid:
         self._kernel_args = None
 
     def _kernel_arrays(self) -> tuple:
-        """The grid as the arrays :func:`vimpact.kernels.hermite.hermite_eval` takes
-        (everything but the points, ``extrapolate`` and ``out``)."""
+        """Return the grid as the arrays :func:`vimpact.kernels.hermite.hermite_eval` takes.
+
+        Everything but the points, ``extrapolate`` and ``out``.
+        """
         if self._kernel_args is None:
             d = len(self.axes)
             is_log = np.array([a in self.log_axes for a in self.axes], dtype=np.bool_)
@@ -260,8 +270,10 @@ class HermiteGrid:
 
     # ---- range checks ---------------------------------------------------------
     def _check(self, k: int, x: np.ndarray, extrapolate: bool) -> None:
-        """Raise :class:`InputError` for a point outside axis ``k`` (unless
-        ``extrapolate``) or at ``x <= 0`` on a log axis."""
+        """Raise :class:`InputError` for a point outside axis ``k`` or at ``x <= 0`` on a log axis.
+
+        A point outside the axis is allowed with ``extrapolate``.
+        """
         if x.size == 0:
             return
         name, nodes = self.axes[k], self.nodes[k]

@@ -27,7 +27,7 @@ default it interpolates with tensor-product cubic Hermite polynomials in
 ``log Q1`` (and ``log Q2``) and ``nu``, shape-preserving where the data is
 monotone (:mod:`vimpact.lookup.interpolate`); ``method="linear"`` gives the
 multilinear interpolant. The error between the nodes, measured against direct
-simulation (:func:`vimpact.lookup.verify.interpolation_error`), is stored as
+simulation (:func:`vimpact.tablebuild.verify.interpolation_error`), is stored as
 the metadata entry ``vimpact.interpolation_error`` and returned with every
 lookup (``error_bound``). Since ``e_z``, ``e_x`` depend only on these parameters
 (docs/physics.md#dimensionless-parameters), :meth:`RestitutionTable.restitution_curve` turns a
@@ -50,6 +50,7 @@ from vimpact.kernels.status import TABLE as STATUS_TABLE
 from vimpact.lookup.interpolate import LOG_AXES, cluster_nodes, same_node
 from vimpact.model.scene import DEFAULT_THETA_RATIO, HALF_SPACE_LIMIT, Scene
 from vimpact.model.validation import InputError, positive, require
+from vimpact.tableformat.metadata import COMMON_METADATA, META_PREFIX, decode_value, encode_value
 
 __all__ = ["AXES", "DATA_STATUSES", "LOG_AXES", "LOOKUP_METHODS", "LOOKUP_MODELS",
            "MAX_CURVE_POINTS", "OUTPUTS", "SPEC_HINTS", "RestitutionTable", "format_info",
@@ -87,7 +88,6 @@ MAX_CURVE_POINTS = 100_000
 BOUND_SLACK = 1e-6
 
 _REQUIRED = ("Q1", "nu", "e_z", "e_x", "beta_x", "status")
-_META_PREFIX = "vimpact."  # the sweep's vimpact.sweep.store.META_PREFIX
 
 
 def _axis_is_log(name: str) -> bool:
@@ -118,8 +118,10 @@ class _Grid:
         return {a: len(n) for a, n in zip(self.axes, self.nodes)}
 
     def _weights(self, k: int, x: np.ndarray, extrapolate: bool):
-        """Cell index ``i0``, ``i1`` and weight ``t`` of ``x`` on axis ``k``:
-        ``value = (1 - t) f[i0] + t f[i1]``."""
+        """Return the cell index ``i0``, ``i1`` and weight ``t`` of ``x`` on axis ``k``.
+
+        ``value = (1 - t) f[i0] + t f[i1]``.
+        """
         name, nodes = self.axes[k], self.nodes[k]
         lo, hi = nodes[0], nodes[-1]
         inside = ((x >= lo) | same_node(x, lo)) & ((x <= hi) | same_node(x, hi))
@@ -233,7 +235,7 @@ def incidence(angle_deg, mu, nu):
     if not np.all((nu >= 0.0) & (nu <= 0.5)):
         raise InputError(f"nu = {float(nu[~((nu >= 0) & (nu <= 0.5))].flat[0])!r} is not "
                          "allowed: must be in [0, 0.5]")
-    from vimpact.sweep.parameters import incidence as psi_of  # the one psi rule
+    from vimpact.tableformat.parameters import incidence as psi_of  # the one psi rule
 
     ratio = np.tan(np.radians(angle))
     psi = psi_of(mu, nu, ratio, np.ones_like(ratio))
@@ -269,7 +271,7 @@ def validate_table(data: pd.DataFrame, metadata: dict, path=None) -> None:
     path : the file, for the messages
     """
     where = f"table = {str(path)!r}" if path is not None else "the table"
-    if _META_PREFIX + "model" not in metadata:
+    if META_PREFIX + "model" not in metadata:
         raise InputError(f"{where} is not allowed: it has no vimpact metadata (no key "
                          "vimpact.model): not a restitution table written by `vimpact sweep`")
     status = data["status"].astype(str).to_numpy()
@@ -367,12 +369,12 @@ class RestitutionTable:
         self.metadata: dict[str, str] = {}
         for key, value in (metadata or {}).items():
             key = key.decode() if isinstance(key, bytes) else str(key)
+            if not key.startswith(META_PREFIX):
+                key = META_PREFIX + key
             if isinstance(value, bytes):
                 value = value.decode()
-            elif not isinstance(value, str):
-                value = json.dumps(value)
-            if not key.startswith(_META_PREFIX):
-                key = _META_PREFIX + key
+            elif not isinstance(value, str):  # stored as the writer stores it
+                value = encode_value(key[len(META_PREFIX):], value)
             self.metadata[key] = value
         if self.model == "standard_solid" and "Q2" not in self.data.columns:
             raise InputError(f"the standard_solid table{self._where(path)} lacks the column Q2")
@@ -388,12 +390,14 @@ class RestitutionTable:
     # ---- reading and writing -------------------------------------------
     @classmethod
     def open(cls, path, validate: bool = True) -> RestitutionTable:
-        """Read a restitution table and its ``vimpact.*`` metadata: one Parquet file, or a
-        partitioned dataset written by a large sweep (a directory of part files plus
-        ``_common_metadata``, which holds the metadata).
+        """Read a restitution table and its ``vimpact.*`` metadata.
+
+        The table is one Parquet file, or a partitioned dataset written by a large
+        sweep (a directory of part files plus ``_common_metadata``, which holds the
+        metadata).
 
         The table is checked before use: the file's integrity (page checksums and the
-        content hash, :func:`vimpact.sweep.store.verify_table`, where available), then
+        content hash, :func:`vimpact.tableformat.integrity.verify_table`, where available), then
         its rows (:func:`validate_table`: vimpact metadata, known statuses, finite
         outputs within their physical bounds in data rows, axes in their domains, no
         duplicated node). ``validate=False`` skips both (to inspect a damaged file).
@@ -405,8 +409,7 @@ class RestitutionTable:
         """
         import pyarrow.parquet as pq
 
-        from vimpact.sweep import store
-        from vimpact.sweep.store import COMMON_METADATA
+        from vimpact.tableformat.integrity import verify_table
 
         p = Path(path)
         if p.is_dir():
@@ -418,9 +421,8 @@ class RestitutionTable:
         elif not p.is_file():
             raise InputError(f"table = {str(path)!r} is not allowed: no such file "
                              "(a Parquet restitution table written by `vimpact sweep`)")
-        integrity = getattr(store, "verify_table", None)
-        if validate and integrity is not None:
-            integrity(p)
+        if validate:
+            verify_table(p)
         try:
             arrow = pq.read_table(p)
             raw = (pq.read_schema(p / COMMON_METADATA) if p.is_dir() else arrow.schema).metadata
@@ -429,10 +431,10 @@ class RestitutionTable:
             raise InputError(f"table = {str(path)!r} is not allowed: not a readable Parquet "
                              f"file ({type(exc).__name__}: {why})") from None
         meta = {k.decode(): v.decode() for k, v in (raw or {}).items()
-                if k.decode().startswith(_META_PREFIX)}
+                if k.decode().startswith(META_PREFIX)}
         if p.is_dir():  # the parts' schemas carry per-chunk bookkeeping
             arrow = arrow.replace_schema_metadata(None)
-        if validate and _META_PREFIX + "model" not in meta:
+        if validate and META_PREFIX + "model" not in meta:
             validate_table(arrow.slice(0, 0).to_pandas(), meta, p)  # foreign: before the columns
         table = cls(arrow.to_pandas(), meta, path=p)
         if validate:
@@ -454,11 +456,11 @@ class RestitutionTable:
         """Write the table as Parquet with its ``vimpact.*`` metadata (what :meth:`open` reads)."""
         import pyarrow as pa
 
-        from vimpact.sweep.store import write_atomic
+        from vimpact.tableformat.files import write_atomic
 
         arrow = pa.Table.from_pandas(self.data, preserve_index=False)
         meta = dict(arrow.schema.metadata or {})
-        meta[(_META_PREFIX + "model").encode()] = self.model.encode()  # what open() requires
+        meta[(META_PREFIX + "model").encode()] = self.model.encode()  # what open() requires
         meta.update({k.encode(): v.encode() for k, v in self.metadata.items()})
         # atomically, with page checksums and fresh content/metadata hashes (the stored
         # ones describe the file this table was read from, not these columns)
@@ -467,12 +469,14 @@ class RestitutionTable:
 
     # ---- metadata --------------------------------------------------------
     def meta(self, key: str, default=None):
-        """Metadata value ``vimpact.<key>``, decoded by the sweep's metadata codec
-        (:func:`vimpact.sweep.store.decode_value`: JSON keys such as ``units``,
-        ``numerics``, ``paths`` parsed, integer keys such as ``rows`` as ints)."""
-        from vimpact.sweep.store import decode_value
+        """Return the metadata value ``vimpact.<key>``, decoded.
 
-        value = self.metadata.get(_META_PREFIX + key)
+        Decoded by the table format's metadata codec
+        (:func:`vimpact.tableformat.metadata.decode_value`: JSON keys such as
+        ``units``, ``numerics``, ``paths`` parsed, integer keys such as ``rows`` as
+        ints).
+        """
+        value = self.metadata.get(META_PREFIX + key)
         if value is None:
             return default
         return decode_value(key, value)
@@ -480,7 +484,7 @@ class RestitutionTable:
     @property
     def model(self) -> str:
         """Rheology of the table (``vimpact.model``; inferred from ``Q2`` if missing)."""
-        model = self.metadata.get(_META_PREFIX + "model")
+        model = self.metadata.get(META_PREFIX + "model")
         if model:
             return model
         if "Q2" in self.data.columns and (self.data["Q2"].to_numpy(float) > 0).any():
@@ -500,7 +504,7 @@ class RestitutionTable:
 
     @property
     def version(self) -> str | None:
-        """vimpact version that wrote the table."""
+        """Vimpact version that wrote the table."""
         return self.meta("version")
 
     # ---- rows ------------------------------------------------------------
@@ -513,8 +517,11 @@ class RestitutionTable:
         return len(self.data)
 
     def info(self) -> dict:
-        """Summary: model, rows, ok rows, status counts, covered ranges, grid,
-        numerics, version (JSON-serializable; ``str(table)`` is the readable form)."""
+        """Return a summary of the table.
+
+        Model, rows, ok rows, status counts, covered ranges, grid, numerics, version
+        (JSON-serializable; ``str(table)`` is the readable form).
+        """
         ok = self.ok
         params = ["Q1"] + (["Q2"] if self.model == "standard_solid" else []) + ["nu"]
         params += [c for c in ("theta_ratio", "psi", "mu") if c in self.data.columns]
@@ -572,25 +579,25 @@ class RestitutionTable:
     # ---- adaptive tables --------------------------------------------------
     @property
     def is_adaptive(self) -> bool:
-        """The table is adaptive (``vimpact.mode = adaptive``: cells refined locally, its
-        structure in ``vimpact.adaptive``; :mod:`vimpact.lookup.adaptive`), not a grid."""
+        """Whether the table is adaptive, not a grid.
+
+        ``vimpact.mode = adaptive``: cells refined locally, its structure in
+        ``vimpact.adaptive`` (:mod:`vimpact.lookup.adaptive`).
+        """
         return self.meta("mode") == "adaptive"
 
     def adaptive_grid(self):
-        """The :class:`vimpact.lookup.adaptive.AdaptiveGrid` of an adaptive table (built
-        once from its node rows and ``vimpact.adaptive``)."""
+        """Return the :class:`vimpact.lookup.adaptive.AdaptiveGrid` of an adaptive table.
+
+        It is built once from its node rows and ``vimpact.adaptive``.
+        """
         if self._adaptive is None:
             from vimpact.lookup.adaptive import AdaptiveGrid
 
             if not self.is_adaptive:
                 raise InputError(f"the table{self._where(self.path)} is not adaptive "
                                  "(vimpact.mode is not 'adaptive')")
-            raw = self.metadata.get(_META_PREFIX + "adaptive")
-            try:
-                meta = json.loads(raw) if raw is not None else None
-            except ValueError:
-                meta = None
-            self._adaptive = AdaptiveGrid.from_rows(meta, self.data)
+            self._adaptive = AdaptiveGrid.from_rows(self.meta("adaptive"), self.data)
         return self._adaptive
 
     # ---- lookup ----------------------------------------------------------
@@ -602,7 +609,7 @@ class RestitutionTable:
             else np.array([])
 
     def _resolve_theta(self, theta_ratio) -> float | None:
-        """The theta_ratio slice to use (None: the table has one value / no column)."""
+        """Return the theta_ratio slice to use (None: the table has one value / no column)."""
         if "theta_ratio" not in self.data.columns:
             if theta_ratio is not None and not same_node(theta_ratio, DEFAULT_THETA_RATIO):
                 raise InputError(
@@ -625,7 +632,7 @@ class RestitutionTable:
         return None if len(values) == 1 else float(match[0])
 
     def _psi_values(self) -> np.ndarray:
-        """The distinct friction incidences ``psi`` of the table (empty: no psi column)."""
+        """Return the distinct friction incidences ``psi`` of the table (empty: no psi column)."""
         if "psi" not in self.data.columns:
             return np.array([])
         v = self.data["psi"].to_numpy(float)
@@ -640,8 +647,10 @@ class RestitutionTable:
         return ["Q1", "Q2", "nu"] if model == "standard_solid" else ["Q1", "nu"]
 
     def _grid(self, theta: float | None) -> _Grid:
-        """The grid at one ``theta_ratio`` (None: the table's only one): axes ``Q1``,
-        (``Q2``), ``nu`` and ``psi`` if the table has a psi column."""
+        """Return the grid at one ``theta_ratio`` (None: the table's only one).
+
+        Axes ``Q1``, (``Q2``), ``nu`` and ``psi`` if the table has a psi column.
+        """
         if theta in self._grids:
             return self._grids[theta]
         axes = self._base_axes() + (["psi"] if len(self._psi_values()) else [])
@@ -653,8 +662,11 @@ class RestitutionTable:
         return grid
 
     def _lookup_grid(self) -> _Grid:
-        """The grid over every lookup axis: ``Q1``, (``Q2``), ``nu``, ``theta_ratio`` (when
-        the table holds several values), ``psi`` (when it has a psi column)."""
+        """Return the grid over every lookup axis.
+
+        ``Q1``, (``Q2``), ``nu``, ``theta_ratio`` (when the table holds several
+        values), ``psi`` (when it has a psi column).
+        """
         key = "all axes"
         if key in self._grids:
             return self._grids[key]
@@ -713,8 +725,10 @@ class RestitutionTable:
         return _Grid(axes, list(nodes), values, failed)
 
     def _hermite_grid(self, theta: float | None, grid: _Grid | None = None):
-        """The cubic interpolant of the grid for ``theta`` (or of ``grid``, cached under
-        ``theta``; slopes computed once)."""
+        """Return the cubic interpolant of the grid for ``theta``.
+
+        Or of ``grid``, cached under ``theta``; slopes computed once.
+        """
         if theta not in self._hermite:
             from vimpact.lookup.interpolate import HermiteGrid
 
@@ -725,23 +739,22 @@ class RestitutionTable:
 
     @property
     def interpolation_error(self) -> dict | None:
-        """The measured interpolation error (metadata ``vimpact.interpolation_error``,
-        written by :func:`vimpact.lookup.verify.interpolation_error` /
-        ``vimpact table verify --write``), or None if not measured."""
-        raw = self.metadata.get(_META_PREFIX + "interpolation_error")
-        if raw is None:
-            return None
-        try:
-            value = json.loads(raw)
-        except ValueError:
-            return None
+        """The measured interpolation error, or None if not measured.
+
+        Metadata ``vimpact.interpolation_error``, written by
+        :func:`vimpact.tablebuild.verify.interpolation_error` / ``vimpact table verify
+        --write``.
+        """
+        value = self.meta("interpolation_error")
         return value if isinstance(value, dict) else None
 
     def error_bound(self, method: str = "cubic") -> dict | None:
-        """Output -> the error bound measured between the nodes for ``method``
-        (``{"e_z": ..., "beta_x": ..., "e_x": ...}``: the stored ``bound``, 1.5 times
+        """Return the error bound measured between the nodes for ``method``, per output.
+
+        ``{"e_z": ..., "beta_x": ..., "e_x": ...}`` (the stored ``bound``, 1.5 times
         the largest error found at the held-out points, see
-        :data:`vimpact.lookup.verify.BOUND_FACTOR`), or None if not measured."""
+        :data:`vimpact.tablebuild.verify.BOUND_FACTOR`), or None if not measured.
+        """
         err = self.interpolation_error
         if not err or err.get("method", "cubic") != method:
             return None
@@ -753,8 +766,7 @@ class RestitutionTable:
 
     def lookup(self, Q1, nu, Q2=None, extrapolate: bool = False, theta_ratio=None,
                method: str = "cubic", psi=None) -> dict:
-        """Interpolate ``e_z``, ``e_x``, ``beta_x`` at ``Q1``, ``nu`` (``Q2``, ``theta_ratio``,
-        ``psi``).
+        """Interpolate ``e_z``, ``e_x``, ``beta_x`` at ``Q1``, ``nu`` (``Q2``, ``theta_ratio``, ``psi``).
 
         ``method="cubic"`` (default): tensor-product cubic Hermite in ``log Q1``,
         ``log Q2``, ``nu``, ``log theta_ratio`` and ``psi`` (the axes the table has),
@@ -907,10 +919,11 @@ class RestitutionTable:
         return result
 
     def to_xarray(self, theta_ratio=None):
-        """The grid as an :class:`xarray.Dataset`: data variables ``e_z``, ``e_x``,
-        ``beta_x`` (dimensionless) over the labelled axes ``Q1``, (``Q2``), ``nu``,
-        (``theta_ratio`` when the table holds several, ``psi`` when it has a psi
-        column); ``theta_ratio`` (one of the table's values) selects that slice.
+        """Return the grid as an :class:`xarray.Dataset`.
+
+        Data variables ``e_z``, ``e_x``, ``beta_x`` (dimensionless) over the labelled
+        axes ``Q1``, (``Q2``), ``nu``, (``theta_ratio`` when the table holds several,
+        ``psi`` when it has a psi column); ``theta_ratio`` (one of the table's values) selects that slice.
 
         Units and descriptions are attributes of each variable and axis; the
         dataset's attributes hold the model, numerics, interpolation error and
@@ -1052,7 +1065,7 @@ class RestitutionTable:
         p = Path(path)
         require("out", str(path), p.suffix.lower() == ".csv", "a file name ending in .csv")
         require("out", str(path), p.parent.is_dir(), "in an existing directory")
-        from vimpact.sweep.store import atomic_file, refuse_symlink
+        from vimpact.tableformat.files import atomic_file, refuse_symlink
         refuse_symlink(p, "out")  # before the work
         df = self.restitution_curve(material, R, m, v_z0, **options)
         with atomic_file(p, "out", mode="w") as f:  # never through a symbolic link

@@ -8,7 +8,7 @@ from __future__ import annotations
 import contextlib
 from pathlib import Path
 
-from vimpact.sweep.store import atomic_file, refuse_symlink
+from vimpact.tableformat.files import atomic_file, refuse_symlink
 
 __all__ = ["FORMATS", "STYLE", "check_out", "drawing"]
 

@@ -33,6 +33,7 @@ from vimpact.model.hertz import Q1_PER_TAU
 from vimpact.model.material import shear_modulus
 from vimpact.model.scene import REFERENCE_INDENTATION
 from vimpact.model.toml_input import tangential_speed
+from vimpact.tableformat.parameters import incidence, psi_reference
 
 #: The reference scene of :meth:`vimpact.Scene.from_dimensionless`: R = 1 m,
 #: m = 1 kg, v_z0 = v_x0 = 1 m/s, omega0 = 0, Hertz indentation d = 1e-4 m.
@@ -40,12 +41,12 @@ REFERENCE = {"R_m": 1.0, "m_kg": 1.0, "v_z0_m_s": 1.0, "v_x0_m_s": 1.0, "omega0_
 
 
 def chunk_generator(seed: int, chunk: int) -> np.random.Generator:
-    """The random generator of ``chunk``: ``SeedSequence(seed, spawn_key=(chunk,))``."""
+    """Return the random generator of ``chunk``: ``SeedSequence(seed, spawn_key=(chunk,))``."""
     return np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(chunk,)))
 
 
 def chunk_parameters(spec, chunk: int) -> dict[str, np.ndarray]:
-    """The parameter sets of ``chunk`` of ``spec``: one array per input.
+    """Return the parameter sets of ``chunk`` of ``spec``: one array per input.
 
     Grid mode: the axis values of rows ``chunk_rows(chunk)``. Random mode: the
     drawn physical inputs, ``G_arm<i>_Pa`` and ``tau_arm<i>_s`` for Prony arms.
@@ -67,44 +68,6 @@ def chunk_parameters(spec, chunk: int) -> dict[str, np.ndarray]:
     if "angle_deg" in out:  # drawn instead of v_x0 (no draw of its own)
         out["v_x0_m_s"] = tangential_speed(out["v_z0_m_s"], out["angle_deg"])
     return out
-
-
-def psi_reference(psi: np.ndarray, nu: np.ndarray, mu: float,
-                  v_z0: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
-    """Tangential speed and friction coefficient of the reference scene at incidence ``psi``.
-
-    With friction the result depends on ``psi = 2 (1 - nu) / (mu (2 - nu)) v_c0 / v_z0``
-    (and ``chi``, fixed by ``nu`` and ``theta_ratio``), not on ``mu`` and ``v_c0``
-    apart, so a grid row with ``psi > 0`` takes the given ``mu`` and
-    ``v_x0 = psi mu (2 - nu) / (2 (1 - nu)) v_z0`` (``nu <= 0.5``: no division by 0).
-    ``psi = 0`` is the limit ``mu -> inf`` at ``v_c0 != 0``: full stick, the stick
-    grid's row (``v_x0 = v_z0``, ``mu = inf``), not a normal impact.
-
-    Parameters
-    ----------
-    psi : incidence, dimensionless, >= 0
-    nu : Poisson ratio, dimensionless, in [0, 0.5]
-    mu : friction coefficient of the rows with ``psi > 0``, dimensionless, > 0
-    v_z0 : normal impact speed of the reference scene, m/s
-
-    Returns
-    -------
-    ``(v_x0, mu)``: m/s and dimensionless, one value per row.
-    """
-    psi = np.asarray(psi, dtype=float)
-    stick = psi == 0.0
-    v_x0 = np.where(stick, v_z0, psi * mu * (2.0 - nu) / (2.0 * (1.0 - nu)) * v_z0)
-    return v_x0, np.where(stick, np.inf, mu)
-
-
-def incidence(mu: np.ndarray, nu: np.ndarray, v_c0: np.ndarray, v_z0: np.ndarray) -> np.ndarray:
-    """``psi = 2 (1 - nu) / (mu (2 - nu)) v_c0 / v_z0`` (dimensionless) of physical rows:
-    0 for full stick (``mu = inf``) and for ``v_c0 = 0``; ``inf`` (signed) for ``mu = 0``
-    with ``v_c0 != 0`` (frictionless)."""
-    with np.errstate(divide="ignore", invalid="ignore"):
-        psi = 2.0 * (1.0 - nu) / (mu * (2.0 - nu)) * v_c0 / v_z0
-        frictionless = np.sign(v_c0) * np.inf
-    return np.where(v_c0 == 0.0, 0.0, np.where(mu == 0.0, frictionless, psi))
 
 
 def engine_columns(spec, p: dict[str, np.ndarray]) -> tuple[list[tuple[np.ndarray, dict]], dict]:

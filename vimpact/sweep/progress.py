@@ -77,7 +77,7 @@ class Progress:
                     nrows=None if sized else 24, smoothing=0.1)
 
     def line(self) -> str:
-        """The progress line: rows done/total, rows/s of this run, time left."""
+        """Return the progress line: rows done/total, rows/s of this run, time left."""
         elapsed = time.monotonic() - self.t0
         new = self.done - self.initial
         rate = new / elapsed if elapsed > 0 else 0.0
@@ -102,6 +102,7 @@ class Progress:
                 print(self.line(), file=self.stream, flush=True)
 
     def close(self, finished: bool = True) -> None:
+        """Close the bar (or print the last line when ``finished``)."""
         if self.bar is not None:
             self.bar.close()
             self.bar = None

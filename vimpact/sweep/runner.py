@@ -18,20 +18,11 @@ Every backend writes the same part files (:mod:`vimpact.sweep.store`), so they
 can be mixed: a sweep started on a cluster can be resumed in-process, shards
 can be combined anywhere, and the table is the same bit for bit.
 
-``[grid] tolerance`` (:attr:`SweepSpec.grid_tolerance`): before any chunk is
-made, :func:`refined_spec` refines the grid axes with
-:func:`vimpact.lookup.refine.refine_grid` until the cubic lookup meets the
-tolerance between the nodes (progress on stderr), so chunking, resume and
-shards all see the final axes. The refined axes are deterministic and cached in
-the parts directory (:data:`GRID_CACHE`), so ``--resume``, shards and
-``--combine`` do not refine again. A tolerance the refinement cannot reach
-within its node budget (:data:`vimpact.lookup.refine.MAX_AXIS_NODES` per axis,
-:data:`vimpact.lookup.refine.MAX_NODES` rows) is refused with an
-:class:`~vimpact.model.validation.InputError` before anything is written. The
-table's metadata then holds the refinement report as ``grid_refinement``
-(JSON: nodes inserted per round and axis, the cells they split and the error
-found there, and the held-out check it reached) and, measured on the finished
-table as ``vimpact table verify --write`` does, ``interpolation_error``.
+``[grid] tolerance`` (:attr:`SweepSpec.grid_tolerance`): the grid is refined
+before any chunk is made and the finished table's interpolation error measured,
+by the table-build workflow above the sweep (:mod:`vimpact.tablebuild.sweep`,
+which runs :func:`run_sweep` with its :class:`SweepStages`); a plain
+:func:`run_sweep` refuses such a spec.
 
 Python API::
 
@@ -44,8 +35,6 @@ Python API::
 from __future__ import annotations
 
 import dataclasses
-import json
-import math
 import os
 import socket
 import sys
@@ -54,7 +43,6 @@ from pathlib import Path
 
 import numpy as np
 
-from vimpact.model.scene import DEFAULT_THETA_RATIO
 from vimpact.model.validation import InputError
 from vimpact.sweep import store
 from vimpact.sweep.progress import Progress
@@ -164,9 +152,12 @@ def _isnull(values: np.ndarray) -> np.ndarray:
 
 def guard_nan(cols: dict, status: np.ndarray, error: np.ndarray, vc0_zero: np.ndarray,
               finished: np.ndarray) -> None:
-    """NaN only with a status that explains it: a finished row with a NaN output that no
+    """Allow NaN only with a status that explains it.
+
+    A finished row with a NaN output that no
     status explains (``e_x``, ``beta_x`` are NaN when ``v_c0 = 0``) becomes
-    ``non_finite`` with all outputs NaN and the columns named in ``error``."""
+    ``non_finite`` with all outputs NaN and the columns named in ``error``.
+    """
     explained = np.broadcast_to(np.asarray(vc0_zero, dtype=bool), finished.shape)
     nothing = np.zeros(finished.shape, dtype=bool)
     bad_cols = {c: np.isnan(cols[c]) & finished
@@ -181,8 +172,10 @@ def guard_nan(cols: dict, status: np.ndarray, error: np.ndarray, vc0_zero: np.nd
 
 
 def chunk_summary(table) -> dict:
-    """The small summary a part stores and a task returns: rows per status (``counts``)
-    and rows and first row per kernel path (``paths``)."""
+    """Return the small summary a part stores and a task returns.
+
+    Rows per status (``counts``) and rows and first row per kernel path (``paths``).
+    """
     status = table.column("status").to_numpy(zero_copy_only=False)
     names, counts = np.unique(status.astype(str), return_counts=True)
     path = np.asarray(table.column("path").to_pylist(), dtype=object)
@@ -233,160 +226,53 @@ def _dask_task(spec: SweepSpec, chunk: int, parts: str) -> dict:
     return out
 
 
-# ---- [grid] tolerance: the refined grid ---------------------------------------------
+# ---- stages: what a workflow above the sweep adds -----------------------------------
 
-#: The refined axes of a sweep with ``[grid] tolerance``, in its parts directory (the
-#: leading underscore keeps it out of a Parquet dataset's files).
-GRID_CACHE = "_grid_refinement.json"
-#: Models whose grids can be refined (their lookups are cubic in log Q1 (, log Q2), nu).
-REFINABLE = ("kelvin_voigt", "standard_solid")
+def _as_is(spec: SweepSpec, parts: Path, log: Callable[[str], None] | None) -> SweepSpec:
+    """Return the spec to chunk when no workflow prepares it: the spec itself.
+
+    A grid with a ``tolerance`` is refused (its refinement is the table-build
+    workflow's).
+    """
+    tol = getattr(spec, "grid_tolerance", None)
+    if tol is not None and spec.mode == "grid":
+        raise InputError(f"grid.tolerance = {tol!r} is not allowed in a plain sweep of "
+                         f"{spec.path.name}: a grid refined to a tolerance is built by "
+                         "vimpact.tablebuild.sweep.run_sweep (`vimpact sweep SPEC` runs it)")
+    return spec
+
+
+def _done(spec: SweepSpec, out: Path, log: Callable[[str], None] | None, again: bool) -> None:
+    """Nothing to add to a finished table."""
 
 
 @dataclasses.dataclass(frozen=True)
-class RefinedSweepSpec(SweepSpec):
-    """A grid :class:`SweepSpec` whose axes were refined to its ``grid_tolerance``;
-    ``grid_refinement`` (JSON text, the report of
-    :func:`vimpact.lookup.refine.refine_grid`) goes into the parts' and the table's
-    metadata."""
+class SweepStages:
+    """What a workflow above the sweep adds to a run of :func:`run_sweep`.
 
-    grid_refinement: str = ""
+    The sweep makes, checks and combines the chunks of a spec; a workflow (the table
+    build, :mod:`vimpact.tablebuild.sweep`) may change the spec before the chunks
+    are made and add to the table once it is written, without the sweep knowing it.
 
-    def metadata(self) -> dict:
-        return {**super().metadata(), "grid_refinement": self.grid_refinement}
-
-
-def _write_json_atomic(path: Path, value: dict) -> None:
-    with store.atomic_file(path, str(path), mode="w") as f:  # never through a symlink
-        json.dump(value, f)
-
-
-def _read_grid_cache(path: Path, spec: SweepSpec):
-    """The cached ``(axes, report)`` of this sweep (same sweep hash), or None."""
-    try:
-        cached = json.loads(path.read_text())
-        if cached.get("sweep_hash") != spec.sweep_hash:
-            return None
-        return ({a: np.asarray(v, dtype=float) for a, v in cached["axes"].items()},
-                cached["report"])
-    except (OSError, ValueError, KeyError, TypeError, AttributeError):
-        return None
-
-
-def _reached(report: dict) -> str:
-    final = report.get("final", {}).get("outputs", {})
-    parts = [f"{k} {final[k]['max']:.3g}" for k in report.get("outputs", ())
-             if isinstance(final.get(k), dict) and final[k].get("max") is not None]
-    return ", ".join(parts) or "none measured (every held-out simulation failed)"
-
-
-def refined_spec(spec: SweepSpec, parts: Path, log: Callable[[str], None] | None = None
-                 ) -> SweepSpec:
-    """``spec`` with its grid axes refined to ``spec.grid_tolerance`` (``spec`` itself
-    without one).
-
-    The refinement (:func:`vimpact.lookup.refine.refine_grid`, with the spec's
-    numerics and scene options, cubic lookup, outputs ``e_z`` and ``beta_x``) is read
-    from ``parts/GRID_CACHE`` when a run of the same sweep (same sweep hash) made it,
-    and written there otherwise.
-
-    Parameters
+    Attributes
     ----------
-    spec : a grid spec
-    parts : the sweep's parts directory (created if needed)
-    log : called with one line of progress per refinement round (or None)
-
-    Raises
-    ------
-    InputError
-        ``grid.tolerance`` on a grid that cannot be refined (elastic, several
-        ``theta_ratio`` values), or a tolerance the refinement did not reach within
-        its node budget: the message gives the smallest error it reached.
+    prepare : ``prepare(spec, parts, log) -> spec``: the spec whose chunks are made,
+        called under the output's lock before any chunk (default: the spec itself;
+        a grid with ``tolerance`` is refused)
+    finish : ``finish(spec, out, log, again)``: called after the table ``out`` is
+        written, and with ``again=True`` when a run finds it already complete
+    kept : names of the workflow's own files in the parts directory: they leave it
+        while the parts are combined (the directory must then hold only parts) and
+        come back if the combination fails
     """
-    tol = getattr(spec, "grid_tolerance", None)
-    if tol is None or spec.mode != "grid":
-        return spec
-    if getattr(spec, "grid_refine", "tensor") == "adaptive":
-        raise InputError(f'grid.refine = "adaptive" is not allowed for a sweep of '
-                         f"{spec.path.name}: an adaptive table is built cell by cell, not in "
-                         f"chunks; build it with `vimpact table build {spec.path}`")
-    from vimpact.lookup import refine
 
-    if spec.model not in REFINABLE:
-        raise InputError(f"grid.tolerance = {tol!r} is not allowed for a {spec.model} grid: "
-                         f"only {' and '.join(REFINABLE)} grids are refined (remove it)")
-    theta = np.asarray(spec.axes.get("theta_ratio", [DEFAULT_THETA_RATIO]), dtype=float)
-    if theta.size != 1:
-        raise InputError(f"grid.tolerance = {tol!r} is not allowed with {theta.size} "
-                         "theta_ratio values: a refined grid has one theta_ratio (one "
-                         "spec per value)")
-    if "psi" in spec.axes:
-        raise InputError(f"grid.tolerance = {tol!r} is not allowed with a psi axis: the "
-                         "refinement covers Q1, Q2 and nu of stick grids (check a psi grid "
-                         "with vimpact table verify instead)")
-    cache = Path(parts) / GRID_CACHE
-    cached = _read_grid_cache(cache, spec)
-    if cached is not None:
-        axes, report = cached
-        if log is not None:
-            log(f"refined grid read from {cache}")
-    else:
-        start = {a: spec.axes[a] for a in ("Q1", "Q2", "nu") if a in spec.axes}
-        if log is not None:
-            log(f"refining the grid to tolerance {tol:g} ("
-                + " x ".join(f"{a} {len(v)}" for a, v in start.items()) + " nodes)")
-        axes, report = refine.refine_grid(
-            spec.model, start, float(tol), spec.numerics, theta_ratio=float(theta[0]),
-            tangential=spec.tangential, tangential_memory=spec.tangential_memory,
-            rotation=spec.rotation, max_nodes=refine.MAX_NODES,
-            max_axis_nodes=refine.MAX_AXIS_NODES, progress=log)
-        if not report["met"]:
-            raise InputError(
-                f"grid.tolerance = {tol:g} is not allowed for this grid: the refinement "
-                f"did not reach it within its budget ({refine.MAX_AXIS_NODES} nodes per "
-                f"axis, {refine.MAX_NODES} rows; stopped: {report['stopped']}); the "
-                f"smallest error it reached, at held-out points of its finest grid: "
-                f"{_reached(report)}. Nothing was written: loosen grid.tolerance or "
-                "narrow the axes")
-        Path(parts).mkdir(parents=True, exist_ok=True)
-        _write_json_atomic(cache, {"sweep_hash": spec.sweep_hash,
-                                   "axes": {a: [float(x) for x in v] for a, v in axes.items()},
-                                   "report": report})
-        if log is not None:
-            log("refined grid: " + " x ".join(f"{a} {len(v)}" for a, v in axes.items())
-                + f" nodes, held-out error {_reached(report)}")
-    new_axes = {k: (np.asarray(axes[k], dtype=float) if k in axes else v)
-                for k, v in spec.axes.items()}
-    fields = {f.name: getattr(spec, f.name) for f in dataclasses.fields(spec)
-              if f.name != "grid_refinement"}
-    fields.update(axes=new_axes, rows=math.prod(len(v) for v in new_axes.values()))
-    return RefinedSweepSpec(**fields, grid_refinement=json.dumps(report))
+    prepare: Callable[..., SweepSpec] = _as_is
+    finish: Callable[..., None] = _done
+    kept: tuple[str, ...] = ()
 
 
-def measure_interpolation_error(spec: SweepSpec, out: Path, log=None) -> dict | None:
-    """Measure the finished table's interpolation error and store it in its metadata,
-    as ``vimpact table verify TABLE --write`` does (:func:`vimpact.lookup.verify.
-    interpolation_error` with its defaults, :func:`vimpact.lookup.verify.
-    write_interpolation_error`). Only for a refined grid (``grid_tolerance`` set)."""
-    if getattr(spec, "grid_tolerance", None) is None or spec.mode != "grid":
-        return None
-    from vimpact.lookup.table import RestitutionTable
-    from vimpact.lookup.verify import interpolation_error, write_interpolation_error
-
-    table = RestitutionTable.open(out)
-    if log is not None:
-        log("measuring the interpolation error at held-out points (table verify)")
-    result = interpolation_error(table)
-    write_interpolation_error(table, result)
-    worst = {k: v["max"] for k, v in result["outputs"].items() if k in ("e_z", "beta_x")}
-    if log is not None:
-        log("interpolation error stored: " + ", ".join(
-            f"{k} max {v:.3g}" if v is not None else f"{k} not measured"
-            for k, v in worst.items()))
-        if any(v is None or v > spec.grid_tolerance for v in worst.values()):
-            log(f"warning: the measured error exceeds grid.tolerance = "
-                f"{spec.grid_tolerance:g} at some held-out point; the table stores the "
-                "measurement as it is")
-    return result
+#: A plain sweep: the spec as it is, nothing added.
+PLAIN = SweepStages()
 
 
 def _stderr_log(progress) -> Callable[[str], None] | None:
@@ -401,7 +287,8 @@ def run_sweep(spec_path, out=None, resume: bool = False,
               progress: Callable[[int, int], None] | None | bool = None, *,
               workers: int | None = None, scheduler: str | None = None,
               shard: tuple[int, int] | None = None, combine: bool = False,
-              chunk_order=None, timings: dict | None = None) -> Path:
+              chunk_order=None, timings: dict | None = None,
+              stages: SweepStages = PLAIN) -> Path:
     """Run the sweep of a TOML specification and write its Parquet table.
 
     Parameters
@@ -423,6 +310,9 @@ def run_sweep(spec_path, out=None, resume: bool = False,
         ascending); the table does not depend on it
     timings : in-process only: a dict that receives ``kernel_s`` and ``total_s`` of
         :func:`vimpact.simulate_batch` summed over the chunks
+    stages : what a workflow above the sweep adds (:class:`SweepStages`; default
+        none: a grid with ``tolerance`` is refused, see
+        :func:`vimpact.tablebuild.sweep.run_sweep`)
 
     Returns
     -------
@@ -434,8 +324,8 @@ def run_sweep(spec_path, out=None, resume: bool = False,
         for a bad spec or output, parts of another run, parts without ``resume``,
         missing chunks at ``combine``, a second sweep into the same output;
         :class:`~vimpact.model.validation.InputError` (a ``ValueError``) for a
-        ``[grid] tolerance`` the refinement cannot reach within its node budget
-        (:func:`refined_spec`), before anything is written.
+        ``[grid] tolerance`` without the table-build stages, before anything is
+        written.
     SweepInterrupted
         (a ``KeyboardInterrupt``) on Ctrl-C: finished chunks stay; the message
         says how to resume.
@@ -463,29 +353,32 @@ def run_sweep(spec_path, out=None, resume: bool = False,
         if shard is not None:  # shards run side by side (SLURM array): a shared lock
             with store.OutputLock(out, shared=True):
                 return _run(spec, spec_path, out, parts, True, progress, workers, scheduler,
-                            shard, False, chunk_order, timings)
+                            shard, False, chunk_order, timings, stages)
         with store.OutputLock(out):
             return _run(spec, spec_path, out, parts, resume, progress, workers, scheduler, None,
-                        combine, chunk_order, timings)
+                        combine, chunk_order, timings, stages)
     finally:
         if scheduler is not None and not isinstance(scheduler, str):
             scheduler.close()
 
 
 def _run(spec, spec_path, out, parts, resume, progress, workers, scheduler, shard, combine,
-         chunk_order, timings) -> Path:
+         chunk_order, timings, stages: SweepStages) -> Path:
     layout = spec.table_layout
     log = _stderr_log(progress)
     store.remove_temporaries(out.parent, out.name)  # a final write cut short
     if store.is_complete(spec, out) and (resume or combine or shard is not None):
-        if _needs_measurement(spec, out):  # cut short after the table was written
-            measure_interpolation_error(spec, out, log)
+        stages.finish(spec, out, log, True)  # e.g. cut short after the table was written
         return out
     done: dict[int, Path] = {}
     if parts.exists() and not parts.is_dir():
         raise ValueError(f"{parts} is in the way: it should be the directory of the "
                          "finished chunks; remove it")
-    spec = refined_spec(spec, parts, log)
+    if getattr(spec, "grid_refine", "tensor") == "adaptive":
+        raise InputError(f'grid.refine = "adaptive" is not allowed for a sweep of '
+                         f"{spec.path.name}: an adaptive table is built cell by cell, not in "
+                         f"chunks; build it with `vimpact table build {spec.path}`")
+    spec = stages.prepare(spec, parts, log)
     if parts.exists():
         done = store.existing_parts(spec, parts)
         if done and not (resume or combine):
@@ -495,7 +388,7 @@ def _run(spec, spec_path, out, parts, resume, progress, workers, scheduler, shar
         if layout == "dataset" and (parts / store.COMMON_METADATA).exists():
             (parts / store.COMMON_METADATA).unlink()  # stale: rewritten at the end
     if combine:
-        _combine(spec, parts, out, log)
+        _combine(spec, parts, out, log, stages)
         return out
     parts.mkdir(parents=True, exist_ok=True)
     todo = [c for c in range(spec.n_chunks) if c not in done]
@@ -521,7 +414,7 @@ def _run(spec, spec_path, out, parts, resume, progress, workers, scheduler, shar
         bar.close()
         if shard is not None:
             return parts
-        _combine(spec, parts, out, log)
+        _combine(spec, parts, out, log, stages)
     except KeyboardInterrupt:
         bar.close(finished)
         hint = f"vimpact sweep {spec_path}" + (f" --out {out}" if out != spec.output else "")
@@ -531,33 +424,37 @@ def _run(spec, spec_path, out, parts, resume, progress, workers, scheduler, shar
     return out
 
 
-def _combine(spec: SweepSpec, parts: Path, out: Path, log) -> None:
-    """:func:`vimpact.sweep.store.combine`, then (refined grid) the measured interpolation
-    error. The refinement cache leaves the parts directory first (the directory must
-    hold only parts to be removed, a dataset only its parts); it is put back if the
-    combination fails, so that ``--resume`` still finds it."""
-    cache = Path(parts) / GRID_CACHE
-    saved = cache.read_text() if cache.is_file() else None
-    if saved is not None:
-        cache.unlink()
+def _combine(spec: SweepSpec, parts: Path, out: Path, log, stages: SweepStages) -> None:
+    """Run :func:`vimpact.sweep.store.combine`, then ``stages.finish``.
+
+    The stages' own files
+    (``stages.kept``) leave the parts directory first (the directory must hold only
+    parts to be removed, a dataset only its parts); they are put back if the
+    combination fails, so that ``--resume`` still finds them.
+    """
+    saved = {}
+    for name in stages.kept:
+        kept = Path(parts) / name
+        if kept.is_file():
+            saved[name] = kept.read_text()
+            kept.unlink()
     try:
         store.combine(spec, parts, out, lambda first: explain_paths(spec, first))
     except BaseException:
-        if saved is not None and Path(parts).is_dir():
-            _write_json_atomic(cache, json.loads(saved))
+        if Path(parts).is_dir():
+            for name, text in saved.items():
+                with store.atomic_file(Path(parts) / name, str(Path(parts) / name),
+                                       mode="w") as f:  # never through a symlink
+                    f.write(text)
         raise
-    measure_interpolation_error(spec, out, log)
-
-
-def _needs_measurement(spec: SweepSpec, out: Path) -> bool:
-    if getattr(spec, "grid_tolerance", None) is None or spec.mode != "grid":
-        return False
-    return "interpolation_error" not in store.read_metadata(out)
+    stages.finish(spec, out, log, False)
 
 
 def warm_kernels(spec: SweepSpec, rows_per_chunk: int = 2, chunks: int = 4) -> None:
-    """Compile (or load from numba's cache) the kernels the spec needs, in this process:
-    a few rows of a few chunks spread over the sweep, so that workers find them cached."""
+    """Compile (or load from numba's cache) the kernels the spec needs, in this process.
+
+    A few rows of a few chunks spread over the sweep, so that workers find them cached.
+    """
     from vimpact.engine.simulate import simulate_batch
     from vimpact.sweep.parameters import engine_columns
 
@@ -603,9 +500,11 @@ def _available_memory() -> int | None:
 
 
 def max_local_workers() -> tuple[int, str]:
-    """The most local Dask workers this machine takes (``--workers``) and why:
+    """Return the most local Dask workers this machine takes (``--workers``) and why.
+
     :data:`WORKERS_PER_CORE` per usable core, and no more than the available memory
-    holds at :data:`WORKER_MEMORY_BYTES` each (at least 1)."""
+    holds at :data:`WORKER_MEMORY_BYTES` each (at least 1).
+    """
     cores = _usable_cores()
     limit, why = WORKERS_PER_CORE * cores, f"{WORKERS_PER_CORE} per core, {cores} cores"
     memory = _available_memory()
@@ -618,8 +517,10 @@ def max_local_workers() -> tuple[int, str]:
 
 
 def check_workers(workers) -> int:
-    """``--workers`` as an int in ``[1, max_local_workers()]``, or :class:`InputError`
-    before anything starts."""
+    """Return ``--workers`` as an int in ``[1, max_local_workers()]``.
+
+    Raises :class:`InputError` before anything starts otherwise.
+    """
     limit, why = max_local_workers()
     if isinstance(workers, bool) or not isinstance(workers, int) or not 1 <= workers <= limit:
         raise InputError(f"--workers = {workers!r} is not allowed: must be an integer from 1 "
@@ -628,9 +529,11 @@ def check_workers(workers) -> int:
 
 
 def local_cluster(workers: int):
-    """A ``dask.distributed.LocalCluster`` of ``workers`` processes with one thread each
-    and ``NUMBA_NUM_THREADS=1`` in their environment (set by the nanny before the worker
-    process imports anything, so numba starts with one thread)."""
+    """Start a ``dask.distributed.LocalCluster`` of ``workers`` processes.
+
+    One thread each and ``NUMBA_NUM_THREADS=1`` in their environment (set by the nanny before the worker
+    process imports anything, so numba starts with one thread).
+    """
     from distributed import LocalCluster
     return LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
                         env={"NUMBA_NUM_THREADS": "1"}, dashboard_address=None)
@@ -646,9 +549,11 @@ def _scheduler_error(address, why: str) -> InputError:
 
 
 def _probe_scheduler(address: str, timeout: float) -> None:
-    """Refuse ``address`` unless a Dask scheduler answers its handshake within
-    ``timeout`` seconds: a refused port, an unknown host, a service that is not Dask
-    (that sends something else, or nothing) each give one :class:`InputError`."""
+    """Refuse ``address`` unless a Dask scheduler answers its handshake in time.
+
+    Within ``timeout`` seconds: a refused port, an unknown host, a service that is not Dask
+    (that sends something else, or nothing) each give one :class:`InputError`.
+    """
     import asyncio
     import concurrent.futures
 
@@ -699,9 +604,11 @@ def _probe_scheduler(address: str, timeout: float) -> None:
 
 
 def connect_scheduler(address, timeout: float = SCHEDULER_TIMEOUT_S):
-    """A ``distributed.Client`` of the Dask scheduler at ``address``, or
-    :class:`InputError` (one line naming ``--scheduler`` and the address) within about
-    ``timeout`` seconds when none answers there; nothing is written before."""
+    """Return a ``distributed.Client`` of the Dask scheduler at ``address``.
+
+    Or :class:`InputError` (one line naming ``--scheduler`` and the address) within about
+    ``timeout`` seconds when none answers there; nothing is written before.
+    """
     if not isinstance(address, str) or not address.strip():
         raise _scheduler_error(address, "must be a Dask scheduler address such as "
                                         "tcp://host:8786")
@@ -753,7 +660,6 @@ def _run_dask(spec, todo, parts, bar, done, workers, scheduler) -> None:
             cluster.close()
 
 
-__all__ = ["GRID_CACHE", "RefinedSweepSpec", "SweepInterrupted", "check_workers",
-           "chunk_summary", "compute_chunk", "connect_scheduler", "explain_paths", "guard_nan",
-           "local_cluster", "max_local_workers", "measure_interpolation_error", "refined_spec",
-           "run_chunk", "run_sweep", "warm_kernels"]
+__all__ = ["PLAIN", "SweepInterrupted", "SweepStages", "check_workers", "chunk_summary",
+           "compute_chunk", "connect_scheduler", "explain_paths", "guard_nan", "local_cluster",
+           "max_local_workers", "run_chunk", "run_sweep", "warm_kernels"]

@@ -105,7 +105,7 @@ them draws as before). The draws therefore depend on ``seed`` and
 ``chunk_size``; tables of schema version 2 drew all rows from one
 ``default_rng(seed)`` and have other draws.
 
-Columns (:data:`COLUMNS` has the unit and meaning of each; the table's metadata
+Columns (:data:`vimpact.tableformat.schema.COLUMNS` has the unit and meaning of each; the table's metadata
 ``units`` and ``columns`` too): ``row``, the physical inputs, ``Q1``, ``Q2``
 (``NaN`` on Kelvin-Voigt and elastic grid rows: no ``G2``, the limit
 ``G2 -> inf``, never ``0``; random rows of these models still get ``0`` from the
@@ -142,7 +142,6 @@ from pathlib import Path
 import numpy as np
 
 from vimpact import __version__
-from vimpact.kernels.status import TABLE as STATUS_TABLE
 from vimpact.model.material_file import inline_material
 from vimpact.model.numerics import Numerics
 from vimpact.model.scene import DEFAULT_THETA_RATIO, Scene
@@ -164,18 +163,18 @@ from vimpact.model.toml_input import (
     required_keys,
     scene_from_values,
 )
-
-#: Version of the table layout (columns, metadata keys and random draws): 3 since
-#: the draws are made per chunk from ``SeedSequence(seed, spawn_key=(chunk,))``; 4 since
-#: every table has the friction outputs (``mu_eff``, ``rebound_angle_deg``,
-#: ``gross_slip_fraction``, ``friction_energy_J``), a spec with friction the inputs
-#: ``mu`` and ``psi``, and Kelvin-Voigt and elastic grid rows ``Q2 = NaN`` (not 0).
-#: The random draws of version 3 are unchanged.
-SCHEMA_VERSION = 4
-
-#: Row statuses of a sweep table: those of :data:`vimpact.STATUSES` and ``failed``
-#: (the status table, :mod:`vimpact.kernels.status`).
-SWEEP_STATUSES = {s.name: s.message for s in STATUS_TABLE}
+from vimpact.tableformat.schema import (  # noqa: F401 - the table's schema, found here too
+    ADHESION_OUTPUTS,
+    ADHESION_RESULTS,
+    COLUMNS,
+    LABELS,
+    OUTPUTS,
+    RELATIVE,
+    RESULTS,
+    SCHEMA_VERSION,
+    SWEEP_STATUSES,
+    TANGENTIAL_OUTPUTS,
+)
 
 DEFAULT_CHUNK_SIZE = 64
 #: Rows of one sweep at most (a grid axis has at most as many points).
@@ -200,92 +199,6 @@ ADAPTIVE_LEVELS = (2, 16, 24)
 #: Points of one grid axis at most (the axes are held in memory, the grid is not).
 MAX_AXIS_POINTS = 10**7
 
-# ---- columns ----------------------------------------------------------------
-
-#: Unit and meaning of every column a sweep table can have.
-COLUMNS = {
-    "row": ("", "row index, 0-based: chunk c holds rows c * chunk_size ..."),
-    "E_Pa": ("Pa", "Young's modulus (relaxed) as drawn"),
-    "G_Pa": ("Pa", "shear modulus (Kelvin-Voigt, elastic) or relaxed modulus G_inf (Prony)"),
-    "G1_Pa": ("Pa", "standard solid: parallel spring G1 (relaxed modulus)"),
-    "G2_Pa": ("Pa", "standard solid: spring G2 of the Maxwell arm"),
-    "eta_Pa_s": ("Pa s", "viscosity: Kelvin-Voigt dashpot, standard-solid arm dashpot, "
-                         "Prony parallel dashpot"),
-    "R_m": ("m", "sphere radius"),
-    "m_kg": ("kg", "sphere mass"),
-    "v_z0_m_s": ("m/s", "normal impact speed (into the half-space)"),
-    "v_x0_m_s": ("m/s", "tangential speed of the centre"),
-    "omega0_rad_s": ("rad/s", "spin about the y axis"),
-    "angle_deg": ("deg", "impact angle from the normal as drawn: v_x0 = v_z0 tan(angle)"),
-    "mu": ("1", "Coulomb friction coefficient, static = kinetic (inf: full stick)"),
-    "Q1": ("1", "damping parameter sqrt(15/32) (eta/G_inf) / T"),
-    "Q2": ("1", "stiffness ratio G1/G2 (standard solid; inf without an arm, eta = 0). "
-                "Kelvin-Voigt and elastic rows have no G2: NaN, meaning G2 -> inf (the "
-                "Kelvin-Voigt limit of the standard solid), never 0 (which would read as "
-                "G1 = 0, a Maxwell fluid, and as log 0 on a log Q2 axis)"),
-    "nu": ("1", "Poisson ratio"),
-    "theta_ratio": ("1", "moment of inertia Theta / (m R^2)"),
-    "psi": ("1", "incidence of Maw, Barber and Fawcett 2 (1 - nu) / (mu (2 - nu)) v_c0 / v_z0 "
-                 "(0: full stick, mu = inf, or v_c0 = 0; inf: mu = 0 with v_c0 != 0)"),
-    "e_z": ("1", "normal restitution |v_z,end| / v_z0"),
-    "e_x": ("1", "tangential restitution |v_c,end| / |v_c0|"),
-    "beta_x": ("1", "signed tangential restitution -v_c,end / v_c0"),
-    "energy_ratio": ("1", "kinetic energy after / before"),
-    "t_contact_s": ("s", "contact time"),
-    "u_max_m": ("m", "maximum indentation"),
-    "a_max_m": ("m", "maximum contact half-width"),
-    "t_hertz_s": ("s", "Hertz contact time of the relaxed modulus"),
-    "d_hertz_m": ("m", "Hertz maximum indentation of the relaxed modulus"),
-    "a_hertz_m": ("m", "Hertz contact radius of the relaxed modulus"),
-    "t_contact_rel": ("1", "t_contact / t_hertz"),
-    "u_max_rel": ("1", "u_max / d_hertz"),
-    "a_max_rel": ("1", "a_max / a_hertz"),
-    "v_z_end_m_s": ("m/s", "normal velocity at the end (negative: rebound)"),
-    "v_x_end_m_s": ("m/s", "tangential velocity of the centre at the end"),
-    "omega_end_rad_s": ("rad/s", "spin at the end"),
-    "mu_eff": ("1", "impulse ratio |int F_x dt| / int F_z dt (mu in gross slip; NaN when "
-                    "v_c0 = 0)"),
-    "rebound_angle_deg": ("deg", "angle of the centre's rebound velocity to the normal"),
-    "gross_slip_fraction": ("1", "fraction of the contact time in gross slip (every element "
-                                 "in contact slipping; 0 in full stick; NaN when v_c0 = 0)"),
-    "friction_energy_J": ("J", "energy dissipated by slip (0 in full stick)"),
-    "adhesion_J_m2": ("J/m^2", "work of adhesion dgamma (docs/physics.md#adhesion)"),
-    "lam": ("1", "adhesion number sqrt(2 pi a_H dgamma / E*) / d (Hertz scales of the "
-                 "relaxed modulus)"),
-    "F_tensile_max_N": ("N", "largest pulling force on the sphere (0 without adhesion)"),
-    "model": ("", "rheology of the row: elastic, kelvin_voigt, standard_solid or prony "
-                  "(a Kelvin-Voigt row has Q2 = NaN)"),
-    "path": ("", "the kernel that ran the row (vimpact.engine.routing; why: the paths metadata)"),
-    "status": ("", "outcome of the row, see the statuses metadata"),
-    "error": ("", "why the row failed before or in the simulation (null otherwise)"),
-}
-
-#: Result columns: sweep name -> column of :func:`vimpact.simulate_batch`.
-RESULTS = {
-    "e_z": "e_z", "e_x": "e_x", "beta_x": "beta_x", "energy_ratio": "energy_ratio",
-    "t_contact_s": "t_contact", "u_max_m": "u_max", "a_max_m": "a_max",
-    "t_hertz_s": "t_hertz", "d_hertz_m": "d_hertz", "a_hertz_m": "a_hertz",
-    "v_z_end_m_s": "v_z_end", "v_x_end_m_s": "v_x_end", "omega_end_rad_s": "omega_end",
-    "mu_eff": "mu_eff", "rebound_angle_deg": "rebound_angle",
-    "gross_slip_fraction": "gross_slip_fraction", "friction_energy_J": "friction_energy",
-}
-RELATIVE = {"t_contact_rel": ("t_contact_s", "t_hertz_s"), "u_max_rel": ("u_max_m", "d_hertz_m"),
-             "a_max_rel": ("a_max_m", "a_hertz_m")}
-OUTPUTS = ("e_z", "e_x", "beta_x", "energy_ratio", "t_contact_s", "u_max_m", "a_max_m",
-            "t_hertz_s", "d_hertz_m", "a_hertz_m", "t_contact_rel", "u_max_rel", "a_max_rel",
-            "v_z_end_m_s", "v_x_end_m_s", "omega_end_rad_s", "mu_eff", "rebound_angle_deg",
-            "gross_slip_fraction", "friction_energy_J")
-#: Outputs of a table with adhesion (a ``lam`` axis or ``adhesion_J_m2`` drawn), after
-#: :data:`OUTPUTS`.
-ADHESION_OUTPUTS = ("F_tensile_max_N",)
-#: Their columns of :func:`vimpact.simulate_batch`.
-ADHESION_RESULTS = {"F_tensile_max_N": "F_tensile_max"}
-#: Outputs that are NaN when v_c0 = 0 (no tangential force).
-TANGENTIAL_OUTPUTS = ("e_x", "beta_x", "mu_eff", "gross_slip_fraction")
-#: String columns: the row's rheology (``model``: elastic, kelvin_voigt, standard_solid or
-#: prony; tells a Kelvin-Voigt row's ``Q2 = NaN`` apart), and path, status, error (null where
-#: not applicable: path of a row that never ran, error of a good row).
-LABELS = ("model", "path", "status", "error")
 
 # ---- spec keys -------------------------------------------------------------
 
@@ -313,13 +226,17 @@ ADHESION_KEY = "adhesion_J_m2"
 
 @dataclasses.dataclass(frozen=True)
 class Draw:
-    """How one random input is drawn: ``kind`` is ``fixed``, ``uniform``,
-    ``log_uniform`` or ``choice``; ``values`` the value, the range or the choices."""
+    """How one random input is drawn.
+
+    ``kind`` is ``fixed``, ``uniform``, ``log_uniform`` or ``choice``; ``values`` the
+    value, the range or the choices.
+    """
 
     kind: str
     values: tuple[float, ...]
 
     def sample(self, rng: np.random.Generator, n: int) -> np.ndarray:
+        """Draw ``n`` values with ``rng``."""
         if self.kind == "fixed":
             return np.full(n, self.values[0])
         if self.kind == "uniform":
@@ -363,8 +280,11 @@ def _draw(spec: TomlSource, key: str, value) -> Draw:
 
 
 def _draw_mu(spec: TomlSource, key: str, value) -> Draw:
-    """A friction coefficient: like :func:`_draw`, every value >= 0; a fixed value or a
-    choice may be ``inf`` (TOML ``inf`` or ``"inf"``: full stick), a range is finite."""
+    """Parse how a friction coefficient is drawn.
+
+    Like :func:`_draw`, every value >= 0; a fixed value or a choice may be ``inf``
+    (TOML ``inf`` or ``"inf"``: full stick), a range is finite.
+    """
     if isinstance(value, str) or (is_number(value) and math.isinf(value)):
         return Draw("fixed", (friction_coefficient(spec, key, value),))
     if isinstance(value, dict) and "choice" in value and isinstance(value["choice"], list) \
@@ -461,7 +381,7 @@ class SweepSpec:
     material_text : the text of the material file ``[random] material`` names ("" without
         one); part of :attr:`sweep_hash`
     grid_refine : grid mode: ``[grid] refine``, ``"tensor"`` (default: planes of nodes
-        inserted across the grid, :func:`vimpact.lookup.refine.refine_grid`) or
+        inserted across the grid, :func:`vimpact.tablebuild.refine.refine_grid`) or
         ``"adaptive"`` (cells of ``log Q1`` (x ``log Q2``) split where they fail the
         tolerance, :mod:`vimpact.lookup.adaptive`; built by ``vimpact table build``)
     grid_levels : grid mode, adaptive: ``([grid] min_level, [grid] max_level)``, the
@@ -494,18 +414,25 @@ class SweepSpec:
 
     @property
     def n_chunks(self) -> int:
+        """Number of chunks (part files) of the sweep."""
         return -(-self.rows // self.chunk_size)
 
     @property
     def has_friction(self) -> bool:
-        """The spec sets a friction coefficient: a grid with a ``psi`` axis, or a random
-        spec with ``mu``; its table has the columns ``mu`` and ``psi``."""
+        """Whether the spec sets a friction coefficient.
+
+        A grid with a ``psi`` axis, or a random spec with ``mu``; its table has the
+        columns ``mu`` and ``psi``.
+        """
         return "psi" in self.axes or "mu" in self.draws
 
     @property
     def has_adhesion(self) -> bool:
-        """A grid with a ``lam`` axis or a random spec drawing ``adhesion_J_m2``: its table
-        has the columns ``adhesion_J_m2``, ``lam`` and ``F_tensile_max_N``."""
+        """Whether the spec has adhesion.
+
+        A grid with a ``lam`` axis or a random spec drawing ``adhesion_J_m2``: its table
+        has the columns ``adhesion_J_m2``, ``lam`` and ``F_tensile_max_N``.
+        """
         return ADHESION_AXIS in self.axes or ADHESION_KEY in self.draws
 
     @property
@@ -522,9 +449,11 @@ class SweepSpec:
 
     @property
     def sweep_hash(self) -> str:
-        """SHA-256 of the spec text, the resolved numerics, the package and schema
-        version (and the material file's text): parts of a run can be resumed only by a
-        run with the same hash."""
+        """SHA-256 of the spec text, the resolved numerics, the package and schema version.
+
+        The material file's text too; parts of a run can be resumed only by a
+        run with the same hash.
+        """
         h = hashlib.sha256()
         pieces = [self.text, json.dumps(dataclasses.asdict(self.numerics), sort_keys=True),
                   __version__, str(SCHEMA_VERSION)]
@@ -537,19 +466,25 @@ class SweepSpec:
 
     # ---- parameter sets ---------------------------------------------------
     def chunk_parameters(self, chunk: int) -> dict[str, np.ndarray]:
-        """The parameter sets of ``chunk`` (:func:`vimpact.sweep.parameters.chunk_parameters`)."""
+        """Return the parameter sets of ``chunk`` (:func:`vimpact.sweep.parameters.chunk_parameters`)."""
         from vimpact.sweep.parameters import chunk_parameters
         return chunk_parameters(self, chunk)
 
     def parameters(self) -> dict[str, np.ndarray]:
-        """All parameter sets, chunk after chunk (memory grows with ``rows``: for
-        small sweeps and tests; the runners use :meth:`chunk_parameters`)."""
+        """Return all parameter sets, chunk after chunk.
+
+        Memory grows with ``rows``: for small sweeps and tests; the runners use
+        :meth:`chunk_parameters`.
+        """
         chunks = [self.chunk_parameters(c) for c in range(self.n_chunks)]
         return {k: np.concatenate([c[k] for c in chunks]) for k in chunks[0]}
 
     def scene(self, params: dict, i: int) -> Scene:
-        """The scene of row ``i`` of ``params`` (one Python object: to explain a
-        row, not to run a sweep); raises ``ValueError`` for an invalid combination."""
+        """Return the scene of row ``i`` of ``params``.
+
+        One Python object: to explain a row, not to run a sweep; raises
+        ``ValueError`` for an invalid combination.
+        """
         p = {k: float(v[i]) for k, v in params.items()}
         if self.mode == "grid":
             scene = Scene.from_dimensionless(p.get("Q1", 0.0), p["nu"], p.get("Q2"),
@@ -612,11 +547,11 @@ class SweepSpec:
                 + list(LABELS))
 
     def units(self) -> dict[str, str]:
-        """Unit of every column (``"1"`` dimensionless, ``""`` for labels)."""
+        """Return the unit of every column (``"1"`` dimensionless, ``""`` for labels)."""
         return {c: _unit(c) for c in self.columns()}
 
     def schema(self):
-        """The ``pyarrow`` schema of the table (``row`` int64, labels string, else float64)."""
+        """Return the ``pyarrow`` schema of the table (``row`` int64, labels string, else float64)."""
         import pyarrow as pa
         fields = []
         for c in self.columns():
@@ -625,8 +560,11 @@ class SweepSpec:
         return pa.schema(fields)
 
     def metadata(self) -> dict:
-        """Metadata of the table (keys without the ``vimpact.`` prefix; values as Python
-        objects, encoded by :func:`vimpact.sweep.store.encode_metadata`)."""
+        """Return the metadata of the table.
+
+        Keys without the ``vimpact.`` prefix; values as Python objects, encoded by
+        :func:`vimpact.tableformat.metadata.encode_metadata`.
+        """
         return {
             "schema_version": SCHEMA_VERSION,
             "version": __version__,
@@ -840,8 +778,11 @@ def _adaptive(spec: TomlSource, model: str, table: dict, axes: dict,
 
 def _grid(spec: TomlSource, model: str, table) -> tuple[dict[str, np.ndarray], float | None,
                                                        float | None]:
-    """The axes (outermost first), the optional ``tolerance`` and the friction coefficient
-    ``mu`` (``None`` without a ``psi`` axis) of a ``[grid]`` table."""
+    """Parse a ``[grid]`` table: its axes, tolerance and friction coefficient.
+
+    The axes (outermost first), the optional ``tolerance`` and the friction coefficient
+    ``mu`` (``None`` without a ``psi`` axis) of a ``[grid]`` table.
+    """
     if model not in _GRID_KEYS:
         raise spec.error("grid", f"model {model!r} has no dimensionless grid; use [random]")
     if not isinstance(table, dict):

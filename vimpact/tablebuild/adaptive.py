@@ -9,7 +9,7 @@ points (:func:`vimpact.lookup.adaptive.refine_cells`; the other half is left for
 the interpolation along ``nu`` and between check points), on ``e_z`` and
 ``beta_x``. The finished table is then verified at held-out points it never
 used (random points, and random points inside randomly drawn cells:
-:func:`vimpact.lookup.verify.interpolation_error`), which is stored as
+:func:`vimpact.tablebuild.verify.interpolation_error`), which is stored as
 ``vimpact.interpolation_error``; the refinement report is ``vimpact.grid_refinement``
 and the build's time and size ``vimpact.build``.
 """
@@ -26,9 +26,9 @@ import pandas as pd
 
 from vimpact.lookup.adaptive import AdaptiveGrid, lattice_coordinates, refine_cells
 from vimpact.lookup.table import RestitutionTable
-from vimpact.lookup.verify import interpolation_error, simulate_dimensionless
 from vimpact.model.validation import InputError
 from vimpact.sweep.spec import SweepSpec, load_spec
+from vimpact.tablebuild.verify import interpolation_error, simulate_dimensionless
 
 __all__ = ["MAX_POINTS", "build_adaptive", "simulate_nodes"]
 
@@ -81,7 +81,7 @@ def build_adaptive(spec_path, out=None, *, n_verify: int = 2000, seed: int = 0,
         are left unrefined and reported (``met`` false)
     log : called with one line of progress per level
     simulate : the direct simulation (default
-        :func:`vimpact.lookup.verify.simulate_dimensionless`)
+        :func:`vimpact.tablebuild.verify.simulate_dimensionless`)
 
     Returns
     -------

@@ -17,8 +17,8 @@ from __future__ import annotations
 import numpy as np
 
 from vimpact.lookup.friction import gross_slip_onset
-from vimpact.lookup.verify import simulate_dimensionless
 from vimpact.model.validation import InputError
+from vimpact.tablebuild.verify import simulate_dimensionless
 
 __all__ = ["gross_slip_start"]
 
@@ -42,7 +42,7 @@ def gross_slip_start(model: str, Q1, nu, Q2=None, *, theta_ratio: float = 0.4,
     rel_tol : bisection stops when the bracket is narrower than ``rel_tol psi_g``
     mu : friction coefficient of the simulated scenes (the result depends on psi only)
     simulate : the direct simulation (default
-        :func:`vimpact.lookup.verify.simulate_dimensionless`)
+        :func:`vimpact.tablebuild.verify.simulate_dimensionless`)
 
     Returns
     -------

@@ -6,7 +6,7 @@ table's own numerics, and compares them with :meth:`RestitutionTable.lookup`:
 
 - ``axis`` points: the mid-point of every cell edge along one axis, at the
   nodes of the other axes (the error of the interpolation along that axis
-  alone; :func:`vimpact.lookup.refine.refine_grid` uses them to decide where
+  alone; :func:`vimpact.tablebuild.refine.refine_grid` uses them to decide where
   to insert nodes);
 - ``centre`` points: the centre of every cell (mid-way along every axis);
 - ``random`` points: uniform in ``log Q1``, ``log Q2`` and ``nu`` inside the
@@ -50,7 +50,7 @@ _OUTPUTS = ("e_z", "beta_x", "e_x")
 
 
 def numerics_of(table):
-    """The table's numerics (metadata ``vimpact.numerics``) as a :class:`vimpact.Numerics`.
+    """Return the table's numerics (metadata ``vimpact.numerics``) as a :class:`vimpact.Numerics`.
 
     Raises
     ------
@@ -87,7 +87,7 @@ def simulate_dimensionless(model: str, Q1, nu, Q2=None, *, numerics=None,
     theta_ratio : Theta / (m R^2)
     tangential, tangential_memory, rotation : as for :class:`vimpact.Scene`
     psi : friction incidence per point (dimensionless, >= 0; None: full stick); the
-        scene is a psi grid sweep's (:func:`vimpact.sweep.parameters.psi_reference`:
+        scene is a psi grid sweep's (:func:`vimpact.tableformat.parameters.psi_reference`:
         friction coefficient ``mu``, ``v_x0`` from psi; psi = 0 is full stick)
     mu : friction coefficient of the points with ``psi > 0``, dimensionless
 
@@ -112,7 +112,7 @@ def simulate_dimensionless(model: str, Q1, nu, Q2=None, *, numerics=None,
             "tangential": np.full(n, tangential), "tangential_memory": np.full(n, tangential_memory),
             "rotation": np.full(n, bool(rotation))}
     if psi is not None:
-        from vimpact.sweep.parameters import psi_reference
+        from vimpact.tableformat.parameters import psi_reference
         cols["v_x0_m_s"], cols["mu"] = psi_reference(np.broadcast_to(psi, (n,)), nu, mu)
     if model == "kelvin_voigt":
         cols["eta0_Pa_s"] = eta
@@ -218,8 +218,10 @@ def _scene_options(table) -> dict:
 
 
 def _friction(table, psi) -> dict:
-    """Keyword arguments of :func:`simulate_dimensionless` for a psi table: the
-    points' psi and the one friction coefficient its rows with psi > 0 were made with."""
+    """Return the keyword arguments of :func:`simulate_dimensionless` for a psi table.
+
+    They are the points' psi and the one friction coefficient its rows with psi > 0 were made with.
+    """
     if psi is None:
         return {}
     mu = table.data["mu"].to_numpy(float) if "mu" in table.data.columns else np.array([1.0])
@@ -380,20 +382,24 @@ def interpolation_error(table, numerics=None, n: int = 200, seed: int = 0, theta
 
 
 def write_interpolation_error(table, result: dict, path=None):
-    """Store ``result`` as the metadata entry ``vimpact.interpolation_error`` of ``table``
-    and write it to ``path`` (default: where the table was read).
+    """Store ``result`` as the metadata entry ``vimpact.interpolation_error`` and write.
+
+    The entry goes into ``table``, which is written to ``path`` (default: where the
+    table was read).
 
     A table read from a Parquet file is rewritten from that file's own data (read with
     ``pyarrow``, not through pandas), atomically, so its rows, columns and types stay
     exactly as the sweep wrote them and its content hash (``vimpact.content_sha256``)
     stays true; for a partitioned dataset only its ``_common_metadata`` is rewritten. A
     table held in memory is saved with :meth:`RestitutionTable.save` (without a content
-    hash of other data)."""
+    hash of other data).
+    """
     from pathlib import Path
 
     import pyarrow.parquet as pq
 
-    from vimpact.sweep import store
+    from vimpact.tableformat.files import write_atomic
+    from vimpact.tableformat.metadata import COMMON_METADATA
 
     text = json.dumps(result)
     key = "vimpact.interpolation_error"
@@ -403,11 +409,11 @@ def write_interpolation_error(table, result: dict, path=None):
         raise InputError("path = None is not allowed for a table held in memory: give the "
                          "file to write")
     if target.is_dir():
-        schema = pq.read_schema(target / store.COMMON_METADATA)
+        schema = pq.read_schema(target / COMMON_METADATA)
         meta = dict(schema.metadata or {})
         meta[key.encode()] = text.encode()
-        store.write_atomic(schema.empty_table().replace_schema_metadata(meta),
-                           target / store.COMMON_METADATA, schema_only=True)
+        write_atomic(schema.empty_table().replace_schema_metadata(meta),
+                           target / COMMON_METADATA, schema_only=True)
         return target
     source = table.path
     if source is not None and source.is_file():
@@ -415,7 +421,7 @@ def write_interpolation_error(table, result: dict, path=None):
         meta = dict(arrow.schema.metadata or {})
         meta[key.encode()] = text.encode()
         target.parent.mkdir(parents=True, exist_ok=True)
-        store.write_atomic(arrow.replace_schema_metadata(meta), target)
+        write_atomic(arrow.replace_schema_metadata(meta), target)
         return target
     table.metadata.pop("vimpact.content_sha256", None)  # not a hash of this data
     return table.save(target)

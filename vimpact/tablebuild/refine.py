@@ -48,7 +48,7 @@ def grid_table(model: str, axes: dict[str, np.ndarray], numerics,
     numerics : :class:`vimpact.Numerics` of every impact
     theta_ratio, tangential, tangential_memory, rotation : as for :class:`vimpact.Scene`
     simulate : the direct simulation (default
-        :func:`vimpact.lookup.verify.simulate_dimensionless`)
+        :func:`vimpact.tablebuild.verify.simulate_dimensionless`)
 
     Returns
     -------
@@ -56,7 +56,7 @@ def grid_table(model: str, axes: dict[str, np.ndarray], numerics,
     ``mode = grid``, ``numerics`` and the scene options.
     """
     from vimpact.lookup.table import RestitutionTable
-    from vimpact.lookup.verify import simulate_dimensionless
+    from vimpact.tablebuild.verify import simulate_dimensionless
 
     names = list(axes)
     mesh = np.meshgrid(*(np.asarray(axes[a], float) for a in names), indexing="ij")
@@ -74,11 +74,14 @@ def grid_table(model: str, axes: dict[str, np.ndarray], numerics,
 
 
 class _SimulationMemory:
-    """:func:`vimpact.lookup.verify.simulate_dimensionless` that remembers: a point
+    """Direct simulation that remembers the points it simulated.
+
+    :func:`vimpact.tablebuild.verify.simulate_dimensionless`, except that a point
     (the same ``Q1``, ``Q2``, ``nu`` to the bit) simulated before in this refinement is
     not simulated again. Rows are simulated independently of each other, so the
     result is the same as without the memory. One instance per refinement (its
-    numerics and scene options do not change)."""
+    numerics and scene options do not change).
+    """
 
     _COLUMNS = ("e_z", "beta_x", "e_x")
 
@@ -86,7 +89,7 @@ class _SimulationMemory:
         self.known: dict[tuple, tuple] = {}
 
     def __call__(self, model, Q1, nu, Q2=None, **options) -> pd.DataFrame:
-        from vimpact.lookup.verify import simulate_dimensionless
+        from vimpact.tablebuild.verify import simulate_dimensionless
 
         nu = np.asarray(nu, dtype=float)
         n = nu.size
@@ -150,18 +153,18 @@ def refine_grid(model: str, axes: dict, tolerance: float, numerics=None, *,
         (``tolerance / 2``, halved when the final check failed), the
         largest mid-point error per axis, the mid-points inserted per axis, each with
         the cell it splits and the error found there, and the final check's result
-        when no axis needed a node), ``final`` (:func:`vimpact.lookup.verify.interpolation_error`
+        when no axis needed a node), ``final`` (:func:`vimpact.tablebuild.verify.interpolation_error`
         of the refined grid: cell centres and random points included),
         ``stopped`` (why the loop ended), ``nodes`` (grid points).
 
     A sweep with ``[grid] tolerance`` calls it before its chunks are made
-    (:func:`vimpact.sweep.runner.refined_spec`, with the spec's numerics and scene
+    (:func:`vimpact.tablebuild.sweep.refined_spec`, with the spec's numerics and scene
     options and this module's node budget :data:`MAX_NODES`, :data:`MAX_AXIS_NODES`),
     sweeps the refined axes, stores ``report`` as the metadata entry
     ``grid_refinement`` and measures the finished table's ``interpolation_error``.
     """
-    from vimpact.lookup.verify import held_out_errors, interpolation_error
     from vimpact.model.numerics import Numerics
+    from vimpact.tablebuild.verify import held_out_errors, interpolation_error
 
     numerics = numerics or Numerics()
     if not (isinstance(tolerance, (int, float)) and math.isfinite(tolerance) and tolerance > 0):

@@ -1,0 +1,356 @@
+"""Integrity of a vimpact table: content hash, metadata hash, read-back verification.
+
+Every part and every table is written with Parquet page checksums (CRC-32 of each
+page), a content hash ``vimpact.content_sha256`` (:class:`ContentHash`: SHA-256 of
+the column values in a canonical form, independent of the Parquet encoding) and a
+hash of the ``vimpact.*`` metadata entries ``vimpact.metadata_sha256``
+(:func:`metadata_hash`: the footer has no checksum). :func:`verify_table` reads a
+table back and checks all three; :func:`scan` is the check of one file that the
+sweep also applies to its parts. A table without a stored hash (written before it
+existed) is accepted with the hash check skipped.
+"""
+
+from __future__ import annotations
+
+import hashlib
+from pathlib import Path
+
+from vimpact.model.validation import InputError
+from vimpact.tableformat.metadata import COMMON_METADATA, META_PREFIX, decode_metadata
+
+#: Metadata key (without the prefix) of the content hash (:class:`ContentHash`).
+CONTENT_HASH_KEY = "content_sha256"
+#: Metadata key (without the prefix) of the hash of the other ``vimpact.*`` entries
+#: (:func:`metadata_hash`).
+METADATA_HASH_KEY = "metadata_sha256"
+#: First line hashed by :class:`ContentHash`: names the definition (change it with it).
+CONTENT_HASH_VERSION = "vimpact content sha256 v1"
+
+
+class ContentHash:
+    r"""SHA-256 of a table's values in a canonical form.
+
+    The hash is independent of the Parquet encoding (compression, dictionary or
+    plain pages, row groups, Arrow chunks, ``string`` or ``large_string``,
+    nullability flags).
+
+    Definition (version :data:`CONTENT_HASH_VERSION`). Every column has three byte
+    streams over its rows in row order:
+
+    - validity: one byte per row, ``1`` a value, ``0`` a null;
+    - values: fixed-width types (integers, floats, booleans as one byte) the
+      value's little-endian bytes as stored (NaN payloads included), ``0`` for a
+      null; strings and binaries the byte length as little-endian ``int64``, ``0``
+      for a null; a column of Arrow type ``null`` eight zero bytes per row (the
+      same as an all-null ``int64``, ``float64`` or string column);
+    - data: strings and binaries the concatenated bytes of the values (UTF-8);
+      empty for the other types.
+
+    The hash is SHA-256 over the UTF-8 text ``"vimpact content sha256 v1\n"``,
+    ``"rows <n>\n"``, then for each column in table order ``"column <name>\n"``
+    followed by the three 32-byte SHA-256 digests of its streams. Feeding the
+    rows in pieces (:meth:`update` once per part or row group) gives the hash of
+    the whole, so a table is hashed with memory bounded by its largest piece.
+    Stored as the metadata ``vimpact.content_sha256`` (64 hex digits).
+    """
+
+    def __init__(self, names=None):
+        self.names: list[str] | None = list(names) if names is not None else None
+        self.rows = 0
+        self._streams: list[tuple] = []
+
+    def update(self, table) -> ContentHash:
+        """Add the rows of the ``pyarrow`` table (or record batch) ``table``.
+
+        Same column names, in the same order, as the rows before.
+        """
+        names = list(table.column_names)
+        if self.names is None:
+            self.names = names
+        if names != self.names:
+            raise ValueError(f"content hash: columns {names} differ from {self.names}")
+        if not self._streams:
+            self._streams = [(hashlib.sha256(), hashlib.sha256(), hashlib.sha256())
+                             for _ in names]
+        for column, streams in zip(table.columns, self._streams):
+            for stream, piece in zip(streams, _canonical(column)):
+                stream.update(piece)
+        self.rows += table.num_rows
+        return self
+
+    def hexdigest(self) -> str:
+        """Return the hash (64 hex digits) of the rows added so far."""
+        h = hashlib.sha256(f"{CONTENT_HASH_VERSION}\nrows {self.rows}\n".encode())
+        names = self.names or []
+        streams = self._streams or [(hashlib.sha256(),) * 3 for _ in names]
+        for name, (valid, values, data) in zip(names, streams):
+            h.update(f"column {name}\n".encode())
+            for stream in (valid, values, data):
+                h.update(stream.digest())
+        return h.hexdigest()
+
+
+def content_hash(table) -> str:
+    """Return the :class:`ContentHash` of one ``pyarrow`` table (64 hex digits)."""
+    return ContentHash().update(table).hexdigest()
+
+
+def metadata_hash(raw: dict | None) -> str:
+    """Return the SHA-256 (64 hex digits) of the ``vimpact.*`` metadata entries.
+
+    The entries of Parquet key-value metadata ``raw`` (bytes or str keys and values) other than
+    ``vimpact.metadata_sha256`` itself: over the entries sorted by key, each as the
+    little-endian ``uint64`` byte length of the key, the key, the length of the
+    value, the value (UTF-8). Stored as ``vimpact.metadata_sha256``, it makes a
+    changed metadata entry (the sweep hash, the spec, units, the content hash)
+    detectable: the page checksums do not cover the footer.
+    """
+    def as_bytes(x) -> bytes:
+        return x if isinstance(x, bytes) else str(x).encode()
+    own = (META_PREFIX + METADATA_HASH_KEY).encode()
+    items = sorted((as_bytes(k), as_bytes(v)) for k, v in (raw or {}).items())
+    h = hashlib.sha256()
+    for key, value in items:
+        if key.startswith(META_PREFIX.encode()) and key != own:
+            for piece in (key, value):
+                h.update(len(piece).to_bytes(8, "little"))
+                h.update(piece)
+    return h.hexdigest()
+
+
+def with_metadata_hash(schema_or_table):
+    """Return ``schema_or_table`` with ``vimpact.metadata_sha256`` set.
+
+    The value is :func:`metadata_hash` of its metadata.
+    """
+    meta = dict(schema_or_table.schema.metadata or {}) if hasattr(schema_or_table, "schema") \
+        else dict(schema_or_table.metadata or {})
+    meta[(META_PREFIX + METADATA_HASH_KEY).encode()] = metadata_hash(meta).encode()
+    if hasattr(schema_or_table, "replace_schema_metadata"):
+        return schema_or_table.replace_schema_metadata(meta)
+    return schema_or_table.with_metadata(meta)
+
+
+def check_metadata_hash(raw: dict | None) -> None:
+    """:class:`Damaged` if ``raw`` stores a metadata hash that its entries do not give."""
+    raw = raw or {}
+    stored = raw.get((META_PREFIX + METADATA_HASH_KEY).encode())
+    if stored is not None and stored.decode(errors="replace") != metadata_hash(raw):
+        raise Damaged("metadata hash mismatch (a vimpact.* metadata entry changed after "
+                       "it was written)")
+
+
+def _canonical(column) -> tuple[bytes, bytes, bytes]:
+    """Return the validity, values and data bytes of one column (see :class:`ContentHash`)."""
+    import numpy as np
+    import pyarrow as pa
+    import pyarrow.compute as pc
+
+    if isinstance(column, pa.ChunkedArray):
+        column = (column.combine_chunks() if column.num_chunks
+                  else pa.array([], type=column.type))
+    if pa.types.is_dictionary(column.type):
+        column = column.dictionary_decode()
+    n = len(column)
+    kind = column.type
+    if pa.types.is_null(kind):
+        return bytes(n), bytes(8 * n), b""
+    valid = np.asarray(column.is_valid().to_numpy(zero_copy_only=False), dtype=np.uint8)
+    if (pa.types.is_string(kind) or pa.types.is_large_string(kind) or pa.types.is_binary(kind)
+            or pa.types.is_large_binary(kind) or pa.types.is_string_view(kind)
+            or pa.types.is_binary_view(kind)):
+        filled = pc.fill_null(column, "" if "string" in str(kind) else b"")
+        flat = filled.cast(pa.large_binary())
+        offsets_buf, data_buf = flat.buffers()[1], flat.buffers()[2]
+        offsets = np.frombuffer(offsets_buf, dtype="<i8")[flat.offset:flat.offset + n + 1]
+        lengths = np.diff(offsets).astype("<i8")
+        data = (data_buf.to_pybytes()[offsets[0]:offsets[-1]] if n and data_buf is not None
+                else b"")
+        return valid.tobytes(), lengths.tobytes(), data
+    if pa.types.is_boolean(kind):
+        values = np.asarray(pc.fill_null(column, False).to_numpy(zero_copy_only=False),
+                            dtype=np.uint8)
+        return valid.tobytes(), values.tobytes(), b""
+    if pa.types.is_integer(kind) or pa.types.is_floating(kind):
+        values = pc.fill_null(column, 0).to_numpy(zero_copy_only=False)
+        values = values.astype(values.dtype.newbyteorder("<"), copy=False)
+        return valid.tobytes(), values.tobytes(), b""
+    raise ValueError(f"content hash: column type {kind} is not supported")
+
+
+
+# ---- verification ------------------------------------------------------------------
+
+class Damaged(Exception):
+    """A file that fails verification; the message says what failed (one line)."""
+
+
+def first_line(exc: BaseException) -> str:
+    """Return ``exc`` as one line: its type and the first line of its message."""
+    text = (str(exc).strip().splitlines() or [""])[0]
+    return f"{type(exc).__name__}: {text}" if text else type(exc).__name__
+
+
+def open_checked(path: Path):
+    """Open ``path`` as a ``pyarrow.parquet.ParquetFile`` with page checksums verified.
+
+    Raises :class:`Damaged` (missing, truncated, not Parquet, footer unreadable).
+    """
+    import pyarrow.parquet as pq
+    path = Path(path)
+    try:
+        size = path.stat().st_size
+        with open(path, "rb") as f:
+            head = f.read(4)
+            f.seek(max(0, size - 4))
+            tail = f.read(4)
+    except OSError as exc:
+        raise Damaged(f"unreadable ({first_line(exc)})") from None
+    if size == 0:
+        raise Damaged("empty file (0 bytes)")
+    if head != b"PAR1":
+        raise Damaged("not a Parquet file (no PAR1 magic at the start)")
+    if tail != b"PAR1":
+        raise Damaged(f"truncated ({size} bytes, no Parquet footer at the end)")
+    try:
+        return pq.ParquetFile(path, page_checksum_verification=True)
+    except Exception as exc:  # noqa: BLE001 - pyarrow raises several types for a bad footer
+        raise Damaged(f"footer unreadable ({first_line(exc)})") from None
+
+
+def scan(path: Path, hasher: ContentHash | None = None) -> tuple[dict, str, int]:
+    """Read every row group of the Parquet file ``path`` with page checksums checked.
+
+    Returns the decoded ``vimpact.*`` metadata, the :class:`ContentHash` of the
+    data and the number of rows; ``hasher`` (optional) receives the rows too.
+    Raises :class:`Damaged` for a file that cannot be read back or whose stored
+    hash (if any) differs from its data.
+    """
+    pf = open_checked(path)
+    try:
+        meta = decode_metadata(pf.schema_arrow.metadata)
+    except Exception as exc:  # noqa: BLE001
+        raise Damaged(f"schema unreadable ({first_line(exc)})") from None
+    check_metadata_hash(pf.schema_arrow.metadata)
+    own = ContentHash(pf.schema_arrow.names)
+    for group in range(pf.metadata.num_row_groups):
+        try:
+            table = pf.read_row_group(group)
+        except Exception as exc:  # noqa: BLE001 - CRC, decompression, thrift errors
+            why = first_line(exc)
+            what = "page checksum failed" if "checksum" in why.lower() else "data unreadable"
+            raise Damaged(f"{what} in row group {group} ({why})") from None
+        own.update(table)
+        if hasher is not None:
+            hasher.update(table)
+    digest = own.hexdigest()
+    stored = meta.get(CONTENT_HASH_KEY)
+    if stored is not None and stored != digest:
+        raise Damaged(f"content hash mismatch (stored {str(stored)[:12]}..., "
+                       f"data {digest[:12]}...)")
+    return meta, digest, own.rows
+
+
+
+def rows_in_footer(pf) -> int:
+    """Return the number of rows a ``pyarrow.parquet.ParquetFile``'s footer declares."""
+    return int(pf.metadata.num_rows)
+
+
+
+
+def verify_table(path) -> str:
+    """Check that the table at ``path`` reads back as it was written.
+
+    ``path`` is a Parquet file or a dataset directory; raise
+    :class:`~vimpact.model.validation.InputError` naming the file and what failed
+    otherwise.
+
+    Checks: the file exists, is Parquet and not truncated (footer present); it has
+    ``vimpact.*`` metadata (else: foreign), equal to its ``vimpact.metadata_sha256``
+    (:func:`metadata_hash`) where stored; every page reads back, with its CRC-32
+    verified where the writer stored one (vimpact writes them since
+    ``vimpact.content_sha256`` exists); the :class:`ContentHash` recomputed from the
+    data equals ``vimpact.content_sha256``. A dataset: ``_common_metadata``
+    present, no file other than its parts, every part checked so, their rows
+    adding up to ``vimpact.rows``, and the hash over the parts in order equal to
+    the one in ``_common_metadata``.
+
+    A table without a stored content hash (written before vimpact stored one, e.g.
+    a shipped table not yet regenerated) is accepted with the hash check skipped;
+    the returned text says so. Memory: one row group (part) at a time.
+
+    Returns
+    -------
+    str
+        What was checked, e.g. ``"ok: 612 rows, 1 row group(s), content hash
+        verified"`` or ``"... no content hash stored (an older table): hash check
+        skipped"``.
+    """
+    path = Path(path)
+    where = f"table = {str(path)!r} is not allowed"
+    if not path.exists():
+        raise InputError(f"{where}: no such file or directory")
+    try:
+        if path.is_dir():
+            rows, groups, stored = _verify_dataset(path)
+        else:
+            meta, _, rows = scan(path)
+            if not meta:
+                raise Damaged("not a vimpact table (no vimpact.* metadata)")
+            groups = open_checked(path).metadata.num_row_groups
+            stored = CONTENT_HASH_KEY in meta
+    except Damaged as exc:
+        raise InputError(f"{where}: it fails the integrity check: {exc}") from None
+    text = f"ok: {rows} rows, {groups} row group(s), page checksums checked where stored, "
+    return text + ("content hash verified" if stored else
+                   "no content hash stored (an older table): hash check skipped")
+
+
+def _verify_dataset(path: Path) -> tuple[int, int, bool]:
+    common = path / COMMON_METADATA
+    if not common.is_file():
+        raise Damaged(f"an unfinished sweep dataset (no {COMMON_METADATA})")
+    try:
+        import pyarrow.parquet as pq
+        raw = pq.read_schema(common).metadata
+        meta = decode_metadata(raw)
+    except Exception as exc:  # noqa: BLE001
+        raise Damaged(f"{COMMON_METADATA} unreadable ({first_line(exc)})") from None
+    try:
+        check_metadata_hash(raw)
+    except Damaged as exc:
+        raise Damaged(f"{COMMON_METADATA}: {exc}") from None
+    if not meta:
+        raise Damaged(f"not a vimpact table (no vimpact.* metadata in {COMMON_METADATA})")
+    parts = []
+    for entry in sorted(path.iterdir()):
+        if entry.name.startswith((".", "_")):
+            continue  # not read as data (pyarrow ignores these names too)
+        if not (entry.is_file() and entry.name.startswith("part-")
+                and entry.name.endswith(".parquet")):
+            raise Damaged(f"{entry.name} is not one of its parts (move it out of the "
+                           "dataset directory)")
+        parts.append(entry)
+    whole = ContentHash()
+    for part in parts:
+        try:
+            scan(part, whole)
+        except Damaged as exc:
+            raise Damaged(f"part {part.name}: {exc}") from None
+        except ValueError as exc:  # other columns than the parts before
+            raise Damaged(f"part {part.name}: {exc}") from None
+    if isinstance(meta.get("rows"), int) and meta["rows"] != whole.rows:
+        raise Damaged(f"its parts hold {whole.rows} rows, its metadata says {meta['rows']}")
+    stored = meta.get(CONTENT_HASH_KEY)
+    if stored is not None and stored != whole.hexdigest():
+        raise Damaged(f"content hash over the parts mismatch (stored {str(stored)[:12]}..., "
+                       f"data {whole.hexdigest()[:12]}...)")
+    return whole.rows, len(parts), stored is not None
+
+
+
+
+__all__ = ["CONTENT_HASH_KEY", "CONTENT_HASH_VERSION", "METADATA_HASH_KEY", "ContentHash",
+           "Damaged", "check_metadata_hash", "content_hash", "first_line", "metadata_hash",
+           "open_checked", "rows_in_footer", "scan", "verify_table", "with_metadata_hash"]
