@@ -585,36 +585,9 @@ def round_trip_files(problem: DemProblem, speeds, steps_per_contact: int = STEPS
     return rows
 
 
-def oblique_round_trip(problem: DemProblem, steps_per_contact: int = STEPS_PER_CONTACT
-                       ) -> list[dict]:
-    """Export, then run the code on oblique impacts of every wall contact with friction at
-    the speeds and angles of the report's ``beta_x`` targets: :func:`round_trip` rows
-    with ``vimpact_beta`` (vimpact's ``beta_x`` there) and ``stated`` (the report's
-    ``beta_x`` residual, max) added. Pair contacts are left out: in an oblique
-    sphere-sphere impact the line of centres turns during the contact, which no
-    one-contact law follows."""
-    from vimpact.dem.export import export
-
-    ex = export(problem, CODE)
-    obl = {k: t.oblique for k, t in ex.targets.items() if t.oblique is not None}
-    walls = {f.contact.key for f in ex.fits if f.contact.is_wall and f.contact.key in obl}
-    if not walls:
-        return []
-    first = obl[sorted(walls)[0]]
-    speeds, angles = sorted(set(first.v.tolist())), sorted(set(first.angle_deg.tolist()))
-    rows = round_trip_files(problem, speeds, steps_per_contact, fits=ex.fits, angles_deg=angles,
-                            contacts=walls)
-    stated = {f.contact.key: f.res_beta_x.max_abs for f in ex.fits if f.contact.key in walls}
-    for r in rows:
-        ob = obl[r["contact"]]
-        k = int(np.flatnonzero(np.isclose(ob.v, r["v"], rtol=1e-12) & (ob.angle_deg == r["angle"]))[0])
-        r["vimpact_beta"] = float(ob.beta_x[k])
-        r["stated"] = stated[r["contact"]]
-    return rows
-
 
 if __name__ == "__main__":  # python -m vimpact.dem.lammps SETUP.toml [STEPS_PER_CONTACT]
     from vimpact.dem.report import round_trip_main
 
     round_trip_main("LAMMPS", lammps_available, round_trip_files, STEPS_PER_CONTACT,
-                    oblique_round_trip)
+                    oblique=CODE)

@@ -223,7 +223,7 @@ def liggghts_available() -> str | None:
 
 def round_trip(problem: DemProblem, speeds, steps_per_contact: int = STEPS_PER_CONTACT,
                fits: list[ContactFit] | None = None, timeout: float = 600.0,
-               angles_deg=None) -> list[dict]:
+               angles_deg=None, contacts=None) -> list[dict]:
     """Run LIGGGHTS once with the exported files, included unchanged, on head-on
     collisions of every contact (nominal sizes) at ``speeds`` (m/s): one dict per
     collision with ``contact``, ``v``, ``e`` (LIGGGHTS', from its velocities) and
@@ -232,7 +232,8 @@ def round_trip(problem: DemProblem, speeds, steps_per_contact: int = STEPS_PER_C
     With ``angles_deg``: oblique impacts of the wall contacts only at those angles from
     the normal (``v_c0 = v tan(angle)``, no spin); rows also have ``angle``, ``beta``
     (LIGGGHTS', the contact-point velocity from the tangential impulse with its
-    solid-sphere inertia) and ``predicted_beta`` (:func:`tangential_beta`)."""
+    solid-sphere inertia) and ``predicted_beta`` (:func:`tangential_beta`). ``contacts``:
+    the keys of the contacts whose rows are returned (default: every contact)."""
     import os
     import subprocess
     import tempfile
@@ -330,36 +331,12 @@ def round_trip(problem: DemProblem, speeds, steps_per_contact: int = STEPS_PER_C
             # the tangential impulse changes the contact-point velocity F times the centre's
             row["beta"] = -(vt + F * (vel[ids[0]][0] - vt)) / vt
         rows.append(row)
-    return rows
+    return [r for r in rows if contacts is None or r["contact"] in contacts]
 
-
-def oblique_round_trip(problem: DemProblem, steps_per_contact: int = STEPS_PER_CONTACT
-                       ) -> list[dict]:
-    """Export, then run LIGGGHTS on oblique impacts of every wall contact with friction at
-    the speeds and angles of the report's ``beta_x`` targets: :func:`round_trip` rows
-    with ``vimpact_beta`` and ``stated`` (the report's ``beta_x`` residual, max) added."""
-    from vimpact.dem.export import export
-
-    ex = export(problem, CODE)
-    obl = {k: t.oblique for k, t in ex.targets.items() if t.oblique is not None}
-    walls = {f.contact.key for f in ex.fits if f.contact.is_wall and f.contact.key in obl}
-    if not walls:
-        return []
-    first = obl[sorted(walls)[0]]
-    speeds, angles = sorted(set(first.v.tolist())), sorted(set(first.angle_deg.tolist()))
-    rows = [r for r in round_trip(problem, speeds, steps_per_contact, fits=ex.fits,
-                                  angles_deg=angles) if r["contact"] in walls]
-    stated = {f.contact.key: f.res_beta_x.max_abs for f in ex.fits if f.contact.key in walls}
-    for r in rows:
-        ob = obl[r["contact"]]
-        k = int(np.flatnonzero(np.isclose(ob.v, r["v"], rtol=1e-12) & (ob.angle_deg == r["angle"]))[0])
-        r["vimpact_beta"] = float(ob.beta_x[k])
-        r["stated"] = stated[r["contact"]]
-    return rows
 
 
 if __name__ == "__main__":  # python -m vimpact.dem.liggghts SETUP.toml [STEPS_PER_CONTACT]
     from vimpact.dem.report import round_trip_main
 
     round_trip_main("LIGGGHTS", liggghts_available, round_trip, STEPS_PER_CONTACT,
-                    oblique_round_trip)
+                    oblique=CODE)

@@ -277,7 +277,7 @@ def yade_available() -> str | None:
 
 def round_trip(problem: DemProblem, speeds, steps_per_contact: int = STEPS_PER_CONTACT,
                fits: list[ContactFit] | None = None, timeout: float = 600.0,
-               angles_deg=None) -> list[dict]:
+               angles_deg=None, contacts=None) -> list[dict]:
     """Run Yade once with the exported ``yade_materials.py``, unchanged, on head-on
     collisions of every contact (nominal sizes) at ``speeds`` (m/s); one dict per
     collision with ``contact``, ``v``, ``e`` (Yade's, from its velocities) and
@@ -286,7 +286,8 @@ def round_trip(problem: DemProblem, speeds, steps_per_contact: int = STEPS_PER_C
     With ``angles_deg``: oblique impacts of the wall contacts only, at those angles from
     the normal (``v_c0 = v tan(angle)``, no spin); each row also has ``angle``, ``beta``
     (Yade's ``-v_c,end / v_c0``, ``v_c = v_x - R omega_y`` from its velocity and spin)
-    and ``predicted_beta`` (the report's law, :func:`yade_oblique`)."""
+    and ``predicted_beta`` (the report's law, :func:`yade_oblique`). ``contacts``: the keys
+    of the contacts whose rows are returned (default: every contact)."""
     import json
     import os
     import subprocess
@@ -338,39 +339,12 @@ def round_trip(problem: DemProblem, speeds, steps_per_contact: int = STEPS_PER_C
     for r in rows:
         if "vt" in r:
             r["beta"] = -(r["vx_end"] - r["R1"] * r["spin"]) / r["vt"]
-    return rows
+    return [r for r in rows if contacts is None or r["contact"] in contacts]
 
-
-def oblique_round_trip(problem: DemProblem, steps_per_contact: int = STEPS_PER_CONTACT
-                       ) -> list[dict]:
-    """Export, then run the code on oblique impacts of every wall contact with friction at
-    the speeds and angles of the report's ``beta_x`` targets: :func:`round_trip` rows
-    with ``vimpact_beta`` (vimpact's ``beta_x`` there) and ``stated`` (the report's
-    ``beta_x`` residual, max) added. Pair contacts are left out: in an oblique
-    sphere-sphere impact the line of centres turns during the contact, which no
-    one-contact law follows."""
-    from vimpact.dem.export import export
-
-    ex = export(problem, CODE)
-    obl = {k: t.oblique for k, t in ex.targets.items() if t.oblique is not None}
-    walls = {f.contact.key for f in ex.fits if f.contact.is_wall and f.contact.key in obl}
-    if not walls:
-        return []
-    first = obl[sorted(walls)[0]]
-    speeds, angles = sorted(set(first.v.tolist())), sorted(set(first.angle_deg.tolist()))
-    rows = [r for r in round_trip(problem, speeds, steps_per_contact, fits=ex.fits,
-                                  angles_deg=angles) if r["contact"] in walls]
-    stated = {f.contact.key: f.res_beta_x.max_abs for f in ex.fits if f.contact.key in walls}
-    for r in rows:
-        ob = obl[r["contact"]]
-        k = int(np.flatnonzero(np.isclose(ob.v, r["v"], rtol=1e-12) & (ob.angle_deg == r["angle"]))[0])
-        r["vimpact_beta"] = float(ob.beta_x[k])
-        r["stated"] = stated[r["contact"]]
-    return rows
 
 
 if __name__ == "__main__":  # python -m vimpact.dem.yade SETUP.toml [STEPS_PER_CONTACT]
     from vimpact.dem.report import round_trip_main
 
     round_trip_main("Yade", yade_available, round_trip, STEPS_PER_CONTACT,
-                    oblique_round_trip)
+                    oblique=CODE)
