@@ -368,49 +368,20 @@ def yade_coulomb(zeta: float, w_t: float, zeta_t: float, F: float, mu: float, w0
     (e, beta) : arrays; ``beta = -w_end / w0``
     """
     w0 = np.asarray(w0, dtype=float)
-    shape = w0.shape
-    w0 = w0.ravel()
-    lever = (np.zeros_like(w0) if rho is None
-             else 1.0 / np.broadcast_to(np.asarray(rho, dtype=float), shape).ravel())
-    h = math.pi / steps
-    cap = min(float(mu), 1e300)
-    spin = F - 1.0  # m R^2 / Theta
-    x = np.zeros_like(w0)
-    v = np.ones_like(w0)
-    el = np.zeros_like(w0)  # elastic tangential force, units m v0 omega0
-    ux = w0.copy()          # centre's tangential velocity, units v0
-    om = np.zeros_like(w0)  # R omega, units v0
-    an = np.zeros_like(w0)
-    ft = np.zeros_like(w0)
-    live = np.ones(w0.shape, dtype=bool)
-    e = np.full_like(w0, np.nan)
-    wend = np.full_like(w0, np.nan)
-    for _ in range(50 * steps):
-        arm = 1.0 - lever * x
-        v_half = v - 0.5 * h * an
-        ux_half = ux - 0.5 * h * ft
-        om_half = om + 0.5 * h * arm * spin * ft
-        x = x + h * v_half
-        arm = 1.0 - lever * x
-        w = ux_half - arm * om_half
-        f = np.maximum(x + 2.0 * zeta * v_half, 0.0)
-        el = el + (w_t * w_t / F) * h * w
+    lever = None if rho is None else 1.0 / np.broadcast_to(np.asarray(rho, dtype=float),
+                                                         w0.shape)
+    k_t = w_t * w_t / F  # tangential stiffness per unit mass (contact-point mass m / F)
+    c_t = 2.0 * zeta_t * w_t / F
+
+    def force(x, v, s, w, alpha, cap):
+        f = np.maximum(x + 2.0 * zeta * v, 0.0)
+        el = k_t * s  # the incremental elastic force: the sum of k_t w dt
         over = np.abs(el) > cap * f
         el = np.where(over, np.sign(el) * cap * f, el)
-        ft = el + np.where(over, 0.0, 2.0 * zeta_t * w_t / F * w)
-        an = f
-        v = v_half - 0.5 * h * an
-        ux = ux_half - 0.5 * h * ft
-        om = om_half + 0.5 * h * arm * spin * ft
-        ended = live & (x <= 0.0)
-        e[ended] = -v[ended]
-        wend[ended] = (ux - om)[ended]
-        live &= ~ended
-        if not live.any():
-            break
-    if live.any():
-        raise RuntimeError("stepped contact law did not end its contact")
-    return e.reshape(shape), (-wend / w0).reshape(shape)
+        if k_t > 0.0:
+            s = np.where(over, el / k_t, s)
+        return f, el + np.where(over, 0.0, c_t * w), s
+    return _stepped(np.zeros(w0.shape), w0, mu, steps, force, F, lever, contact_time=math.pi)
 
 
 def mfix_coulomb(zeta: float, w_t: float, zeta_t, F: float, mu: float, w0,
@@ -476,9 +447,10 @@ def mfix_coulomb(zeta: float, w_t: float, zeta_t, F: float, mu: float, w0,
 
 
 def _stepped(alpha: np.ndarray, w0: np.ndarray, mu: float, steps: int, force, F: float,
-             lever=None) -> tuple[np.ndarray, np.ndarray]:
-    """Velocity Verlet over many points (time unit ``T = d_H / v0``; ``steps`` per elastic
-    Hertz contact time) until each contact ends (overlap back to zero):
+             lever=None, contact_time: float = 2.9432751843) -> tuple[np.ndarray, np.ndarray]:
+    """Velocity Verlet over many points (``steps`` per ``contact_time``: the elastic Hertz
+    contact time in the time unit ``T = d_H / v0`` by default, ``pi`` for a linear law in
+    ``1/omega0``) until each contact ends (overlap back to zero):
     ``force(x, v, s, w, alpha, mu) -> (a_n, a_t, s)`` gives the normal acceleration and the
     tangential force per unit mass (positive decelerates) and the history after the
     friction cap. The centre moves by ``-a_t``, the spin (``R omega``) by
@@ -490,7 +462,7 @@ def _stepped(alpha: np.ndarray, w0: np.ndarray, mu: float, steps: int, force, F:
     lev = (np.zeros_like(w0) if lever is None
            else np.broadcast_to(np.asarray(lever, dtype=float), shape).ravel())
     spin = F - 1.0
-    h = 2.9432751843 / steps
+    h = contact_time / steps
     cap = min(float(mu), 1e300)  # stick: the tangential force still ends with the normal one
     x = np.zeros_like(alpha)
     v = np.ones_like(alpha)
