@@ -884,13 +884,7 @@ class RestitutionTable:
             out = grid_a({a: arrays[a] for a in grid_a.axes
                           + ([grid_a.tensor_axis] if grid_a.tensor_axis else [])})
             out["e_x"] = np.abs(out["beta_x"])
-            result = {**arrays, **{k: out[k] for k in OUTPUTS}}
-            if all(a.ndim == 0 for a in bcast):
-                result = {k: float(v) for k, v in result.items()}
-            else:
-                result = {k: np.asarray(v, dtype=float) for k, v in result.items()}
-            result["error_bound"] = self.error_bound(method)
-            return result
+            return self._result(arrays, out, bcast, method)
         # one theta_ratio node: the slice at it (a table need not be a grid across thetas)
         theta = None
         if theta_axis and np.ndim(theta_ratio) == 0 and same_node(thetas, theta_ratio).any():
@@ -910,6 +904,13 @@ class RestitutionTable:
         out["e_x"] = np.where(np.isfinite(out["beta_x"]), np.abs(out["beta_x"]), out["e_x"])
         if extrapolate:
             out["e_x"] = np.clip(out["e_x"], 0.0, 1.0)
+        return self._result(arrays, out, bcast, method)
+
+    def _result(self, arrays: dict, out: dict, bcast: list, method: str) -> dict:
+        """Return the inputs and the outputs of a lookup, floats for scalar inputs.
+
+        With the table's ``error_bound`` for ``method``.
+        """
         result = {**arrays, **{k: out[k] for k in OUTPUTS}}
         if all(a.ndim == 0 for a in bcast):
             result = {k: float(v) for k, v in result.items()}
