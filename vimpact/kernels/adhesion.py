@@ -57,6 +57,18 @@ ADH_CONTACTS = 9  # number of separate contact intervals
 N_ADH_OUT = 10
 
 
+@jit()
+def _row_geometry(n_elem, dxi):
+    """``xi^2`` and ``sqrt(xi)`` at the element centres ``xi = (j + 1/2) dxi`` (units a_H)."""
+    xi2 = np.empty(n_elem)
+    sqrt_xi = np.empty(n_elem)
+    for j in range(n_elem):
+        xi = (j + 0.5) * dxi
+        xi2[j] = xi * xi
+        sqrt_xi[j] = math.sqrt(xi)
+    return xi2, sqrt_xi
+
+
 @jit(inline="always")
 def _edge_stress(j, w, q, g, c0, ve, ARMS):
     """Stress of element ``j`` in contact (units of ``E* d``): spring, arms, dashpot."""
@@ -126,12 +138,7 @@ def adhesive_impact(tau0, g, tau, lam, h, n_elem, dxi, max_steps, out):
     den_free = tau0_h + 1.0 + G - sum_gphi
     decay0 = math.exp(-h / c0) if c0 > 0.0 else 0.0
     k_el = 2.0 * ELEMENT_STIFFNESS * dxi  # both halves of the symmetric row
-    xi2 = np.empty(n_elem)
-    sqrt_xi = np.empty(n_elem)
-    for j in range(n_elem):
-        xi = (j + 0.5) * dxi
-        xi2[j] = xi * xi
-        sqrt_xi[j] = math.sqrt(xi)
+    xi2, sqrt_xi = _row_geometry(n_elem, dxi)
     w = np.zeros(n_elem)
     q = np.zeros((n_elem, n_arms))
     u = 0.0
@@ -254,12 +261,7 @@ def quasi_static_row(u_path, lam, n_elem, dxi, F_out, a_out):
     q = np.zeros((n_elem, 0))
     w = np.zeros(n_elem)
     k_el = 2.0 * ELEMENT_STIFFNESS * dxi
-    xi2 = np.empty(n_elem)
-    sqrt_xi = np.empty(n_elem)
-    for j in range(n_elem):
-        xi = (j + 0.5) * dxi
-        xi2[j] = xi * xi
-        sqrt_xi[j] = math.sqrt(xi)
+    xi2, sqrt_xi = _row_geometry(n_elem, dxi)
     n_c = 0
     for i in range(u_path.shape[0]):
         u1 = u_path[i]
