@@ -40,6 +40,8 @@ def test_states_its_error_and_size(table):
     assert TABLE.stat().st_size < 20e6
     build = table.meta("build")
     assert build["seconds"] > 0 and build["simulated"] > 0
+    # what the spec makes today (re-run `vimpact table build` on the spec otherwise)
+    assert table.meta("spec") == SPEC.read_text()
 
 
 def test_gross_slip_is_the_closed_form(table):
@@ -135,3 +137,41 @@ def test_bad_psi_nodes_name_the_key(tmp_path, line, why):
     with pytest.raises(ValueError) as info:
         load_spec(write(tmp_path, text))
     assert "grid.psi_nodes" in str(info.value) and why in str(info.value)
+
+
+SMALL = """
+model = "kelvin_voigt"
+output = "small.parquet"
+[numerics]
+preset = "fast"
+[grid]
+Q1 = { start = 0.05, stop = 0.2, num = 2 }
+nu = [0.3, 0.4, 0.5]
+tolerance = 2e-2
+refine = "adaptive"
+min_level = 0
+max_level = 2
+psi_nodes = [6, 8]
+"""
+
+
+@pytest.mark.slow
+def test_small_build_is_reproduced_by_verify(tmp_path):
+    """`table build` on a small friction spec: rows on the kinks (psi_s of every row at
+    the last node is in gross slip: its beta_x is the closed form), and `table verify`
+    with the build's points reproduces the stored error exactly."""
+    from vimpact.cli.main import main
+    from vimpact.lookup.table import RestitutionTable
+    from vimpact.tablebuild.verify import interpolation_error
+
+    spec = write(tmp_path, SMALL)
+    assert main(["table", "build", str(spec), "--n", "40"]) == 0
+    table = RestitutionTable.open(tmp_path / "small.parquet")
+    stored = table.interpolation_error
+    again = interpolation_error(table, n=40, seed=0)
+    assert again["outputs"] == stored["outputs"]
+    last = table.data[table.data["lattice_psi"] == table.data["lattice_psi"].max()]
+    chi = (1 - last["nu"]) * 3.5 / (2 - last["nu"])
+    np.testing.assert_allclose(last["beta_x"], -1 + 2 * chi * (1 + last["e_z"]) / last["psi"],
+                               rtol=0, atol=1e-9)
+    assert (table.data.loc[table.data["lattice_psi"] == 6 - 1, "psi"] == 1.0).all()
