@@ -32,6 +32,8 @@ import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.interpolate import CubicSpline
 
+from vimpact.model.hertz import HERTZ_TIME_FACTOR
+
 #: integrator tolerances of every law (relative, absolute)
 RTOL, ATOL = 1e-11, 1e-13
 
@@ -143,9 +145,9 @@ def hertz_overlap(E_star: float, R, m, v0):
 
 
 def hertz_contact_time(E_star: float, R: float, m: float, v0):
-    """Elastic Hertz contact time ``2.9432751843 d_H / v0``, s."""
+    """Elastic Hertz contact time ``HERTZ_TIME_FACTOR d_H / v0`` (about 2.943 d_H / v0), s."""
     v0 = np.asarray(v0, dtype=float)
-    return 2.9432751843 * hertz_overlap(E_star, R, m, v0) / v0
+    return HERTZ_TIME_FACTOR * hertz_overlap(E_star, R, m, v0) / v0
 
 
 def viscoelastic_hertz_restitution(A: float, E_star: float, R, m, v0) -> np.ndarray:
@@ -447,7 +449,7 @@ def mfix_coulomb(zeta: float, w_t: float, zeta_t, F: float, mu: float, w0,
 
 
 def _stepped(alpha: np.ndarray, w0: np.ndarray, mu: float, steps: int, force, F: float,
-             lever=None, contact_time: float = 2.9432751843) -> tuple[np.ndarray, np.ndarray]:
+             lever=None, contact_time: float = HERTZ_TIME_FACTOR) -> tuple[np.ndarray, np.ndarray]:
     """Velocity Verlet over many points (``steps`` per ``contact_time``: the elastic Hertz
     contact time in the time unit ``T = d_H / v0`` by default, ``pi`` for a linear law in
     ``1/omega0``) until each contact ends (overlap back to zero):
