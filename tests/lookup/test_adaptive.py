@@ -136,7 +136,7 @@ def _as_table(grid, report):
 
 
 def test_parquet_round_trip(analytic, tmp_path):
-    from vimpact.sweep.store import verify_table
+    from vimpact.tableformat.integrity import verify_table
 
     grid, report = analytic
     table = _as_table(grid, report)

@@ -163,17 +163,13 @@ from vimpact.model.toml_input import (
     required_keys,
     scene_from_values,
 )
-from vimpact.tableformat.schema import (  # noqa: F401 - the table's schema, found here too
+from vimpact.tableformat.schema import (
     ADHESION_OUTPUTS,
-    ADHESION_RESULTS,
     COLUMNS,
     LABELS,
     OUTPUTS,
-    RELATIVE,
-    RESULTS,
     SCHEMA_VERSION,
     SWEEP_STATUSES,
-    TANGENTIAL_OUTPUTS,
 )
 
 DEFAULT_CHUNK_SIZE = 64
@@ -502,7 +498,7 @@ class SweepSpec:
                     scene = dataclasses.replace(
                         scene, adhesion=adhesion_for_number(scene, p[ADHESION_AXIS]))
             if "psi" in p:
-                from vimpact.sweep.parameters import psi_reference
+                from vimpact.tableformat.parameters import psi_reference
                 v_x0, mu = psi_reference(np.array([p["psi"]]), np.array([p["nu"]]),
                                          self.grid_mu, scene.v_z0)
                 scene = dataclasses.replace(scene, v_x0=float(v_x0[0]), mu=float(mu[0]))
@@ -829,5 +825,4 @@ def _grid(spec: TomlSource, model: str, table) -> tuple[dict[str, np.ndarray], f
     return axes, tolerance, mu
 
 
-__all__ = ["COLUMNS", "Draw", "FILE_LAYOUT_MAX_ROWS", "LAYOUTS", "MAX_ROWS", "OUTPUTS",
-           "SCHEMA_VERSION", "SWEEP_STATUSES", "SweepSpec", "load_spec"]
+__all__ = ["Draw", "FILE_LAYOUT_MAX_ROWS", "LAYOUTS", "MAX_ROWS", "SweepSpec", "load_spec"]
