@@ -216,7 +216,8 @@ def _dask_task(spec: SweepSpec, chunk: int, parts: str) -> dict:
     import numba
     try:
         from distributed import get_worker
-        per_worker = max(1, numba.config.NUMBA_NUM_THREADS // max(1, get_worker().state.nthreads))
+        threads = numba.config.NUMBA_NUM_THREADS  # type: ignore[attr-defined]  # set at import
+        per_worker = max(1, threads // max(1, get_worker().state.nthreads))
     except Exception:  # noqa: BLE001 - not on a worker (tests call it directly)
         per_worker = numba.get_num_threads()
     if numba.get_num_threads() > per_worker:  # a cluster we did not start: no oversubscription

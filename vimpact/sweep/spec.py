@@ -320,7 +320,7 @@ def _axis(spec: TomlSource, key: str, value) -> np.ndarray:
             if start <= 0.0:
                 raise spec.bad(f"{key}.start", value["start"], "> 0 for a log-spaced axis")
             num = int(round(math.log10(stop / start) * per)) + 1
-            log = True
+            log: bool | None = True
         else:
             num = spec.integer(f"{key}.num", value["num"], 1)
             log = value.get("log")
@@ -499,6 +499,7 @@ class SweepSpec:
                         scene, adhesion=adhesion_for_number(scene, p[ADHESION_AXIS]))
             if "psi" in p:
                 from vimpact.tableformat.parameters import psi_reference
+                assert self.grid_mu is not None  # load_spec sets it with a psi axis
                 v_x0, mu = psi_reference(np.array([p["psi"]]), np.array([p["nu"]]),
                                          self.grid_mu, scene.v_z0)
                 scene = dataclasses.replace(scene, v_x0=float(v_x0[0]), mu=float(mu[0]))
@@ -635,7 +636,7 @@ def load_spec(path) -> SweepSpec:
             raise spec.error("seed", "missing: random draws need a seed (an integer >= 0)")
         seed = spec.integer("seed", data["seed"], 0)
         draws, arms, rows = _random(spec, model, data["random"])
-        axes = {}
+        axes: dict[str, np.ndarray] = {}
     else:
         mode = "grid"
         seed = spec.integer("seed", data.get("seed", 0), 0)
@@ -717,7 +718,7 @@ def _random(spec: TomlSource, model: str, table) -> tuple[dict, tuple, int]:
         if any(not x >= 0.0 for x in draws[ADHESION_KEY].values):
             raise spec.bad(f"random.{ADHESION_KEY}", table[ADHESION_KEY],
                            "works of adhesion >= 0, J/m^2")
-    arms = ()
+    arms: tuple[dict[str, Draw], ...] = ()
     if model == "prony":
         listed = table.get("arms", [])
         if not isinstance(listed, list) or not all(isinstance(a, dict) for a in listed):
