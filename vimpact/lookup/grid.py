@@ -380,6 +380,7 @@ class TensorLookup:
         theta = None
         if theta_axis and np.ndim(theta_ratio) == 0 and same_node(thetas, theta_ratio).any():
             theta = float(thetas[same_node(thetas, theta_ratio)][0])
+        key: float | str | None
         if theta_axis and theta is None:
             grid, key = self.lookup_grid(), ALL_AXES
         else:

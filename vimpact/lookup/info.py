@@ -43,7 +43,7 @@ def table_info(table: RestitutionTable) -> dict:
         except ValueError as exc:
             note = str(exc)
         build = table.meta("build")
-        if isinstance(build, dict):
+        if isinstance(build, dict) and adaptive is not None:  # None: the cells did not read
             adaptive["build"] = build
     else:
         try:

@@ -9,7 +9,7 @@ table is looked up at.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 
 import numpy as np
 
@@ -66,7 +66,7 @@ def incidence(angle_deg, mu, nu):
 
 def query_arrays(model: str, method: str, Q1, nu, Q2, psi, theta_ratio, psis: np.ndarray,
                  thetas: np.ndarray, resolve_theta: Callable[[float | None], float | None],
-                 ) -> tuple[dict[str, np.ndarray], list[np.ndarray]]:
+                 ) -> tuple[dict[str, np.ndarray], tuple[np.ndarray, ...]]:
     """Check the inputs of a lookup and broadcast them together.
 
     Parameters
@@ -91,7 +91,7 @@ def query_arrays(model: str, method: str, Q1, nu, Q2, psi, theta_ratio, psis: np
     arrays : dict
         Axis -> broadcast float array: ``Q1``, (``Q2``), ``nu``, (``theta_ratio`` when it
         is an axis), (``psi`` when the table has one; its only value if not given).
-    bcast : list of numpy.ndarray
+    bcast : tuple of numpy.ndarray
         The inputs as given, broadcast (0-d for scalars).
 
     Raises
@@ -149,10 +149,11 @@ def query_arrays(model: str, method: str, Q1, nu, Q2, psi, theta_ratio, psis: np
         raise InputError(", ".join(arrays) + " have shapes "
                          + ", ".join(str(a.shape) for a in arrays.values())
                          + " that do not broadcast together") from None
-    return dict(zip(arrays, bcast)), bcast
+    return dict(zip(arrays, bcast)), tuple(bcast)
 
 
-def lookup_result(arrays: dict, out: dict, bcast: list, bound: dict | None) -> dict:
+def lookup_result(arrays: dict, out: dict, bcast: Sequence[np.ndarray],
+                  bound: dict | None) -> dict:
     """Return the inputs and the outputs of a lookup, floats for scalar inputs.
 
     Parameters
@@ -161,7 +162,7 @@ def lookup_result(arrays: dict, out: dict, bcast: list, bound: dict | None) -> d
         Axis -> broadcast input array (:func:`query_arrays`).
     out : dict
         Output name -> interpolated array.
-    bcast : list of numpy.ndarray
+    bcast : sequence of numpy.ndarray
         The broadcast inputs (all 0-d: floats are returned).
     bound : dict or None
         The table's error bound for the method (stored as ``error_bound``).

@@ -25,8 +25,8 @@ BOUND_SLACK = 1e-6
 
 
 def _rows_text(rows: np.ndarray, limit: int = 3) -> str:
-    rows = [int(r) for r in rows[:limit]]
-    return ("row " if len(rows) == 1 else "rows ") + ", ".join(str(r) for r in rows)
+    first = [int(r) for r in rows[:limit]]
+    return ("row " if len(first) == 1 else "rows ") + ", ".join(str(r) for r in first)
 
 
 def validate_table(data: pd.DataFrame, metadata: dict, path=None) -> None:

@@ -210,6 +210,7 @@ def _existing_parts(spec, parts: Path, hasher: ContentHash | None = None) -> dic
         if kind == "foreign":
             raise ValueError(f"{path} {why}; remove {parts} to start over")
         if kind == "bad":
+            assert why is not None  # _check_part says why a part is bad
             try:
                 aside = move_aside(path)
             except FileNotFoundError:  # another process (a shard) moved or replaced it
