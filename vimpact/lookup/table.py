@@ -78,8 +78,8 @@ if TYPE_CHECKING:
     from vimpact.lookup.adaptive import AdaptiveGrid
     from vimpact.lookup.interpolate import HermiteGrid
 
-# the names below were defined here before the reader was split by job; they stay
-# importable from vimpact.lookup.table
+# the reader's public names, each defined in its module of vimpact.lookup, importable
+# from here as well as from vimpact.lookup
 __all__ = ["AXES", "BOUND_SLACK", "DATA_STATUSES", "LOG_AXES", "LOOKUP_METHODS",
            "LOOKUP_MODELS", "MAX_CURVE_POINTS", "OUTPUTS", "SPEC_HINTS", "RestitutionTable",
            "format_info", "incidence", "validate_table"]
