@@ -175,11 +175,10 @@ def test_lock_file_is_not_followed_even_past_the_check(tmp_path, monkeypatch):
     check switched off) is still not followed."""
     import errno
 
-    from vimpact.sweep import store
-    target = victim(tmp_path)
-    lock = store.OutputLock(tmp_path / "out.parquet")
-    lock.path.symlink_to(target)
     from vimpact.tableformat import files
+    target = victim(tmp_path)
+    lock = files.OutputLock(tmp_path / "out.parquet")
+    lock.path.symlink_to(target)
     monkeypatch.setattr(files, "refuse_symlink", lambda *a, **k: None)
     with pytest.raises(OSError) as info:
         lock._open()
@@ -188,12 +187,11 @@ def test_lock_file_is_not_followed_even_past_the_check(tmp_path, monkeypatch):
 
 def test_atomic_file_never_writes_through_a_planted_temporary(tmp_path):
     """A symbolic link planted at the temporary name is replaced, not written through."""
-    from vimpact.sweep import store
     from vimpact.tableformat import files
     target = victim(tmp_path)
     out = tmp_path / "t.csv"
     files._temporary(out).symlink_to(target)
-    with store.atomic_file(out, "out", mode="w") as f:
+    with files.atomic_file(out, "out", mode="w") as f:
         f.write("new")
     assert out.read_text() == "new" and target.read_text() == "keep me"
     assert not out.is_symlink() and not files._temporary(out).exists()
@@ -235,14 +233,14 @@ def test_table_export_refuses_a_symlinked_out(tmp_path, capsys):
 # ---- item 6: shards take a lock that a plain run respects -----------------------------
 
 def test_plain_run_is_refused_while_shards_run_and_the_other_way(tmp_path, capsys):
-    from vimpact.sweep import store
+    from vimpact.tableformat import files
     spec, out = str(sweep_spec(tmp_path)), tmp_path / "out.parquet"
-    with store.OutputLock(out, shared=True), store.OutputLock(out, shared=True):  # 2 shards
+    with files.OutputLock(out, shared=True), files.OutputLock(out, shared=True):  # 2 shards
         code, _, err = run(["sweep", spec, "--out", str(out)], capsys)
         one_line(code, err, "another sweep is writing", "--shard")
         code, _, err = run(["sweep", spec, "--out", str(out), "--combine"], capsys)
         one_line(code, err, "another sweep is writing")
-    with store.OutputLock(out):  # a plain run
+    with files.OutputLock(out):  # a plain run
         code, _, err = run(["sweep", spec, "--out", str(out), "--shard", "0/2"], capsys)
         one_line(code, err, "another sweep is writing", "pid")
     nothing_written(tmp_path, "s.toml")

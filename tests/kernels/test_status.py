@@ -5,7 +5,7 @@ from vimpact.engine.result import FINISHED
 from vimpact.engine.unpack import KERNEL_STATUSES
 from vimpact.kernels import layout, status
 from vimpact.lookup.table import DATA_STATUSES
-from vimpact.sweep.spec import SWEEP_STATUSES
+from vimpact.tableformat.schema import SWEEP_STATUSES
 
 
 def test_names_and_codes_are_unique():

@@ -136,7 +136,7 @@ def _as_table(grid, report):
 
 
 def test_parquet_round_trip(analytic, tmp_path):
-    from vimpact.sweep.store import verify_table
+    from vimpact.tableformat.integrity import verify_table
 
     grid, report = analytic
     table = _as_table(grid, report)
@@ -165,6 +165,18 @@ def test_damaged_structure_is_refused(analytic, tmp_path):
     table.data = table.data.iloc[16:].reset_index(drop=True)  # a leaf node's rows gone
     with pytest.raises(InputError):
         table.lookup(1.0, 0.3, Q2=1.0)
+
+
+def test_info_of_a_damaged_adaptive_table_says_why(analytic):
+    """The summary of a table whose cells cannot be rebuilt names the reason (with a
+    recorded build too) instead of failing."""
+    grid, report = analytic
+    table = _as_table(grid, report)
+    table.metadata["vimpact.build"] = json.dumps({"seconds": 1.0, "simulated": 10})
+    table.data = table.data.iloc[16:].reset_index(drop=True)  # a leaf node's rows gone
+    info = table.info()
+    assert info["adaptive"] is None and "adaptive table" in info["grid_note"]
+    assert "grid            none: adaptive table" in str(table)
 
 
 def test_adaptive_spec_keys(tmp_path):

@@ -32,8 +32,8 @@ NODE_TOLERANCE = 1e-6
 def _stale_reasons(model: str) -> list[str]:
     from vimpact.lookup.table import RestitutionTable
     from vimpact.sweep import load_spec
-    from vimpact.sweep.spec import SCHEMA_VERSION
     from vimpact.tablebuild.verify import numerics_of, simulate_dimensionless
+    from vimpact.tableformat.schema import SCHEMA_VERSION
 
     spec_path = ROOT / "sweeps" / f"{model}_table.toml"
     table = RestitutionTable.open(ROOT / "sweeps" / "tables" / f"{model}_table.parquet")

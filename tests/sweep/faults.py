@@ -219,6 +219,7 @@ def flip_survey(part: Path, spec, flips: int = 200, seed: int = 0) -> dict:
     import pandas as pd
 
     from vimpact.sweep import store
+    from vimpact.tableformat import metadata
 
     original = pq.read_table(part).to_pandas()
     rng = random.Random(seed)
@@ -241,7 +242,7 @@ def flip_survey(part: Path, spec, flips: int = 200, seed: int = 0) -> dict:
             else:
                 now["detected" if kind == "bad" else "refused"] += 1
             try:  # the check resume made before: the footer only
-                meta = store.decode_metadata(pq.read_schema(copy).metadata)
+                meta = metadata.decode_metadata(pq.read_schema(copy).metadata)
                 footer_ok = meta.get("sweep_hash") == spec.sweep_hash \
                     and meta.get("chunk") == int(part.stem.split("-")[1])
             except Exception:  # noqa: BLE001
@@ -264,8 +265,8 @@ def flip_survey(part: Path, spec, flips: int = 200, seed: int = 0) -> dict:
 def overhead(rows: int = 200_000, repeats: int = 3) -> dict:
     """CPU seconds (best of ``repeats``, side by side) of writing and reading a table of
     ``rows`` rows shaped like a sweep's (1 int64, 30 float64, 3 string columns): plain
-    ``pyarrow.parquet`` vs :func:`vimpact.sweep.store.write_atomic` (page checksums,
-    content hash, fsync) and :func:`vimpact.sweep.store.verify_table` (every page
+    ``pyarrow.parquet`` vs :func:`vimpact.tableformat.files.write_atomic` (page checksums,
+    content hash, fsync) and :func:`vimpact.tableformat.integrity.verify_table` (every page
     read with its CRC checked, hash recomputed)."""
     import tempfile
     import time
@@ -273,7 +274,7 @@ def overhead(rows: int = 200_000, repeats: int = 3) -> dict:
     import numpy as np
     import pyarrow as pa
 
-    from vimpact.sweep import store
+    from vimpact.tableformat import files, integrity
 
     rng = np.random.default_rng(0)
     cols = {"row": pa.array(np.arange(rows, dtype=np.int64))}
@@ -294,10 +295,10 @@ def overhead(rows: int = 200_000, repeats: int = 3) -> dict:
         plain, checked = Path(tmp) / "plain.parquet", Path(tmp) / "checked.parquet"
         out = {"rows": rows,
                "write_plain_s": best(lambda: pq.write_table(table, plain)),
-               "write_checked_s": best(lambda: store.write_atomic(table, checked)),
+               "write_checked_s": best(lambda: files.write_atomic(table, checked)),
                "read_plain_s": best(lambda: pq.read_table(plain)),
-               "verify_s": best(lambda: store.verify_table(checked)),
-               "hash_only_s": best(lambda: store.content_hash(table)),
+               "verify_s": best(lambda: integrity.verify_table(checked)),
+               "hash_only_s": best(lambda: integrity.content_hash(table)),
                "bytes_plain": plain.stat().st_size, "bytes_checked": checked.stat().st_size}
     out["write_ratio"] = out["write_checked_s"] / out["write_plain_s"]
     out["verify_vs_read_ratio"] = out["verify_s"] / out["read_plain_s"]

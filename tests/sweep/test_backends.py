@@ -15,8 +15,9 @@ import pytest
 import vimpact as v
 from tests.sweep import write
 from vimpact import cli
-from vimpact.sweep import load_spec, parts_dir, read_metadata, run_sweep, runner, store
+from vimpact.sweep import load_spec, parts_dir, read_metadata, run_sweep, runner
 from vimpact.sweep.parameters import chunk_parameters
+from vimpact.tableformat import files, metadata
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -258,9 +259,9 @@ def test_dataset_layout_reads_back_as_a_table(tmp_path, reference, main, capsys)
 def test_metadata_codec_round_trips():
     values = {"rows": 12, "seed": 3, "rotation": False, "paths": {"a": {"rows": 2}},
               "units": {"e_z": "1"}, "model": "prony", "description": "12"}
-    raw = store.encode_metadata(values)
+    raw = metadata.encode_metadata(values)
     assert raw[b"vimpact.rotation"] == b"false" and raw[b"vimpact.rows"] == b"12"
-    assert store.decode_metadata(raw) == values
+    assert metadata.decode_metadata(raw) == values
 
 
 # ---- command line: progress, output checks, lock -----------------------------------
@@ -298,7 +299,7 @@ def test_bad_output_is_refused_before_any_work(tmp_path, main, capsys, monkeypat
 def test_a_second_sweep_into_the_same_output_is_refused(tmp_path, main, capsys, monkeypatch):
     out = tmp_path / "t.parquet"
     monkeypatch.setattr(runner, "compute_chunk", lambda *a: pytest.fail("computed"))
-    with store.OutputLock(out):
+    with files.OutputLock(out):
         assert main(["sweep", str(write(tmp_path, GRID_SS)), "--out", str(out)]) == 2
     err = capsys.readouterr().err
     assert "another sweep is writing" in err and str(out) in err

@@ -119,7 +119,7 @@ def test_grid_tolerance_on_an_elastic_grid_is_refused(tmp_path):
 def test_refined_dataset_keeps_only_its_parts(tmp_path):
     """Dataset layout: the cache sits among the parts while the sweep runs and leaves
     before _common_metadata is written (a dataset holds only its parts)."""
-    from vimpact.sweep.store import verify_table
+    from vimpact.tableformat.integrity import verify_table
 
     path = tmp_path / "kv.toml"
     path.write_text(KV.format(tol=TOL).replace('output = "kv.parquet"',

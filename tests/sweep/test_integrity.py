@@ -5,7 +5,7 @@ Parts (resume): a bit flip in a data page, a damaged page header, a truncated
 part, a file that is not this chunk's part -> detected, moved to
 ``<parts>/_corrupt/`` with one stderr line, computed again, and the table equals a
 clean run's byte for byte. A part of another sweep -> refused. Final table: the
-same faults -> :func:`~vimpact.sweep.store.verify_table` refuses with
+same faults -> :func:`~vimpact.tableformat.integrity.verify_table` refuses with
 ``InputError``; ``--resume`` writes it again. Full disk (``ENOSPC`` midway) ->
 one clear error, finished parts intact, a later resume completes. A second
 sweep into the same output -> refused while the first lives, allowed once it
@@ -27,7 +27,7 @@ from vimpact import cli
 from vimpact.model.validation import InputError
 from vimpact.sweep import parts_dir, run_sweep, store
 from vimpact.sweep.spec import load_spec
-from vimpact.tableformat import files
+from vimpact.tableformat import files, integrity, metadata
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -77,23 +77,23 @@ def test_content_hash_is_independent_of_the_parquet_encoding(tmp_path):
                       "e_z": [0.5, float("nan"), -0.0, 1e-300],
                       "status": ["ok", "ok", "invalid", "ok"],
                       "error": pa.array([None, None, "nu = 0.7", None], pa.string())})
-    digest = store.content_hash(table)
+    digest = integrity.content_hash(table)
     ways = [dict(compression="zstd", row_group_size=1), dict(compression="none",
             use_dictionary=False), dict(compression="snappy", use_dictionary=True)]
     for k, options in enumerate(ways):
         pq.write_table(table, tmp_path / f"{k}.parquet", **options)
         back = pq.read_table(tmp_path / f"{k}.parquet")
-        assert store.content_hash(back) == digest
+        assert integrity.content_hash(back) == digest
     big = table.cast(pa.schema([("row", pa.int64()), ("e_z", pa.float64()),
                                 ("status", pa.large_string()), ("error", pa.large_string())]))
-    assert store.content_hash(big) == digest
-    pieces = store.ContentHash()
+    assert integrity.content_hash(big) == digest
+    pieces = integrity.ContentHash()
     for batch in table.to_batches(max_chunksize=3):
         pieces.update(batch)
     assert pieces.hexdigest() == digest
     # an all-null string column equals an Arrow null column (a pandas round trip makes one)
     nulls = pa.table({"error": pa.array([None, None], pa.string())})
-    assert store.content_hash(nulls) == store.content_hash(pa.table({"error": pa.nulls(2)}))
+    assert integrity.content_hash(nulls) == integrity.content_hash(pa.table({"error": pa.nulls(2)}))
 
 
 @pytest.mark.parametrize("change", ["value", "nan payload", "null", "string", "name", "order"])
@@ -108,20 +108,20 @@ def test_content_hash_sees_every_change(change):
         "name": lambda: pa.table({"b": [1.0, 2.0], "s": table["s"]}),
         "order": lambda: pa.table({"a": [2.0, 1.0], "s": table["s"]}),
     }[change]()
-    assert store.content_hash(other) != store.content_hash(table)
+    assert integrity.content_hash(other) != integrity.content_hash(table)
 
 
 def test_parts_and_tables_carry_checksums_and_hash(tmp_path, clean):
     spec, clean_bytes = clean
     parts = parts_of(spec, tmp_path / "t.parquet")
     for part in parts.glob("part-*.parquet"):
-        meta = store.read_metadata(part)
-        assert meta["content_sha256"] == store.content_hash(pq.read_table(part))
+        meta = metadata.read_metadata(part)
+        assert meta["content_sha256"] == integrity.content_hash(pq.read_table(part))
         assert store.verify_part(part, load_spec(spec)) is None
     out = run_sweep(spec, out=tmp_path / "t.parquet", resume=True, progress=False)
     assert out.read_bytes() == clean_bytes
-    assert store.verify_table(out).endswith("content hash verified")
-    assert store.read_metadata(out)["content_sha256"] == store.content_hash(pq.read_table(out))
+    assert integrity.verify_table(out).endswith("content hash verified")
+    assert metadata.read_metadata(out)["content_sha256"] == integrity.content_hash(pq.read_table(out))
     # the checksums are there: the same flip that passes an unchecked read is caught
     offset, bit = faults.flip_in_data_page(out, "e_z", seed=3)
     with pytest.raises(OSError, match="CRC|checksum"):
@@ -284,11 +284,11 @@ def test_verify_table_refuses_a_damaged_table(tmp_path, clean, fault):
     spec, clean_bytes = clean
     out = tmp_path / "t.parquet"
     out.write_bytes(clean_bytes)
-    assert store.verify_table(out).startswith("ok: 6 rows, 3 row group(s)")
+    assert integrity.verify_table(out).startswith("ok: 6 rows, 3 row group(s)")
     damage, what = TABLE_FAULTS[fault]
     damage(out)
     with pytest.raises(InputError) as info:
-        store.verify_table(out)
+        integrity.verify_table(out)
     message = str(info.value)
     assert str(out) in message and what in message and "\n" not in message
 
@@ -327,7 +327,7 @@ def test_a_table_without_a_hash_is_accepted_with_the_check_skipped(tmp_path, cle
             if k not in (b"vimpact.content_sha256", b"vimpact.metadata_sha256")}
     old = tmp_path / "old.parquet"
     pq.write_table(table.replace_schema_metadata(meta), old)  # as vimpact wrote before
-    assert store.verify_table(old).endswith("hash check skipped")
+    assert integrity.verify_table(old).endswith("hash check skipped")
     assert store.is_complete(load_spec(spec), old)
 
 
@@ -335,31 +335,31 @@ def test_the_shipped_tables_pass(tmp_path):
     shipped = sorted((ROOT / "sweeps" / "tables").glob("*.parquet"))
     assert shipped
     for table in shipped:
-        assert store.verify_table(table).startswith("ok:")
+        assert integrity.verify_table(table).startswith("ok:")
 
 
 def test_dataset_layout_damaged_part_is_refused_then_recomputed(tmp_path, clean, capsys):
     spec, clean_bytes = clean
     ds_spec = write(tmp_path, 'layout = "dataset"\n' + GRID_KV, "dataset.toml")
     out = run_sweep(ds_spec, out=tmp_path / "ds.parquet", progress=False)
-    assert store.verify_table(out).endswith("content hash verified")
+    assert integrity.verify_table(out).endswith("content hash verified")
     (tmp_path / "clean.parquet").write_bytes(clean_bytes)
     pd.testing.assert_frame_equal(pd.read_parquet(out), pd.read_parquet(tmp_path / "clean.parquet"))
     # one hash for the same rows, whether one file or a dataset of parts
-    assert store.read_metadata(out)["content_sha256"] \
-        == store.read_metadata(tmp_path / "clean.parquet")["content_sha256"]
+    assert metadata.read_metadata(out)["content_sha256"] \
+        == metadata.read_metadata(tmp_path / "clean.parquet")["content_sha256"]
     faults.flip_in_data_page(out / "part-00001.parquet", "e_z", seed=0)
     with pytest.raises(InputError, match="part-00001.parquet"):
-        store.verify_table(out)
+        integrity.verify_table(out)
     rows, progress = counting()
     assert run_sweep(ds_spec, out=out, resume=True, progress=progress) == out
     assert rows == [6]
-    assert store.verify_table(out).endswith("content hash verified")
+    assert integrity.verify_table(out).endswith("content hash verified")
     assert (out / store.CORRUPT_DIR / "part-00001.parquet").exists()
     # a stray file in the dataset would be read as rows: refused, by name
     faults.write_foreign_parquet(out / "stray.parquet")
     with pytest.raises(InputError, match="stray.parquet"):
-        store.verify_table(out)
+        integrity.verify_table(out)
 
 
 # ---- full disk --------------------------------------------------------------------
@@ -393,7 +393,7 @@ def test_full_disk_one_clear_error_then_resume(tmp_path, clean, monkeypatch, cap
 
 HOLD = """
 import sys, time
-from vimpact.sweep.store import OutputLock
+from vimpact.tableformat.files import OutputLock
 with OutputLock(sys.argv[1]):
     print("locked", flush=True)
     time.sleep(60)

@@ -13,7 +13,7 @@ import vimpact as v
 from tests.sweep import write
 from vimpact import cli
 from vimpact.sweep import SweepInterrupted, load_spec, parts_dir, read_metadata, run_sweep, runner
-from vimpact.sweep import spec as sweep
+from vimpact.tableformat import schema
 
 SWEEPS = Path(__file__).resolve().parents[2] / "sweeps"
 TINY = v.Numerics(steps=100, elements=20)
@@ -180,7 +180,7 @@ def test_shipped_tables_are_current():
     assert not stale, ("stale tables, regenerate with `vimpact sweep` (`vimpact table build` "
                        f"for an adaptive spec): {stale}")
     for spec in shipped:
-        assert read_metadata(spec.output)["schema_version"] == sweep.SCHEMA_VERSION
+        assert read_metadata(spec.output)["schema_version"] == schema.SCHEMA_VERSION
 
 
 # ---- end to end ---------------------------------------------------------------
@@ -299,7 +299,7 @@ def test_metadata_round_trips(tmp_path):
     raw = pq.read_schema(path).metadata
     assert raw[b"vimpact.model"] == b"kelvin_voigt"
     meta = read_metadata(path)
-    assert meta["schema_version"] == sweep.SCHEMA_VERSION
+    assert meta["schema_version"] == schema.SCHEMA_VERSION
     assert meta["model"] == "kelvin_voigt" and meta["mode"] == "random"
     assert meta["seed"] == 7 and meta["rows"] == 8
     assert meta["version"] == v.__version__
@@ -412,7 +412,7 @@ def test_nan_without_a_status_becomes_non_finite(tmp_path):
     spec = load_spec(write(tmp_path, GRID_SS))
     cols = {"e_z": np.array([0.5, np.nan]), "e_x": np.array([np.nan, 0.1]),
             "beta_x": np.array([np.nan, 0.1])}
-    cols.update({c: np.zeros(2) for c in sweep.OUTPUTS if c not in cols})
+    cols.update({c: np.zeros(2) for c in schema.OUTPUTS if c not in cols})
     status = np.array(["vc0_zero", "half_space"], dtype=object)
     error = np.array([None, None], dtype=object)
     runner.guard_nan(cols, status, error, np.array([True, False]), np.array([True, True]))

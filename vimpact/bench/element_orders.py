@@ -51,13 +51,12 @@ from vimpact.kernels.elements import (
     KernelSpec,
     element_kernel,
 )
+from vimpact.model.hertz import HERTZ_TIME_FACTOR, Q1_PER_TAU
 
 from .machine import machine_info, module_at_commit, save_figure
 
 TITLE = "element kernel: observed orders in steps and elements against the continuum kernel"
 
-HERTZ_TIME = 2.9432751843
-Q1_PER_TAU = math.sqrt(15.0 / 32.0)
 BEFORE = "308d824"  # main before the arms were taken implicitly in the kick
 #: the default step refinement of a solid sphere's tangential problem (routing)
 TANGENTIAL_FACTOR = math.sqrt(2.0 / 3.0 * 3.5)
@@ -78,7 +77,7 @@ def run_rows(spec, *, h, dxi, tau0=0.0, g=(), tau=(), nu=NU, theta_ratio=THETA_R
         tau0.copy(), g, tau, np.full(n, g.shape[1], dtype=np.int64),
         np.full(n, 2.0 * (1.0 - nu) / (2.0 - nu)), np.full(n, 1.0 + 1.0 / theta_ratio), mu.copy(),
         h.copy(), np.ceil(row_width / dxi - 1e-9).astype(np.int64), dxi.copy(),
-        np.ceil(max_time * HERTZ_TIME / h).astype(np.int64), np.zeros((n, 0, N_REC)), 1, out)
+        np.ceil(max_time * HERTZ_TIME_FACTOR / h).astype(np.int64), np.zeros((n, 0, N_REC)), 1, out)
     return out
 
 
@@ -162,7 +161,7 @@ def envelope(spec, ez_ref, ex_ref, levels, **material) -> dict:
     ez_env, ex_env = [], []
     for n in levels:
         counts = n + np.arange(ENVELOPE_SHIFTS) / ENVELOPE_SHIFTS
-        out = run_rows(spec, h=HERTZ_TIME / (6.0 * n) / TANGENTIAL_FACTOR, dxi=1.0 / counts,
+        out = run_rows(spec, h=HERTZ_TIME_FACTOR / (6.0 * n) / TANGENTIAL_FACTOR, dxi=1.0 / counts,
                        **material)
         assert (out[:, OUT_STATUS] == STATUS_OK).all(), out[:, OUT_STATUS]
         ez_env.append(float(np.abs(-out[:, OUT_VZ_END] - ez_ref).max()))
@@ -178,7 +177,7 @@ def element_reference(spec, **material) -> tuple[float, float, float]:
     1600 elements per a_H and two spacings 0.02 % and 0.04 % apart: their mean,
     and the spread of beta_x over the three).
     """
-    out = run_rows(spec, h=HERTZ_TIME / 9600 / TANGENTIAL_FACTOR,
+    out = run_rows(spec, h=HERTZ_TIME_FACTOR / 9600 / TANGENTIAL_FACTOR,
                    dxi=1.0 / (1600.0 + np.array([0.0, 0.37, 0.71])), **material)
     assert (out[:, OUT_STATUS] == STATUS_OK).all()
     return (float(-out[:, OUT_VZ_END].mean()), float(out[:, OUT_VC_END].mean()),
@@ -255,9 +254,9 @@ def run(quick: bool) -> dict:
                         np.abs(np.abs(out[:, OUT_VC_END]) - ex_ref).tolist())
 
             ladders: dict[str, dict[str, Any]] = {
-                "time": dict(h=HERTZ_TIME / steps / TANGENTIAL_FACTOR, dxi=1.0 / fine_elems),
-                "space": dict(h=HERTZ_TIME / fine_steps / TANGENTIAL_FACTOR, dxi=1.0 / elems),
-                "joint": dict(h=HERTZ_TIME / joint / TANGENTIAL_FACTOR, dxi=6.0 / joint),
+                "time": dict(h=HERTZ_TIME_FACTOR / steps / TANGENTIAL_FACTOR, dxi=1.0 / fine_elems),
+                "space": dict(h=HERTZ_TIME_FACTOR / fine_steps / TANGENTIAL_FACTOR, dxi=1.0 / elems),
+                "joint": dict(h=HERTZ_TIME_FACTOR / joint / TANGENTIAL_FACTOR, dxi=6.0 / joint),
             }
             for lname, kw in ladders.items():
                 ez, ex = errors(run_rows(spec, tau0=tau0, g=g, tau=tau, kernel=k, **kw))
@@ -266,7 +265,7 @@ def run(quick: bool) -> dict:
                 r[f"{lname}_e_z_fitted_order"] = fitted_order(ez)
                 r[f"{lname}_e_x_fitted_order"] = fitted_order(ex)
             if label == "after":
-                out = run_rows(spec, h=HERTZ_TIME / sweep_steps / TANGENTIAL_FACTOR,
+                out = run_rows(spec, h=HERTZ_TIME_FACTOR / sweep_steps / TANGENTIAL_FACTOR,
                                dxi=1.0 / sweep, tau0=tau0, g=g, tau=tau, kernel=k)
                 ez, ex = -out[:, OUT_VZ_END] - ez_ref, np.abs(out[:, OUT_VC_END]) - ex_ref
                 r["sweep_e_z_error"], r["sweep_e_x_error"] = ez.tolist(), ex.tolist()

@@ -22,8 +22,9 @@ import numba
 import numpy as np
 
 from vimpact.kernels.elements import OUT_T_CONTACT, OUT_T_GROSS_SLIP, OUT_VC_END, VERLET, KernelSpec
+from vimpact.model.hertz import HERTZ_TIME_FACTOR
 
-from .element_orders import HERTZ_TIME, TANGENTIAL_FACTOR, mu_for, run_rows
+from .element_orders import TANGENTIAL_FACTOR, mu_for, run_rows
 from .machine import figure, machine_info, median_time, save_figure
 
 TITLE = "Coulomb friction: friction kernel against stick kernel, beta_x error vs time"
@@ -57,7 +58,7 @@ def run(quick: bool) -> dict:
     numba.set_num_threads(1)  # one thread: the ratio, not the parallel speed-up
     data: dict[str, Any] = {"machine": machine_info(), "steps": steps, "elements": elements, "rows": rows,
             "threads_used": 1, "cost": {}, "ladder": {}}
-    h = HERTZ_TIME / steps / TANGENTIAL_FACTOR
+    h = HERTZ_TIME_FACTOR / steps / TANGENTIAL_FACTOR
     for name, (tau0, g, tau) in MATERIALS.items():
         stick = KernelSpec(VERLET, True, 0, len(g) > 0, tau0 > 0.0)
         fric = stick._replace(friction=True)
@@ -87,7 +88,7 @@ def run(quick: bool) -> dict:
         ladder = {}
         for label, (spec, mu) in (("friction_psi_3chi", (fric, mu_for(3.0))),
                                   ("stick", (stick, math.inf))):
-            hs = HERTZ_TIME / ladder_steps / TANGENTIAL_FACTOR
+            hs = HERTZ_TIME_FACTOR / ladder_steps / TANGENTIAL_FACTOR
             dx = 1.0 / np.maximum(ladder_steps // 7, 10)
             fine = run_rows(spec, mu=mu, h=hs[-1] / 2, dxi=dx[-1] / 2, tau0=tau0, g=g, tau=tau,
                             nu=NU, theta_ratio=THETA)
@@ -98,7 +99,7 @@ def run(quick: bool) -> dict:
                            theta_ratio=THETA)
                 t = median_time(lambda: run_rows(spec, **kwi), repeats) / 2
                 out = run_rows(spec, **kwi)
-                pts.append({"steps": int(round(HERTZ_TIME / hi / TANGENTIAL_FACTOR)),
+                pts.append({"steps": int(round(HERTZ_TIME_FACTOR / hi / TANGENTIAL_FACTOR)),
                             "elements": int(round(1 / di)), "seconds_per_impact": t,
                             "beta_x_error": abs(float(-out[0, OUT_VC_END]) - beta_fine)})
             err = np.array([p["beta_x_error"] for p in pts])

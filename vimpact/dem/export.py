@@ -26,21 +26,21 @@ class Export:
 
 
 def code_module(code: str):
-    """The module of a DEM code (one of :data:`CODES`)."""
+    """Return the module of a DEM code (one of :data:`CODES`)."""
     return importlib.import_module(f"vimpact.dem.{one_of('--for', code, CODES)}")
 
 
 def export(problem: DemProblem, code: str, out_dir=None, numerics=None,
            targets: dict[str, Targets] | None = None, steps_per_contact: int | None = None,
            progress=None, tangential: bool | None = None) -> Export:
-    """Fit ``code``'s constants for every contact of ``problem``; with ``out_dir``
-    write its input file(s), ``report_<code>.md`` and ``report_<code>.png`` there.
+    """Fit ``code``'s constants for every contact of ``problem``; write the files.
 
-    ``targets`` (from an earlier call, by contact key) skips the vimpact runs of
-    the contacts it holds (those without ``beta_x`` are run again when the code
-    has a tangential restitution). ``steps_per_contact``
-    sets the exported time step of the codes that get one (LAMMPS, LIGGGHTS,
-    Yade; default: the module's ``STEPS_PER_CONTACT``). ``progress(text)`` is
+    With ``out_dir``, the code's input file(s), ``report_<code>.md`` and
+    ``report_<code>.png`` are written there. ``targets`` (from an earlier call, by
+    contact key) skips the vimpact runs of the contacts it holds (those without
+    ``beta_x`` are run again when the code has a tangential restitution).
+    ``steps_per_contact`` sets the exported time step of the codes that get one (LAMMPS,
+    LIGGGHTS, Yade; default: the module's ``STEPS_PER_CONTACT``). ``progress(text)`` is
     called before each contact's vimpact runs and before the fit. ``tangential=False``
     skips ``beta_x`` (and the tangential fits) for a code that has it.
     """
@@ -101,12 +101,13 @@ def export_to_residual(problem: DemProblem, code: str, residual: float, out_dir=
                        numerics=None, steps_per_contact: int | None = None,
                        progress=None, tangential: bool | None = None
                        ) -> tuple[Export, bool, int]:
-    """Split every size-range type into size classes
-    (:meth:`DemProblem.with_size_classes`) until the largest ``e_z`` residual of
-    every contact is at most ``residual``: 1 class, then (the size range's error
-    falling about as 1/k) the number that scaling says, checked again, up to
-    :data:`MAX_SIZE_CLASSES`; it stops early when a split no longer lowers the
-    residual (what is left is not the size range's, e.g. the speed dependence a
+    """Split the size-range types into size classes until ``e_z`` meets ``residual``.
+
+    Size classes as in :meth:`DemProblem.with_size_classes`, until the largest ``e_z``
+    residual (dimensionless) of every contact is at most ``residual``: 1 class, then
+    (the size range's error falling about as 1/k) the number that scaling says, checked
+    again, up to :data:`MAX_SIZE_CLASSES`; it stops early when a split no longer lowers
+    the residual (what is left is not the size range's, e.g. the speed dependence a
     constant-``e`` code cannot follow). Writes the files of the best problem (with
     ``beta_x`` and the tangential fits, unless ``tangential=False``; the search itself
     uses ``e_z`` only).

@@ -58,9 +58,12 @@ class Oblique:
 
 
 def oblique_targets(problem: DemProblem, contact: Contact, numerics=None) -> Oblique:
-    """Run vimpact with the contact's friction at :data:`OBLIQUE_SPEEDS` of the set-up's
-    speeds times its impact angles (``[speeds] angles_deg``, else
-    :data:`DEFAULT_ANGLES_DEG`), nominal sizes."""
+    """Run vimpact's oblique impacts of ``contact``, with its friction, at nominal sizes.
+
+    At :data:`OBLIQUE_SPEEDS` of the set-up's speeds (m/s) times its impact angles
+    (``[speeds] angles_deg``, else :data:`DEFAULT_ANGLES_DEG`, degrees from the
+    normal).
+    """
     from vimpact.model.numerics import Numerics
 
     numerics = numerics or Numerics.preset("fast")
@@ -117,7 +120,7 @@ class Targets:
     oblique: Oblique | None = None
 
     def subset(self, mask: np.ndarray) -> Targets:
-        """The points selected by ``mask``."""
+        """Return the points selected by ``mask``."""
         pick = lambda a: None if a is None else a[mask]  # noqa: E731
         return Targets(self.contact, self.v[mask], self.level[mask], self.R[mask], self.m[mask],
                        self.e_z[mask], pick(self.beta_x), self.t_contact[mask], self.status[mask],
@@ -130,8 +133,11 @@ class Targets:
 
 
 def adhesive_scene(contact: Contact, level, v: float = 1.0):
-    """The adhesive normal-impact scene (:class:`vimpact.Scene`, ``adhesion`` the
-    contact's) of ``contact`` at the size level ``level`` and approach speed ``v`` (m/s)."""
+    """Return the adhesive normal-impact scene of ``contact`` at a size level and speed.
+
+    A :class:`vimpact.Scene` with the contact's ``adhesion``, at the size level
+    ``level`` and approach speed ``v`` (m/s).
+    """
     from vimpact.model.pair import Body, Wall, pair_scene
     from vimpact.model.scene import Scene
 
@@ -144,9 +150,12 @@ def adhesive_scene(contact: Contact, level, v: float = 1.0):
 
 
 def adhesive_restitution(contact: Contact, level, speeds, numerics):
-    """vimpact's adhesive ``e_z`` (0 where the sphere sticks), contact time and status of
-    ``contact`` at ``level`` over ``speeds`` (:func:`vimpact.engine.adhesion.simulate_adhesive`),
-    as a DataFrame like :func:`vimpact.engine.pairs.pair_restitution`'s."""
+    """Run vimpact's adhesive normal impacts of ``contact`` at ``level`` over ``speeds`` (m/s).
+
+    Returns ``e_z`` (0 where the sphere sticks), contact time (s) and status
+    (:func:`vimpact.engine.adhesion.simulate_adhesive`) as a DataFrame like
+    :func:`vimpact.engine.pairs.pair_restitution`'s.
+    """
     import pandas as pd
 
     from vimpact.engine.adhesion import simulate_adhesive
@@ -160,8 +169,11 @@ def adhesive_restitution(contact: Contact, level, speeds, numerics):
 
 def compute_targets(problem: DemProblem, contact: Contact, *, tangential: bool = False,
                     numerics=None) -> Targets:
-    """Run vimpact for ``contact`` at every size level and speed of ``problem`` (with
-    adhesion, :func:`adhesive_restitution`: ``e_z`` 0 where the sphere sticks)."""
+    """Run vimpact for ``contact`` at every size level and speed of ``problem``.
+
+    With adhesion through :func:`adhesive_restitution` (``e_z`` 0 where the sphere
+    sticks).
+    """
     from vimpact.model.numerics import Numerics
 
     numerics = numerics or Numerics.preset("fast")
@@ -205,6 +217,7 @@ class Residual:
 
     @classmethod
     def of(cls, predicted, target) -> Residual:
+        """Return the residual of ``predicted`` against ``target`` (both dimensionless)."""
         d = np.asarray(predicted, dtype=float) - np.asarray(target, dtype=float)
         return cls(float(np.max(np.abs(d))), float(np.sqrt(np.mean(d * d))))
 
@@ -239,7 +252,7 @@ class ContactFit:
 
 
 def fit_constant(target: np.ndarray, lo: float = 0.0, hi: float = 1.0) -> tuple[float, Residual]:
-    """The constant closest to ``target`` in RMS (its mean), clipped to ``[lo, hi]``."""
+    """Return the constant closest to ``target`` in RMS (its mean), clipped to ``[lo, hi]``."""
     c = float(np.clip(np.mean(target), lo, hi))
     return c, Residual.of(np.full_like(target, c), target)
 
@@ -282,16 +295,22 @@ def fit_viscoelastic_hertz(t: Targets, E_star: float, mass_factor: np.ndarray | 
 
 def viscoelastic_hertz_prediction(t: Targets, E_star: float, A: float,
                                   mass_factor: np.ndarray | None = None) -> np.ndarray:
-    """The viscoelastic Hertz law's restitution at the points of ``t`` with constant ``A``
-    (times ``mass_factor`` per point, as in :func:`fit_viscoelastic_hertz`)."""
+    """Return the viscoelastic Hertz law's restitution at the points of ``t``.
+
+    With the damping constant ``A`` (s), times ``mass_factor`` per point as in
+    :func:`fit_viscoelastic_hertz`; ``E_star`` the effective modulus, Pa.
+    """
     f = np.ones_like(t.v) if mass_factor is None else np.asarray(mass_factor, dtype=float)
     return laws.viscoelastic_hertz_curve(np.minimum(A * f * t.v / laws.hertz_overlap(
         E_star, t.R, t.m, t.v), 1e3))
 
 
 def linear_tangential_beta(en: float, et_like: tuple[float, float]) -> float:
-    """``beta`` of a linear spring-dashpot contact that ends at zero overlap with
-    normal restitution ``en`` and tangential oscillator ``(w_t/omega0, zeta_t)``."""
+    """Return the tangential restitution ``beta`` of a linear spring-dashpot contact.
+
+    The contact ends at zero overlap, with normal restitution ``en`` and the
+    tangential oscillator ``(w_t/omega0, zeta_t)`` (both dimensionless).
+    """
     return laws.linear_spring_dashpot(laws.zeta_of_restitution(en), "overlap", et_like)[1]
 
 
@@ -312,11 +331,11 @@ def grid_search(cost, start, half_width, lower, upper, xatol: float = 5e-4, n: i
     """Minimize ``cost`` over two parameters by shrinking grids, each evaluated in one call.
 
     Each round evaluates an ``n x n`` grid of half-widths ``half_width`` around the
-    centre (clipped to ``[lower, upper]``) in one call of ``cost`` (so that a stepped law
-    runs every candidate at once), moves the centre to the best point and, when that
+    centre (clipped to ``[lower, upper]``) in one call of ``cost`` (so that a stepped
+    law runs every candidate at once), moves the centre to the best point and, when that
     point is inside the grid, shrinks the half-widths to one grid spacing (else doubles
-    them, up to 4 times the first: the minimum lies further out). Stops when the spacing is below ``xatol`` in
-    both parameters.
+    them, up to 4 times the first: the minimum lies further out). Stops when the spacing
+    is below ``xatol`` in both parameters.
 
     Parameters
     ----------

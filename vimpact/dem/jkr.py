@@ -78,7 +78,7 @@ class JkrLaw:
         return brentq(f, a_min, hi, xtol=1e-15 * hi, rtol=1e-14)
 
     def force(self, delta: float, rate: float) -> float:
-        """Normal force on the sphere (positive: pushes it out), N."""
+        """Return the normal force on the sphere (positive: pushes it out), N."""
         a = self.radius(delta)
         w = 2.0 * self.cohesion
         elastic = (4.0 * self.E_star * a**3 / (3.0 * self.R)
@@ -86,8 +86,11 @@ class JkrLaw:
         return elastic + self.eta_n0 * a * self.m * rate
 
     def restitution(self, v: float, rtol: float = 1e-9) -> float:
-        """``e_z`` at approach speed ``v`` (m/s); 0 if the sphere sticks (it turns back
-        towards the wall in contact after it had started to rebound)."""
+        """Return ``e_z`` at approach speed ``v`` (m/s); 0 if the sphere sticks.
+
+        It sticks when it turns back towards the wall in contact after it had
+        started to rebound.
+        """
         def rhs(_, y):
             return [y[1], -self.force(y[0], y[1]) / self.m]
 
@@ -117,8 +120,11 @@ class JkrLaw:
 
 
 def law_sticking_velocity(law: JkrLaw, v_guess: float, rtol: float = 1e-3) -> float:
-    """Speed (m/s) below which ``law``'s sphere sticks, by bisection to relative width
-    ``rtol`` (the bracket grows from ``v_guess`` by halving/doubling)."""
+    """Return the speed (m/s) below which ``law``'s sphere sticks.
+
+    By bisection to relative width ``rtol``; the bracket grows from ``v_guess``
+    (m/s) by halving/doubling.
+    """
     lo = hi = positive("v_guess", v_guess)
     while law.restitution(lo) > 0.0:
         lo *= 0.5
@@ -162,17 +168,20 @@ class JkrFit:
     v_stick_law: float
 
     def coeffs(self) -> str:
-        """The ``pair_coeff`` / ``fix wall/gran`` model text."""
+        """Return the ``pair_coeff`` / ``fix wall/gran`` model text."""
         return (f"jkr {self.E_lammps:.12g} {self.law.eta_n0:.12g} {self.nu:.12g} "
                 f"{self.law.cohesion:.12g} damping viscoelastic tangential linear_nohistory 0 0")
 
 
 def fit_jkr(scene: Scene, speeds, numerics=None, target=None) -> JkrFit:
-    """Fit LAMMPS' ``cohesion`` and ``eta_n0`` to vimpact's adhesive ``e_z`` of ``scene``
-    at ``speeds`` (m/s; ``scene.v_z0`` is replaced), least squares, starting from the
-    true surface energy times ``exp(0.4)`` and the damping ``2 E* tau / m`` (``tau`` the
-    material's viscous time, at least ``1e-3`` Hertz times). ``target``: vimpact's
-    ``e_z`` at ``speeds`` when already run (else it is run here)."""
+    """Fit LAMMPS' ``cohesion`` and ``eta_n0`` to vimpact's adhesive ``e_z`` of ``scene``.
+
+    At ``speeds`` (m/s; ``scene.v_z0`` is replaced), least squares, starting from
+    the true surface energy (J/m^2) times ``exp(0.4)`` and the damping
+    ``2 E* tau / m`` (1/s; ``tau`` the material's viscous time, at least ``1e-3``
+    Hertz times). ``target``: vimpact's ``e_z`` at ``speeds`` when already run (else
+    it is run here).
+    """
     speeds = np.asarray(speeds, dtype=float)
     if speeds.size < 2 or not np.all(np.isfinite(speeds) & (speeds > 0.0)):
         raise InputError(f"speeds = {speeds!r} is not allowed: must be at least two "
@@ -207,8 +216,10 @@ def fit_jkr(scene: Scene, speeds, numerics=None, target=None) -> JkrFit:
 
 
 def lammps_restitution(fit: JkrFit, v: float, steps_per_contact: int = 4000) -> float:
-    """``e_z`` LAMMPS gives with ``fit``'s constants at ``v`` (m/s), sphere on a wall
-    (0 if the sphere is still in contact at the end)."""
+    """Return the ``e_z`` LAMMPS gives with ``fit``'s constants at ``v`` (m/s), sphere on a wall.
+
+    0 if the sphere is still in contact at the end.
+    """
     from vimpact.dem.lammps import collision_script, run_lammps
 
     L = fit.law

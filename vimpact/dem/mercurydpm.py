@@ -53,11 +53,13 @@ HEADER = "Species/HertzianBSHPViscoelasticMindlinSpecies.h"
 
 def mercury_beta(c: Contact, A: float, G, c_t, mu: float, v, R, m, w0,
                  steps: int | None = None) -> np.ndarray:
-    """MercuryDPM's ``beta`` (:func:`vimpact.dem.laws.mercury_mindlin_coulomb`) for the
-    contact ``c`` with dissipation time ``A`` (s), effective shear modulus ``G`` (Pa),
+    """Return MercuryDPM's ``beta`` for the contact ``c`` (:func:`vimpact.dem.laws.mercury_mindlin_coulomb`).
+
+    With dissipation time ``A`` (s), effective shear modulus ``G`` (Pa),
     sliding dissipation ``c_t`` and friction ``mu``, at normal speeds ``v`` (m/s),
     effective radius ``R`` (m) and mass ``m`` (kg), and ``w0 = v_c0 / v_z0`` (arrays;
-    ``G`` and ``c_t`` numbers, or arrays of candidates that broadcast with them)."""
+    ``G`` and ``c_t`` numbers, or arrays of candidates that broadcast with them).
+    """
     E = c.E_star
     d = laws.hertz_overlap(E, R, m, v)
     D = c_t * np.sqrt(8.0 * G * m) * (R * d)**0.25 * v / (4.0 / 3.0 * E * np.sqrt(R) * d**1.5)
@@ -66,10 +68,12 @@ def mercury_beta(c: Contact, A: float, G, c_t, mu: float, v, R, m, w0,
 
 
 def _fit_tangential(c: Contact, t: Targets, A: float, G0: float):
-    """``(G, c_t, beta at the fit points, target, basis)``: MercuryDPM's effective shear
-    modulus and sliding dissipation closest to vimpact's ``beta_x`` in RMS, over the oblique
-    impacts with the contact's friction (``t.oblique``), else in full stick at a few
-    nominal speeds."""
+    """Fit MercuryDPM's effective shear modulus (Pa) and sliding dissipation to ``beta_x``.
+
+    Closest to vimpact's ``beta_x`` in RMS, over the oblique impacts with the
+    contact's friction (``t.oblique``), else in full stick at a few nominal
+    speeds. Returns ``(G, c_t, beta at the fit points, target, basis)``.
+    """
     ob = t.oblique
     if ob is not None:
         v, R, m, w0, target, mu = ob.v, ob.R, ob.m, ob.w0, ob.beta_x, ob.mu
@@ -92,6 +96,12 @@ def _fit_tangential(c: Contact, t: Targets, A: float, G0: float):
 
 
 def fit(problem: DemProblem, targets: dict[str, Targets]) -> list[ContactFit]:
+    """Fit each contact's species: dissipation ``A`` (s) to ``e_z``, Mindlin constants to ``beta_x``.
+
+    The effective modulus is the pair's ``E*`` (Pa); the effective shear modulus
+    (Pa) and sliding dissipation are fitted when vimpact's ``beta_x`` is among the
+    targets.
+    """
     fits = []
     for c in problem.contacts:
         t = targets[c.key]
@@ -125,6 +135,11 @@ def fit(problem: DemProblem, targets: dict[str, Targets]) -> list[ContactFit]:
 
 
 def render(problem: DemProblem, fits: list[ContactFit]) -> dict[str, str]:
+    """Return ``mercurydpm_species.cpp``: the species and mixed species of the fits (SI units).
+
+    To be pasted into a driver's ``setupInitialConditions()`` before particles and
+    walls are created.
+    """
     ident = {t.index: f"s_{t.name}" for t in problem.types}
     ident.update({w.index: f"s_{w.name}" for w in problem.walls})
     lines = ["// MercuryDPM species written by `vimpact dem` (SI units)",

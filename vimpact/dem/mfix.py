@@ -42,8 +42,11 @@ ETAT_FAC_RANGE = (0.0, 1.0)
 
 
 def _beta(en: float, etat_fac: float, F: float) -> float:
-    """Tangential restitution in stick: ``k_t = KT_FAC k_n``, ``eta_t = etat_fac eta_n``,
-    contact-point mass ``m_eff / F``."""
+    """Return MFiX's tangential restitution in stick.
+
+    ``k_t = KT_FAC k_n``, ``eta_t = etat_fac eta_n``, contact-point mass
+    ``m_eff / F``; normal restitution ``en``.
+    """
     w_t = math.sqrt(KT_FAC * F)  # / omega0
     zeta_t = etat_fac * laws.zeta_of_restitution(en) * math.sqrt(F / KT_FAC)
     return linear.tangential_beta(en, w_t, zeta_t)
@@ -56,10 +59,12 @@ FIT_STEPS = 1000
 
 def _oblique_beta(en: float, etat_fac, F: float, mu: float, w0,
                   steps: int = laws.FRICTION_STEPS) -> np.ndarray:
-    """MFiX's ``beta`` in oblique impacts with friction ``mu`` at ``w0 = v_c0 / v_z0``
-    (:func:`vimpact.dem.laws.mfix_coulomb`; the law scales with the speed, so ``beta``
-    depends on the angle only); ``etat_fac`` a number or an array of candidates that
-    broadcasts with ``w0``."""
+    """Return MFiX's ``beta`` in oblique impacts with friction ``mu`` at ``w0 = v_c0 / v_z0``.
+
+    :func:`vimpact.dem.laws.mfix_coulomb`; the law scales with the speed, so
+    ``beta`` depends on the angle only. ``etat_fac`` is a number or an array of
+    candidates that broadcasts with ``w0``.
+    """
     zeta = laws.zeta_of_restitution(en)
     return laws.mfix_coulomb(zeta, math.sqrt(KT_FAC * F),
                              etat_fac * zeta * math.sqrt(F / KT_FAC), F, mu, w0, steps)[1]
@@ -67,9 +72,11 @@ def _oblique_beta(en: float, etat_fac, F: float, mu: float, w0,
 
 def _fit_oblique(en: float, F: float, mu: float, w0: np.ndarray, target: np.ndarray,
                  xatol: float = 5e-4) -> float:
-    """``DES_ETAT_FAC`` in :data:`ETAT_FAC_RANGE` closest (RMS) to ``target`` at ``w0``:
-    grids of 21 values, each stepped in one run, shrunk around the best to one spacing
-    until the spacing is below ``xatol``."""
+    """Return the ``DES_ETAT_FAC`` in :data:`ETAT_FAC_RANGE` closest (RMS) to ``target`` at ``w0``.
+
+    Grids of 21 values, each stepped in one run, shrunk around the best to one
+    spacing until the spacing is below ``xatol``.
+    """
     lo, hi = ETAT_FAC_RANGE
     best = 0.5 * (lo + hi)
     while True:
@@ -83,6 +90,12 @@ def _fit_oblique(en: float, F: float, mu: float, w0: np.ndarray, target: np.ndar
 
 
 def fit(problem: DemProblem, targets: dict[str, Targets]) -> list[ContactFit]:
+    """Fit MFiX's restitution ``en`` per contact and its one tangential damping factor.
+
+    ``en`` is the constant closest to vimpact's ``e_z``; the stiffness (N/m) gives
+    the Hertz contact time. ``DES_ETAT_FAC`` (``DES_ETAT_W_FAC``) is fitted per
+    contact and exported as the mean over particle pairs (walls).
+    """
     fits = []
     # MFiX takes one friction for particle pairs and one for walls: the first contact's
     written_mu = {}
@@ -141,6 +154,7 @@ def fit(problem: DemProblem, targets: dict[str, Targets]) -> list[ContactFit]:
 
 
 def render(problem: DemProblem, fits: list[ContactFit]) -> dict[str, str]:
+    """Return ``mfix.dat``: the MFiX-DEM keywords of the fits (SI units)."""
     N = len(problem.types)
     e = {}
     for f in fits:

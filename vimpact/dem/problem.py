@@ -97,7 +97,7 @@ class ParticleType:
         return self.density * 4.0 / 3.0 * math.pi * R**3
 
     def body(self, R: float | None = None) -> Body:
-        """A :class:`Body` of this type (nominal radius by default), at rest."""
+        """Return a :class:`Body` of this type at rest, radius ``R`` (m; nominal by default)."""
         R = self.radius if R is None else R
         m = self.mass(R)
         return Body(self.material, R, m, Theta=self.theta_ratio * m * R**2)
@@ -114,8 +114,11 @@ class WallType:
 
 @dataclass(frozen=True)
 class Contact:
-    """A particle-particle or particle-wall contact, its friction coefficient and its work
-    of adhesion ``adhesion`` (``dgamma``, J/m^2; 0: none)."""
+    """A particle-particle or particle-wall contact.
+
+    With its friction coefficient ``mu`` and its work of adhesion ``adhesion``
+    (``dgamma``, J/m^2; 0: none).
+    """
 
     first: ParticleType
     second: ParticleType | WallType
@@ -129,6 +132,7 @@ class Contact:
 
     @property
     def is_wall(self) -> bool:
+        """Whether the second partner is a wall."""
         return isinstance(self.second, WallType)
 
     @property
@@ -137,8 +141,10 @@ class Contact:
         return pair_material(self.first.material, self.second.material)
 
     def levels(self) -> list[tuple[Body, Body | Wall]]:
-        """The pair at each size level (min, nominal, max radius of both types; one
-        level without a size range)."""
+        """Return the pair at each size level.
+
+        Min, nominal and max radius of both types; one level without a size range.
+        """
         n = max(len(self.first.radii), 1 if self.is_wall else len(self.second.radii))
         out = []
         for k in range(n):
@@ -190,13 +196,16 @@ class DemProblem:
         return any(len(t.radii) > 1 for t in self.types)
 
     def with_size_classes(self, k: int) -> DemProblem:
-        """The same set-up with every size-range type split into ``k`` types of equal
-        radius ratio (``NAME_1`` .. ``NAME_k``, smallest first; friction as the type's)."""
+        """Return the same set-up with every size-range type split into ``k`` size classes.
+
+        Types of equal radius ratio (``NAME_1`` .. ``NAME_k``, smallest first;
+        friction as the type's).
+        """
         return problem_from_toml(self.toml, self.source, base=self.base,
                                  temperature=self.temperature, size_classes=k)
 
     def contact(self, a: str, b: str) -> Contact:
-        """The contact of the named type/wall pair (either order)."""
+        """Return the contact of the named type/wall pair (either order)."""
         for c in self.contacts:
             if (c.first.name, c.second.name) in ((a, b), (b, a)):
                 return c
@@ -314,7 +323,7 @@ def problem_from_toml(text: str, source: str = "<string>", *, base: Path | None 
     names = [base_of[t.name] for t in types] + [w.name for w in walls]
 
     def per_contact(table: str, what: str, absent: float, finite: bool):
-        """The coefficient of a ``[table]`` by contact (``NAME-NAME`` or ``default``)."""
+        """Return the coefficient of a ``[table]`` by contact (``NAME-NAME`` or ``default``)."""
         fr = data.get(table, {})
         if not isinstance(fr, dict):
             raise _err(source, f"[{table}]", fr, f"a table of {what}")
@@ -356,8 +365,10 @@ def problem_from_toml(text: str, source: str = "<string>", *, base: Path | None 
 
 
 def load_problem(path, temperature: float | None = None) -> DemProblem:
-    """Read a DEM set-up TOML file (module doc); ``temperature`` (K) overrides its
-    ``temperature_K``."""
+    """Read a DEM set-up TOML file (module doc).
+
+    ``temperature`` (K) overrides its ``temperature_K``.
+    """
     from vimpact.model.toml_input import read_text
     path = Path(path)
     return problem_from_toml(read_text(path, "DEM set-up"), str(path), base=path.parent,

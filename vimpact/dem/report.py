@@ -94,9 +94,12 @@ def markdown(code: str, problem: DemProblem, targets: dict[str, Targets],
              fits: list[ContactFit], files: list[str], png: str,
              steps_per_contact: int | None = None, step_error=None,
              beta_step_error: str | None = None) -> str:
-    """The report text; ``steps_per_contact`` and ``step_error`` (the code module's
+    """Return the report text (Markdown).
+
+    ``steps_per_contact`` and ``step_error`` (the code module's
     ``TIME_STEP_ERROR``) add the exported time step and the code's error at it,
-    ``beta_step_error`` (``BETA_TIME_STEP_ERROR``) its measured error in ``beta_x``."""
+    ``beta_step_error`` (``BETA_TIME_STEP_ERROR``) its measured error in ``beta_x``.
+    """
     lines = [f"# vimpact dem: {code}", "",
              f"Input: `{problem.source}`; normal impact speeds {problem.speeds.min():g} to "
              f"{problem.speeds.max():g} m/s ({problem.speeds.size} points, log-spaced)"
@@ -153,8 +156,10 @@ def markdown(code: str, problem: DemProblem, targets: dict[str, Targets],
 
 def oblique_round_trip(code: str, round_trip, problem: DemProblem,
                        steps_per_contact: int) -> list[dict]:
-    """Export for ``code``, then run the code on oblique impacts of every wall contact with
-    friction at the speeds and angles of the report's ``beta_x`` targets.
+    """Export for ``code``, then run the code on oblique impacts of the wall contacts.
+
+    Every wall contact with friction, at the speeds (m/s) and angles (degrees from
+    the normal) of the report's ``beta_x`` targets.
 
     ``round_trip(problem, speeds, steps, fits=, angles_deg=, contacts=)`` is the code's
     round trip; its rows get ``vimpact_beta`` (vimpact's ``beta_x`` there) and ``stated``
@@ -185,8 +190,10 @@ def oblique_round_trip(code: str, round_trip, problem: DemProblem,
 
 def round_trip_main(code: str, available, round_trip, steps_per_contact: int,
                     oblique: str | None = None) -> None:
-    """``python -m vimpact.dem.CODE SETUP.toml [STEPS_PER_CONTACT]``: run the DEM code
-    on the exported files at five speeds over the set-up's range and print the
+    """Run ``python -m vimpact.dem.CODE SETUP.toml [STEPS_PER_CONTACT]``: a round trip.
+
+    Runs the DEM code on the exported files at five speeds over the set-up's range
+    and prints the
     restitution it gives next to the report's prediction (one row per collision;
     ``round_trip(problem, speeds, steps)`` returns rows with ``contact``, ``v``
     (m/s), ``predicted``, ``e`` and optionally ``level``), then the largest difference.
@@ -196,7 +203,8 @@ def round_trip_main(code: str, available, round_trip, steps_per_contact: int,
     report's speeds and angles), with ``angle``,
     ``beta``, ``predicted_beta``, ``vimpact_beta`` and ``stated`` (the report's beta_x
     residual of that contact); printed likewise, with the largest
-    ``|beta - vimpact_beta|`` against the stated residual."""
+    ``|beta - vimpact_beta|`` against the stated residual.
+    """
     import sys
 
     from vimpact.dem.problem import load_problem

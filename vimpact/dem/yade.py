@@ -58,7 +58,7 @@ def mass_ratio(contact: Contact) -> float:
 
 def yade_law(tc: float, en: float, et: float, q: float, F: float, m: float = 1.0,
              tangential: bool = True) -> tuple[float, float, float]:
-    """What Yade's linear law restitutes: ``(e, beta, contact time)``.
+    """Return what Yade's linear law restitutes: ``(e, beta, contact time)``, contact time in s.
 
     Parameters
     ----------
@@ -84,12 +84,14 @@ def yade_law(tc: float, en: float, et: float, q: float, F: float, m: float = 1.0
 
 def yade_oblique(tc: float, en: float, et: float, q: float, F: float, mu: float, w0,
                  steps: int | None = None, R: float | None = None, v=None) -> np.ndarray:
-    """Yade's ``beta`` in oblique impacts with Coulomb friction ``mu`` at ``w0 = v_c0 / v_z0``
-    (array): its law stepped as Yade steps it (:func:`vimpact.dem.laws.yade_coulomb`).
+    """Return Yade's ``beta`` in oblique impacts with Coulomb friction ``mu`` at ``w0 = v_c0 / v_z0``.
+
+    ``w0`` an array; the law stepped as Yade steps it (:func:`vimpact.dem.laws.yade_coulomb`).
     Without ``R``, the one-contact law: it scales with the speed, so ``beta`` depends on
     the angle only. With the sphere radius ``R`` (m) and the normal speeds ``v`` (m/s,
     like ``w0``): Yade's wall contact, whose contact point is on the wall plane (lever
-    ``R - delta``), so that ``beta`` shifts by about ``delta/R`` with the speed."""
+    ``R - delta``), so that ``beta`` shifts by about ``delta/R`` with the speed.
+    """
     mR = q
     kn = mR * (math.pi**2 + linear.ln2(en)) / tc**2
     cn = -2.0 * mR * math.log(en) / tc
@@ -119,6 +121,13 @@ def _en_for(target: float, q: float) -> float:
 
 
 def fit(problem: DemProblem, targets: dict[str, Targets]) -> list[ContactFit]:
+    """Fit Yade's ``en``, ``et`` and contact time ``tc`` (s) per contact.
+
+    ``en`` gives the constant closest to vimpact's ``e_z`` (Yade clips the normal
+    force at zero), ``tc`` makes the contact last the Hertz contact time, ``et`` is
+    fitted to vimpact's ``beta_x`` (oblique impacts with the contact's friction,
+    else full stick).
+    """
     fits = []
     for c in problem.contacts:
         t = targets[c.key]
@@ -278,8 +287,9 @@ def yade_available() -> str | None:
 def round_trip(problem: DemProblem, speeds, steps_per_contact: int = STEPS_PER_CONTACT,
                fits: list[ContactFit] | None = None, timeout: float = 600.0,
                angles_deg=None, contacts=None) -> list[dict]:
-    """Run Yade once with the exported ``yade_materials.py``, unchanged, on head-on
-    collisions of every contact (nominal sizes) at ``speeds`` (m/s); one dict per
+    """Run Yade once with the exported ``yade_materials.py`` on head-on collisions of every contact.
+
+    The file is used unchanged; nominal sizes, ``speeds`` in m/s. One dict per
     collision with ``contact``, ``v``, ``e`` (Yade's, from its velocities) and
     ``predicted`` (the report's).
 
@@ -287,7 +297,8 @@ def round_trip(problem: DemProblem, speeds, steps_per_contact: int = STEPS_PER_C
     the normal (``v_c0 = v tan(angle)``, no spin); each row also has ``angle``, ``beta``
     (Yade's ``-v_c,end / v_c0``, ``v_c = v_x - R omega_y`` from its velocity and spin)
     and ``predicted_beta`` (the report's law, :func:`yade_oblique`). ``contacts``: the keys
-    of the contacts whose rows are returned (default: every contact)."""
+    of the contacts whose rows are returned (default: every contact).
+    """
     import json
     import os
     import subprocess

@@ -40,8 +40,11 @@ def _lagrange_thirds(t, w):
 
 @jit(inline="always")
 def _tensor_weights(nodes, x, w):
-    """First node of the local stencil on the tensor axis and its Lagrange weights in
-    ``w`` (returns ``(first, count)``); a single node has weight 1."""
+    """Return ``(first, count)`` of the local stencil on the tensor axis; its weights go to ``w``.
+
+    ``first`` is the stencil's first node, ``w`` receives its Lagrange weights; a
+    single node has weight 1.
+    """
     n = nodes.shape[0]
     if n == 1:
         w[0] = 1.0
@@ -67,8 +70,11 @@ def _tensor_weights(nodes, x, w):
 @jit(inline="always")
 def _eval_point(p, k, lo, hi, child, leaf_of, leaf_nodes, tnodes, values, out_row,
                 u, idx, wa, wt):
-    """Interpolated outputs at one point ``p`` (adaptive coordinates, then the tensor one);
-    ``u``, ``idx``, ``wa``, ``wt`` are scratch arrays of the work item."""
+    """Write the interpolated outputs at one point ``p`` into ``out_row``.
+
+    ``p`` holds the adaptive coordinates, then the tensor one; ``u``, ``idx``,
+    ``wa``, ``wt`` are scratch arrays of the work item.
+    """
     n_out = values.shape[2]
     for d in range(k):
         idx[d] = 0

@@ -46,8 +46,11 @@ def arm_coefficients(tau, h):
 
 @jit(inline="always")
 def _follow_over(w0, w1, qrow, g, tau, dt):
-    """Like :func:`_follow` over a part ``dt`` of a step (an element entering
-    contact within the step); coefficients computed here, entries are rare."""
+    """Advance the arms like :func:`_follow`, over a part ``dt`` (/ T) of a step.
+
+    For an element entering contact within the step; the coefficients are computed
+    here, as entries are rare.
+    """
     acc = 0.0
     for i in range(g.shape[0]):
         E, omE, phi = _arm_coefficient(tau[i], dt)
@@ -89,7 +92,7 @@ def _relax(w0, qrow, g, E, omE, phi, tau0_h, den_free, decay0):
 
 @jit()
 def _free_rate(w, qrow, g, tau, tau0):
-    """Current ``dw/dt`` of a free surface element (kernel units)."""
+    """Return the current ``dw/dt`` of a free surface element, in units of ``v_z0``."""
     n = g.shape[0]
     r = w
     for i in range(n):
@@ -108,14 +111,14 @@ def _free_rate(w, qrow, g, tau, tau0):
 
 @jit(inline="always")
 def _to_stress(target, s0, p0, prow, g, E, omE, phi, tau0_dt):
-    """The end value ``s1`` of a path ``s0 -> s1`` (linear over a time ``dt``)
-    whose element stress is ``target``: Coulomb slip (docs/physics.md#coulomb-friction).
+    """Return the end value ``s1`` of the linear path ``s0 -> s1`` with element stress ``target``.
 
-    Solves ``s1 + sum g_i (s1 - p_i(s1)) + tau0 (s1 - s0) / dt = target`` with
-    the arms on the exact linear-path update from ``p0`` (``E``, ``omE``,
-    ``phi`` the coefficients for ``dt``, ``tau0_dt = tau0 / dt``); writes the
-    arms to ``prow`` and returns ``s1``. Like :func:`_relax`, with a target
-    stress instead of zero.
+    The path is linear over a time ``dt`` (/ T); Coulomb slip
+    (docs/physics.md#coulomb-friction). Solves
+    ``s1 + sum g_i (s1 - p_i(s1)) + tau0 (s1 - s0) / dt = target`` with the arms on
+    the exact linear-path update from ``p0`` (``E``, ``omE``, ``phi`` the
+    coefficients for ``dt``, ``tau0_dt = tau0 / dt``); writes the arms to ``prow``
+    and returns ``s1``. Like :func:`_relax`, with a target stress instead of zero.
     """
     num = target + tau0_dt * s0
     den = tau0_dt + 1.0
@@ -130,8 +133,11 @@ def _to_stress(target, s0, p0, prow, g, E, omE, phi, tau0_dt):
 
 @jit(inline="always")
 def _follow_value(w0, w1, qrow, g, E, omE, phi):
-    """``sum g_i (w1 - q_i)`` after the path ``w0 -> w1``, without changing the arms
-    (the trial force of an element that leaves contact within the step)."""
+    """Return the arms' stress ``sum g_i (w1 - q_i)`` after the path ``w0 -> w1``.
+
+    The arms are not changed: the trial force of an element that leaves contact
+    within the step.
+    """
     acc = 0.0
     for i in range(g.shape[0]):
         acc += g[i] * (w1 - (E[i] * qrow[i] + omE[i] * w0 + phi[i] * (w1 - w0)))
@@ -184,8 +190,10 @@ def arm_implicit_coefficients(g, tau, h):
 
 @jit(inline="always")
 def _arm_start(w, qrow, g, kap):
-    """``sum g_i kap_i (w - q_i)``: the arms' start-of-step stress in the Verlet kick
-    (:func:`arm_implicit_coefficients`)."""
+    """Return ``sum g_i kap_i (w - q_i)``, the arms' start-of-step stress in the Verlet kick.
+
+    ``kap_i`` from :func:`arm_implicit_coefficients`.
+    """
     acc = 0.0
     for i in range(g.shape[0]):
         acc += g[i] * kap[i] * (w - qrow[i])
@@ -194,12 +202,15 @@ def _arm_start(w, qrow, g, kap):
 
 @jit(inline="always")
 def _follow_over_impulse(w0, w1, qrow, g, tau, dt):
-    """Like :func:`_follow_over` (arms along ``w0 -> w1`` over ``dt``, written to
-    ``qrow``); returns ``(sum g_i (w1 - q_i), mean)``, ``mean`` the arms' stress
-    averaged over ``dt``, exact for the linear path:
-    ``sum g_i [(1 - phi_i)(w0 - q0_i) + (tau_i phi_i / dt)(w1 - w0)]``. An element
+    """Advance the arms like :func:`_follow_over` and return their end and mean stress.
+
+    The arms follow ``w0 -> w1`` over ``dt`` (/ T), written to ``qrow``; returns
+    ``(sum g_i (w1 - q_i), mean)``, ``mean`` the arms' stress averaged over ``dt``,
+    exact for the linear path:
+    ``sum g_i [(1 - phi_i)(w0 - q0_i) + (tau_i phi_i / dt)(w1 - w0)]``. For an element
     entering contact within a step: an arm faster than that part jumps to its
-    dashpot-like stress at once, which a straight line from the entry stress misses."""
+    dashpot-like stress at once, which a straight line from the entry stress misses.
+    """
     acc = 0.0
     mean = 0.0
     for i in range(g.shape[0]):

@@ -164,11 +164,11 @@ def _rhs(s, v, tau0, unloading):
 
 @jit()
 def _dp_step(s, v, t, fs, fv, ft, h, tau0, unloading):
-    """One Dormand-Prince 5(4) step of length ``h`` from ``(s, v, t)`` with
-    derivative ``(fs, fv, ft)`` (FSAL).
+    """Take one Dormand-Prince 5(4) step of length ``h`` (/ T) from ``(s, v, t)``.
 
-    Returns the new state, its derivative and the error estimate (fifth minus
-    fourth order solution): ``(s1, v1, t1, fs1, fv1, ft1, es, ev, et)``.
+    ``(fs, fv, ft)`` is the derivative at the start (first same as last). Returns the
+    new state, its derivative and the error estimate (fifth minus fourth order
+    solution): ``(s1, v1, t1, fs1, fv1, ft1, es, ev, et)``.
     """
     k2s, k2v, k2t = _rhs(s + h * _A21 * fs, v + h * _A21 * fv, tau0, unloading)
     k3s, k3v, k3t = _rhs(s + h * (_A31 * fs + _A32 * k2s),
@@ -202,9 +202,12 @@ def _err_norm(es, ev, et, s0, v0, t0, s1, v1, t1, rtol, atol_s, atol_v, atol_t):
 
 @jit()
 def _hermite_root(y0, d0, y1, d1):
-    """Root in ``[0, 1]`` of the cubic Hermite interpolant with end values
-    ``y0, y1`` (opposite signs or ``y1 = 0``) and end slopes ``d0, d1`` (per
-    unit ``theta``); safeguarded Newton on the cubic, linear guess."""
+    """Return the root in ``[0, 1]`` of the cubic Hermite interpolant of one step.
+
+    End values ``y0, y1`` (opposite signs or ``y1 = 0``) and end slopes ``d0, d1``
+    (per unit ``theta``, the fraction of the step); safeguarded Newton on the cubic
+    from the linear guess.
+    """
     lo = 0.0
     hi = 1.0
     x = y0 / (y0 - y1)
@@ -235,9 +238,9 @@ def _hermite_root(y0, d0, y1, d1):
 
 @jit()
 def _locate(s, v, t, fs, fv, ft, sig, h, tau0, unloading, comp, s1, v1, t1, fs1, fv1, ft1):
-    """Re-take the step from ``(s, v, t)`` at ``sigma = sig`` so that state
-    component ``comp`` (0: ``s``, 1: ``v``) is zero at its end.
+    """Re-take the step from ``(s, v, t)`` so that state component ``comp`` is zero at its end.
 
+    ``comp`` is 0 for ``s``, 1 for ``v``; the step is taken at ``sigma = sig``.
     ``(s1, ..., ft1)`` is the accepted full step of length ``h`` in which it
     changed sign (or became zero). Returns the step length and the state and
     derivative at its end.
@@ -292,7 +295,7 @@ def _locate(s, v, t, fs, fv, ft, sig, h, tau0, unloading, comp, s1, v1, t1, fs1,
 
 @jit()
 def _force(s, v, tau0, unloading):
-    """Normal force ``F`` / (m v_z0 / T) at ``(s, v)``."""
+    """Return the normal force ``F`` at ``(s, v)``, in units of ``m v_z0 / T``."""
     if unloading:
         sp = max(s, 0.0)
         return 1.25 * sp * sp * sp
@@ -309,8 +312,12 @@ def rejected_step_factor(err):
 
 @jit(inline="always")
 def accepted_step_factor(err, err_old, rejected):
-    """PI step-size factor after an accepted step (Hairer, Norsett & Wanner); not above 1
-    right after a rejection."""
+    """Return the PI step-size factor after an accepted step (Hairer, Norsett & Wanner).
+
+    ``err`` and ``err_old`` are the error norms of this step and the previous one
+    (dimensionless, 1 at the tolerance); the factor is not above 1 right after a
+    rejection.
+    """
     fac = _SAFETY * err ** (-_ALPHA) * err_old ** _BETA if err > 0.0 else _FAC_MAX
     fac = min(_FAC_MAX, max(_FAC_MIN, fac))
     return min(fac, 1.0) if rejected else fac

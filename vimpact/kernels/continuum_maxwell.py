@@ -229,8 +229,10 @@ def _n_unload(n, tang):
 
 @jit()
 def _rk_mask(phase, n, tang, mask):
-    """1 for the Runge-Kutta components of a phase's state, 0 for the arm
-    quantities (and unused slots); returns their count."""
+    """Write the Runge-Kutta mask of a phase's state into ``mask``; return its count.
+
+    1 for the Runge-Kutta components, 0 for the arm quantities (and unused slots).
+    """
     for c in range(mask.shape[0]):
         mask[c] = 0.0
     if phase == 0:
@@ -294,14 +296,16 @@ def _filter_weights(z):
 
 @jit()
 def _arm(x0, ez, w0, wr, wj, dt, p0, pr, j):
-    """The quadratic-drive filter update ``exp(-z) X_0 + Delta (w_0 P_0 + w_r P_r) + w_J J``."""
+    """Return the quadratic-drive filter update ``exp(-z) X_0 + Delta (w_0 P_0 + w_r P_r) + w_J J``."""
     return ez * x0 + dt * (w0 * p0 + wr * pr) + wj * j
 
 
 @jit()
 def _arm3(x0, ez, c0, c1, cr, cj, dt, p0, dp0, pr, j):
-    """The cubic-drive filter update ``exp(-z) X_0 + Delta (c_0 P_0 + c_1 Delta P'_0
-    + c_r P_r) + c_J J``."""
+    """Return the cubic-drive filter update of an arm quantity.
+
+    ``exp(-z) X_0 + Delta (c_0 P_0 + c_1 Delta P'_0 + c_r P_r) + c_J J``.
+    """
     return ez * x0 + dt * (c0 * p0 + c1 * dt * dp0 + cr * pr) + cj * j
 
 
@@ -492,10 +496,13 @@ def _rhs(phase, y0, x, K, r, advance, tau0, g, itau, n, kappa, mu_t, tang, rc, h
 @jit()
 def _rhs_once(phase, y0, x, K, r, tau0, g, itau, n, kappa, mu_t, tang, rc, hs, nh, ah, e_val,
               kh):
-    """:func:`_rhs` at a state that holds its arm quantities (no advance), for the
-    few evaluations outside the steps. The right-hand side is a called function,
-    compiled once (inlined into :func:`_step` and here it was lowered twice) for
-    an ``advance`` typed bool, not a literal (which would compile it once per value)."""
+    """Evaluate :func:`_rhs` at a state that holds its arm quantities (no advance).
+
+    For the few evaluations outside the steps. The right-hand side is a called
+    function, compiled once (inlined into :func:`_step` and here it was lowered
+    twice) for an ``advance`` typed bool, not a literal (which would compile it once
+    per value).
+    """
     return _rhs(phase, y0, x, K, r, np.bool_(False), tau0, g, itau, n, kappa, mu_t, tang, rc, hs,
                 nh, ah, e_val, kh)
 
@@ -522,7 +529,7 @@ def _dense_d(rc, k, th, c):
 
 @jit(inline="always")
 def _edge(rc, hs, nh, s_t, kh):
-    """Loading step ``k`` and ``theta`` with ``s(k, theta) = s_t``.
+    """Return the loading step ``k`` and ``theta`` with ``s(k, theta) = s_t``.
 
     ``hs`` holds ``s`` at the start of each stored step (increasing) and, at
     ``nh``, at the end of the last one. Below 0 the first step's polynomial is
@@ -571,11 +578,14 @@ def _edge(rc, hs, nh, s_t, kh):
 @jit()
 def _step(phase, m, y, h, K, y1, tmp, mask, n_rk, tau0, g, itau, n, kappa, mu_t, tang, rc, hs,
           nh, ah, e_val, atol, rtol, kh):
-    """One Dormand-Prince 5(4) step of length ``h`` from ``y`` (``K[0]`` its
-    derivative); ``y1`` and ``K[1..6]`` receive the new state and stages
-    (``K[6]`` the derivative at ``y1``). The arm quantities of every stage and
-    of ``y1`` are their exact filter updates (:func:`_rhs` with ``advance``).
-    Returns the error norm over the ``n_rk`` Runge-Kutta components."""
+    """Take one Dormand-Prince 5(4) step of length ``h`` (/ T) from ``y``; return its error norm.
+
+    ``K[0]`` is the derivative at ``y``; ``y1`` and ``K[1..6]`` receive the new
+    state and stages (``K[6]`` the derivative at ``y1``). The arm quantities of
+    every stage and of ``y1`` are their exact filter updates (:func:`_rhs` with
+    ``advance``). The error norm (dimensionless, 1 at the tolerance) is taken over
+    the ``n_rk`` Runge-Kutta components.
+    """
     for r in range(1, 7):
         if r == 1:
             for c in range(m):
@@ -614,9 +624,11 @@ def _step(phase, m, y, h, K, y1, tmp, mask, n_rk, tau0, g, itau, n, kappa, mu_t,
 
 @jit()
 def _store(rc, hs, ah, nh, y, y1, K, h, m, n, tang):
-    """Write the dense output of an accepted loading step into row ``nh``
-    (Hairer, Norsett & Wanner's ``contd5`` coefficients), its end ``s`` and
-    the arm quantities at its start."""
+    """Write the dense output of an accepted loading step into row ``nh``.
+
+    Hairer, Norsett & Wanner's ``contd5`` coefficients, the step's end ``s`` and
+    the arm quantities at its start.
+    """
     for c in range(m):
         dif = y1[c] - y[c]
         bspl = h * K[0, c] - dif
@@ -637,8 +649,11 @@ def _store(rc, hs, ah, nh, y, y1, K, h, m, n, tang):
 
 @jit()
 def _surface_catches(u_end, v_end, a_end, n, g, tau, tau0, tol):
-    """Does the free centre element (``w = u_end``, arms ``a_end``) catch the
-    sphere (``u = u_end + v_end (t - t_end)``) after separation?"""
+    """Return whether the free centre element catches the sphere after separation.
+
+    The element starts at ``w = u_end`` with arms ``a_end``; the sphere moves on as
+    ``u = u_end + v_end (t - t_end)`` (kernel units).
+    """
     if not (v_end < 0.0):
         return True
     if n == 0:

@@ -114,14 +114,16 @@ from vimpact.kernels.record import _record
 
 @jit(inline="always")
 def _path_in_cone(L0, L1, C0, C1, alpha):
-    """Integral over ``t`` in ``[0, alpha]`` (in steps) of a sticking element's
-    tangential force on its way out: its stick path ``L0 + t (L1 - L0)``, clipped
+    """Return the integral of a sticking element's tangential force on its way out.
+
+    Over ``t`` in ``[0, alpha]`` (in steps): its stick path ``L0 + t (L1 - L0)``, clipped
     to the cone ``|f_t| <= C0 + t (C1 - C0)``, which shrinks to 0 with the normal
     force at ``t = alpha``. ``|L| - C`` is convex, so the element sticks on
     ``[0, t*]`` and rides the cone (sign of ``L(alpha)``) down to 0 on
     ``[t*, alpha]``. Without the clip a linear path to the cone's end value,
     ``mu`` times a negative normal force, crosses it and, for ``mu v_z0 >> v_c0``,
-    pushes far beyond anything the element holds."""
+    pushes far beyond anything the element holds.
+    """
     if alpha <= 0.0:
         return 0.0
     dL = L1 - L0
@@ -650,7 +652,7 @@ class KernelSpec(NamedTuple):
 
 
 def _constants(spec: KernelSpec) -> tuple[int, bool, int, bool, bool, bool]:
-    """The effects of ``spec`` as plain Python constants (checked)."""
+    """Return the effects of ``spec`` as plain Python constants (checked)."""
     integrator, tangential, memory = int(spec.integrator), bool(spec.tangential), int(spec.memory)
     arms, dashpot, friction = bool(spec.arms), bool(spec.dashpot), bool(spec.friction)
     if friction and tangential and memory != 0:
@@ -663,7 +665,7 @@ def _constants(spec: KernelSpec) -> tuple[int, bool, int, bool, bool, bool]:
 
 @functools.cache
 def element_impact(spec: KernelSpec):
-    """The serial one-impact kernel specialized for ``spec`` (compiled on first use, cached).
+    """Return the serial one-impact kernel specialized for ``spec`` (compiled on first use, cached).
 
     Signature: ``impact(tau0, g, tau, kappa, mu_t, mu, h, n_elem, dxi, max_steps,
     rec, rec_every, out)``, the scalars and arrays of one row of
@@ -685,7 +687,7 @@ def element_impact(spec: KernelSpec):
 
 @functools.cache
 def element_kernel(spec: KernelSpec):
-    """The batch kernel specialized for ``spec`` (compiled on first use, cached on disk).
+    """Return the batch kernel specialized for ``spec`` (compiled on first use, cached on disk).
 
     Signature: ``run(tau0, g, tau, n_arms, kappa, mu_t, mu, h, n_elem, dxi,
     max_steps, rec, rec_every, out)`` with per-set arrays of length ``n``
@@ -710,7 +712,7 @@ def element_kernel(spec: KernelSpec):
 
 
 def _batch_template(key: tuple):
-    """The batch loop over ``_spec_impact`` (bound by :func:`element_kernel`), keyed by ``key``."""
+    """Return the batch loop over ``_spec_impact`` (bound by :func:`element_kernel`), keyed by ``key``."""
 
     def run(tau0, g, tau, n_arms, kappa, mu_t, mu, h, n_elem, dxi, max_steps, rec, rec_every, out):
         if False:  # noqa: SIM108 - keeps key a cell of the function (its cache key), never run

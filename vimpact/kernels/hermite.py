@@ -38,8 +38,11 @@ CHUNK = 2048
 
 @jit()
 def _cell(c, raw, s0, n, x, is_log, extrapolate, w, k):
-    """Cell index along one axis; writes the weights ``w0, w1, g0, g1`` into
-    ``w[k, 0..3]`` (order: value lo, slope lo, value hi, slope hi)."""
+    """Return the cell index of ``x`` along one axis; write its basis weights into ``w[k]``.
+
+    The weights ``w0, w1, g0, g1`` go to ``w[k, 0..3]`` in the order value lo,
+    slope lo, value hi, slope hi.
+    """
     if n == 1:
         w[k, 0] = 1.0
         w[k, 1] = 0.0

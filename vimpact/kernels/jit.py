@@ -15,5 +15,5 @@ import numba
 
 
 def jit(parallel: bool = False, inline: str = "never"):
-    """Decorator factory for the package's numba kernels."""
+    """Return the decorator that compiles one of the package's numba kernels."""
     return numba.njit(cache=True, error_model="numpy", parallel=parallel, inline=inline)

@@ -1,5 +1,6 @@
-"""Layouts shared by every kernel: integrator codes, status codes, the columns
-of the per-impact output row and of a trajectory record.
+"""Layouts shared by every kernel: integrator and status codes, output and record columns.
+
+The columns are those of the per-impact output row and of a trajectory record.
 
 Kernel units are described in :mod:`vimpact.kernels.elements`. Everything here
 is plain numbers (no numba: the command line's parser and the value objects

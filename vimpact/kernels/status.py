@@ -81,7 +81,7 @@ INVALID = "invalid"
 
 
 def code(name: str) -> int:
-    """The kernel code of status ``name`` (``KeyError`` if it has none)."""
+    """Return the kernel code of status ``name`` (``KeyError`` if it has none)."""
     value = BY_NAME[name].code
     if value is None:
         raise KeyError(f"status {name!r} is not written by a kernel")

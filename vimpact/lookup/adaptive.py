@@ -156,7 +156,7 @@ class AdaptiveGrid:
         self.names = list(values)
         self.values = np.stack([np.asarray(values[n], dtype=float).reshape(
             len(self.keys), len(self.tensor_nodes)) for n in self.names], axis=-1)
-        self._kernel = None
+        self._kernel: tuple | None = None  # the kernel's arrays, made once
 
     # ---- geometry ---------------------------------------------------------
     @property
@@ -422,7 +422,9 @@ def refine_cells(evaluate: Callable[[np.ndarray], np.ndarray], k: int, n_tensor:
 
     active = _local(k, list(range(2**min_level)))  # index along axis 0 fastest
     level = min_level
-    leaves, unmet, levels = [], [], []
+    leaves: list = []
+    unmet: list[dict] = []
+    levels: list[dict] = []
     max_leaf = 0.0
     stopped = "met"
     while len(active):

@@ -257,7 +257,7 @@ class HermiteGrid:
         self.data = np.nan_to_num(data.reshape(-1, 1 << d, len(self.names)))
         self._rows = self.data.reshape(len(self.data), -1)  # one row of numbers per node
         self.strides = np.array([int(np.prod(self.shape[k + 1:])) for k in range(d)], dtype=np.int64)
-        self._kernel_args = None
+        self._kernel_args: tuple | None = None
 
     def _kernel_arrays(self) -> tuple:
         """Return the grid as the arrays :func:`vimpact.kernels.hermite.hermite_eval` takes.

@@ -12,7 +12,9 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, cast
+from typing import TYPE_CHECKING, TypeVar, cast
+
+import numpy as np
 
 from vimpact.model.temperature import ShiftLaw
 from vimpact.model.validation import non_negative, poisson_ratio, positive, require
@@ -23,8 +25,15 @@ if TYPE_CHECKING:  # the fit loads scipy: only when asked
 MODELS = ("elastic", "kelvin_voigt", "standard_solid", "prony")
 
 
-def shear_modulus(E: float, nu: float) -> float:
-    """Shear modulus ``G = E / (2 (1 + nu))`` in Pa from Young's modulus ``E`` in Pa."""
+#: A modulus or Poisson ratio: one number, or one per row (elementwise)
+_Value = TypeVar("_Value", float, np.ndarray)
+
+
+def shear_modulus(E: _Value, nu: _Value | float) -> _Value:
+    """Shear modulus ``G = E / (2 (1 + nu))`` in Pa from Young's modulus ``E`` in Pa.
+
+    Elementwise for arrays of ``E`` (Pa) and ``nu`` (dimensionless).
+    """
     return E / (2.0 * (1.0 + nu))
 
 

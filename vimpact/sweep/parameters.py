@@ -11,16 +11,17 @@ A random ``angle_deg`` (impact angle from the normal) is drawn instead of
 ``v_x0_m_s``; the chunk's ``v_x0_m_s = v_z0 tan(angle)`` is added to its
 parameters (it takes no draw).
 
-Memory is bounded by the chunk size. :func:`engine_columns` turns the
-parameters of a chunk into the scene columns of :func:`vimpact.simulate_batch`
-and the physical input columns of the table, with NumPy only. Friction: a grid
-row at incidence ``psi`` is the reference scene with ``v_x0`` and ``mu`` from
-:func:`psi_reference`; a random row with ``mu`` gets its ``psi`` from
-:func:`incidence`. Kelvin-Voigt and elastic grid rows get ``Q2 = NaN`` (no
-``G2``: the limit ``G2 -> inf``), and ``inputs["model"]`` holds each row's
-rheology (a string, for the table's ``model`` column). Adhesion: a grid row at
-adhesion number ``lam`` gets the work of adhesion that gives its reference scene
-this number (and ``v_x0 = 0``: normal impact); a random row with ``adhesion_J_m2`` gets its ``lam``.
+Memory is bounded by the chunk size. :func:`engine_columns` turns the parameters of a
+chunk into the scene columns of :func:`vimpact.simulate_batch` and the physical input
+columns of the table, with NumPy only. Friction: a grid row at incidence ``psi`` is
+the reference scene with ``v_x0`` and ``mu`` from
+:func:`~vimpact.tableformat.parameters.psi_reference`; a random row with ``mu`` gets
+its ``psi`` from :func:`~vimpact.tableformat.parameters.incidence`. Kelvin-Voigt and
+elastic grid rows get ``Q2 = NaN`` (no ``G2``: the limit ``G2 -> inf``), and
+``inputs["model"]`` holds each row's rheology (a string, for the table's ``model``
+column). Adhesion: a grid row at adhesion number ``lam`` gets the work of adhesion
+that gives its reference scene this number (and ``v_x0 = 0``: normal impact); a random
+row with ``adhesion_J_m2`` gets its ``lam``.
 """
 
 from __future__ import annotations
@@ -169,5 +170,4 @@ def engine_columns(spec, p: dict[str, np.ndarray]) -> tuple[list[tuple[np.ndarra
     return batches, inputs
 
 
-__all__ = ["REFERENCE", "chunk_generator", "chunk_parameters", "engine_columns", "incidence",
-           "psi_reference"]
+__all__ = ["REFERENCE", "chunk_generator", "chunk_parameters", "engine_columns"]

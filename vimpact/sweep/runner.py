@@ -46,15 +46,16 @@ import numpy as np
 from vimpact.model.validation import InputError
 from vimpact.sweep import store
 from vimpact.sweep.progress import Progress
-from vimpact.sweep.spec import (
+from vimpact.sweep.spec import SweepSpec, load_spec
+from vimpact.tableformat import files
+from vimpact.tableformat.metadata import COMMON_METADATA
+from vimpact.tableformat.schema import (
     ADHESION_RESULTS,
     LABELS,
     OUTPUTS,
     RELATIVE,
     RESULTS,
     TANGENTIAL_OUTPUTS,
-    SweepSpec,
-    load_spec,
 )
 
 
@@ -215,7 +216,8 @@ def _dask_task(spec: SweepSpec, chunk: int, parts: str) -> dict:
     import numba
     try:
         from distributed import get_worker
-        per_worker = max(1, numba.config.NUMBA_NUM_THREADS // max(1, get_worker().state.nthreads))
+        threads = numba.config.NUMBA_NUM_THREADS  # type: ignore[attr-defined]  # set at import
+        per_worker = max(1, threads // max(1, get_worker().state.nthreads))
     except Exception:  # noqa: BLE001 - not on a worker (tests call it directly)
         per_worker = numba.get_num_threads()
     if numba.get_num_threads() > per_worker:  # a cluster we did not start: no oversubscription
@@ -351,10 +353,10 @@ def run_sweep(spec_path, out=None, resume: bool = False,
         scheduler = connect_scheduler(scheduler)
     try:
         if shard is not None:  # shards run side by side (SLURM array): a shared lock
-            with store.OutputLock(out, shared=True):
+            with files.OutputLock(out, shared=True):
                 return _run(spec, spec_path, out, parts, True, progress, workers, scheduler,
                             shard, False, chunk_order, timings, stages)
-        with store.OutputLock(out):
+        with files.OutputLock(out):
             return _run(spec, spec_path, out, parts, resume, progress, workers, scheduler, None,
                         combine, chunk_order, timings, stages)
     finally:
@@ -366,7 +368,7 @@ def _run(spec, spec_path, out, parts, resume, progress, workers, scheduler, shar
          chunk_order, timings, stages: SweepStages) -> Path:
     layout = spec.table_layout
     log = _stderr_log(progress)
-    store.remove_temporaries(out.parent, out.name)  # a final write cut short
+    files.remove_temporaries(out.parent, out.name)  # a final write cut short
     if store.is_complete(spec, out) and (resume or combine or shard is not None):
         stages.finish(spec, out, log, True)  # e.g. cut short after the table was written
         return out
@@ -385,8 +387,8 @@ def _run(spec, spec_path, out, parts, resume, progress, workers, scheduler, shar
             raise ValueError(
                 f"{parts} holds {len(done)} finished chunk(s) of an earlier run: use --resume "
                 f"(resume=True) to continue it, or remove {parts} to start over")
-        if layout == "dataset" and (parts / store.COMMON_METADATA).exists():
-            (parts / store.COMMON_METADATA).unlink()  # stale: rewritten at the end
+        if layout == "dataset" and (parts / COMMON_METADATA).exists():
+            (parts / COMMON_METADATA).unlink()  # stale: rewritten at the end
     if combine:
         _combine(spec, parts, out, log, stages)
         return out
@@ -443,7 +445,7 @@ def _combine(spec: SweepSpec, parts: Path, out: Path, log, stages: SweepStages) 
     except BaseException:
         if Path(parts).is_dir():
             for name, text in saved.items():
-                with store.atomic_file(Path(parts) / name, str(Path(parts) / name),
+                with files.atomic_file(Path(parts) / name, str(Path(parts) / name),
                                        mode="w") as f:  # never through a symlink
                     f.write(text)
         raise

@@ -166,17 +166,13 @@ from vimpact.model.toml_input import (
     required_keys,
     scene_from_values,
 )
-from vimpact.tableformat.schema import (  # noqa: F401 - the table's schema, found here too
+from vimpact.tableformat.schema import (
     ADHESION_OUTPUTS,
-    ADHESION_RESULTS,
     COLUMNS,
     LABELS,
     OUTPUTS,
-    RELATIVE,
-    RESULTS,
     SCHEMA_VERSION,
     SWEEP_STATUSES,
-    TANGENTIAL_OUTPUTS,
 )
 
 DEFAULT_CHUNK_SIZE = 64
@@ -327,7 +323,7 @@ def _axis(spec: TomlSource, key: str, value) -> np.ndarray:
             if start <= 0.0:
                 raise spec.bad(f"{key}.start", value["start"], "> 0 for a log-spaced axis")
             num = int(round(math.log10(stop / start) * per)) + 1
-            log = True
+            log: bool | None = True
         else:
             num = spec.integer(f"{key}.num", value["num"], 1)
             log = value.get("log")
@@ -510,7 +506,8 @@ class SweepSpec:
                     scene = dataclasses.replace(
                         scene, adhesion=adhesion_for_number(scene, p[ADHESION_AXIS]))
             if "psi" in p:
-                from vimpact.sweep.parameters import psi_reference
+                from vimpact.tableformat.parameters import psi_reference
+                assert self.grid_mu is not None  # load_spec sets it with a psi axis
                 v_x0, mu = psi_reference(np.array([p["psi"]]), np.array([p["nu"]]),
                                          self.grid_mu, scene.v_z0)
                 scene = dataclasses.replace(scene, v_x0=float(v_x0[0]), mu=float(mu[0]))
@@ -648,7 +645,7 @@ def load_spec(path) -> SweepSpec:
             raise spec.error("seed", "missing: random draws need a seed (an integer >= 0)")
         seed = spec.integer("seed", data["seed"], 0)
         draws, arms, rows = _random(spec, model, data["random"])
-        axes = {}
+        axes: dict[str, np.ndarray] = {}
     else:
         mode = "grid"
         seed = spec.integer("seed", data.get("seed", 0), 0)
@@ -732,7 +729,7 @@ def _random(spec: TomlSource, model: str, table) -> tuple[dict, tuple, int]:
         if any(not x >= 0.0 for x in draws[ADHESION_KEY].values):
             raise spec.bad(f"random.{ADHESION_KEY}", table[ADHESION_KEY],
                            "works of adhesion >= 0, J/m^2")
-    arms = ()
+    arms: tuple[dict[str, Draw], ...] = ()
     if model == "prony":
         listed = table.get("arms", [])
         if not isinstance(listed, list) or not all(isinstance(a, dict) for a in listed):
@@ -862,5 +859,4 @@ def _grid(spec: TomlSource, model: str, table) -> tuple[dict[str, np.ndarray], f
     return axes, tolerance, mu
 
 
-__all__ = ["COLUMNS", "Draw", "FILE_LAYOUT_MAX_ROWS", "LAYOUTS", "MAX_ROWS", "OUTPUTS",
-           "SCHEMA_VERSION", "SWEEP_STATUSES", "SweepSpec", "load_spec"]
+__all__ = ["Draw", "FILE_LAYOUT_MAX_ROWS", "LAYOUTS", "MAX_ROWS", "SweepSpec", "load_spec"]

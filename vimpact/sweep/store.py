@@ -23,25 +23,26 @@ package and schema version), its chunk and row range, and a small summary
 (rows per status, rows and first row per kernel path) that the combination
 merges without reading the data again.
 
-Integrity: every part and every table is written with Parquet page checksums
-(CRC-32 of each page), a content hash ``vimpact.content_sha256``
-(:class:`ContentHash`: SHA-256 of the column values in a canonical form,
-independent of the Parquet encoding) and a hash of the ``vimpact.*`` metadata
-entries ``vimpact.metadata_sha256`` (:func:`metadata_hash`: the footer has no
-checksum). A part is trusted only after
-:func:`verify_part` has read it back (page checksums checked, hash
-recomputed): ``--resume`` moves a part that fails to ``<parts>/_corrupt/`` (one
-line on stderr names it and the reason) and computes it again; the combination
-verifies every part, then the table it wrote (:func:`verify_table`), before it
-removes any part. A table without a stored hash (written before it existed) is
-accepted with the hash check skipped.
+Integrity: every part and every table is written with Parquet page checksums (CRC-32
+of each page), a content hash ``vimpact.content_sha256``
+(:class:`~vimpact.tableformat.integrity.ContentHash`: SHA-256 of the column values in
+a canonical form, independent of the Parquet encoding) and a hash of the ``vimpact.*``
+metadata entries ``vimpact.metadata_sha256``
+(:func:`~vimpact.tableformat.integrity.metadata_hash`: the footer has no checksum). A
+part is trusted only after :func:`verify_part` has read it back (page checksums
+checked, hash recomputed): ``--resume`` moves a part that fails to
+``<parts>/_corrupt/`` (one line on stderr names it and the reason) and computes it
+again; the combination verifies every part, then the table it wrote
+(:func:`~vimpact.tableformat.integrity.verify_table`), before it removes any part. A
+table without a stored hash (written before it existed) is accepted with the hash
+check skipped.
 
-Metadata: the Parquet key-value metadata ``vimpact.<key>``, written and read with
-the one codec of :mod:`vimpact.tableformat.metadata`, which the reader
+Metadata: the Parquet key-value metadata ``vimpact.<key>``, written and read with the
+one codec of :mod:`vimpact.tableformat.metadata`, which the reader
 (:mod:`vimpact.lookup.table`) uses too. The table format itself (codec, content and
-metadata hashes, :func:`verify_table`, atomic writes and the output lock) lives in
-:mod:`vimpact.tableformat`; this module holds what is the sweep's own: its parts, their
-checks and their combination into the table.
+metadata hashes, :func:`~vimpact.tableformat.integrity.verify_table`, atomic writes
+and the output lock) lives in :mod:`vimpact.tableformat`; this module holds what is
+the sweep's own: its parts, their checks and their combination into the table.
 """
 
 from __future__ import annotations
@@ -53,40 +54,27 @@ import sys
 from pathlib import Path
 
 from vimpact.model.validation import InputError
-from vimpact.tableformat.files import (  # noqa: F401 - the sweep's callers find them here too
-    COMPRESSION,
-    OutputLock,
-    atomic_file,
+from vimpact.tableformat.files import (
     fsync_dir,
     refuse_symlink,
     remove_temporaries,
     write_atomic,
 )
-from vimpact.tableformat.integrity import (  # noqa: F401
+from vimpact.tableformat.integrity import (
     CONTENT_HASH_KEY,
-    CONTENT_HASH_VERSION,
-    METADATA_HASH_KEY,
     ContentHash,
     Damaged,
     check_metadata_hash,
-    content_hash,
     first_line,
-    metadata_hash,
     open_checked,
     rows_in_footer,
     scan,
     verify_table,
 )
-from vimpact.tableformat.metadata import (  # noqa: F401
+from vimpact.tableformat.metadata import (
     COMMON_METADATA,
-    INT_KEYS,
-    JSON_KEYS,
-    META_PREFIX,
     decode_metadata,
-    decode_value,
     encode_metadata,
-    encode_value,
-    read_metadata,
     schema_path,
 )
 
@@ -222,6 +210,7 @@ def _existing_parts(spec, parts: Path, hasher: ContentHash | None = None) -> dic
         if kind == "foreign":
             raise ValueError(f"{path} {why}; remove {parts} to start over")
         if kind == "bad":
+            assert why is not None  # _check_part says why a part is bad
             try:
                 aside = move_aside(path)
             except FileNotFoundError:  # another process (a shard) moved or replaced it
@@ -452,10 +441,5 @@ def check_output(out: Path, layout: str, name: str = "--out") -> None:
                          "writable directory")
 
 
-__all__ = ["COMMON_METADATA", "CONTENT_HASH_KEY", "CONTENT_HASH_VERSION", "CORRUPT_DIR",
-           "ContentHash", "INT_KEYS", "JSON_KEYS", "METADATA_HASH_KEY", "META_PREFIX",
-           "OutputLock", "atomic_file", "check_output", "metadata_hash", "refuse_symlink",
-           "combine", "content_hash", "decode_metadata", "decode_value", "encode_metadata",
-           "encode_value", "existing_parts", "fsync_dir", "is_complete", "move_aside",
-           "part_path", "parts_dir", "read_metadata", "remove_temporaries", "rows_in_footer",
-           "summary", "verify_part", "verify_table", "write_atomic", "write_part"]
+__all__ = ["CORRUPT_DIR", "check_output", "combine", "existing_parts", "is_complete",
+           "move_aside", "part_path", "parts_dir", "summary", "verify_part", "write_part"]

@@ -110,6 +110,9 @@ def build_adaptive(spec_path, out=None, *, n_verify: int = 2000, seed: int = 0,
             statuses[key] = st
         return values[..., :2]
 
+    if spec.grid_tolerance is None:  # a SweepSpec made by hand (load_spec requires one)
+        raise InputError(f"spec = {str(spec.path)!r} is not allowed: `table build` needs a "
+                         "[grid] tolerance")
     tol = float(spec.grid_tolerance)
     leaves, keys, values, report = refine_cells(
         evaluate, len(axes), len(nu), CELL_SHARE * tol, check=(0, 1),

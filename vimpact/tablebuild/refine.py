@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -184,7 +185,7 @@ def refine_grid(model: str, axes: dict, tolerance: float, numerics=None, *,
                              f"logarithmic, give {a} > 0")
         nodes[a] = v
     memory = _SimulationMemory()  # points of earlier rounds are not simulated again
-    opts = dict(theta_ratio=theta_ratio, tangential=tangential,
+    opts: dict[str, Any] = dict(theta_ratio=theta_ratio, tangential=tangential,
                 tangential_memory=tangential_memory, rotation=rotation, simulate=memory)
     rounds, stopped = [], "max_rounds"
     table = final = None
@@ -201,7 +202,8 @@ def refine_grid(model: str, axes: dict, tolerance: float, numerics=None, *,
         worst = np.nanmax(np.column_stack([err[f"{k}_err"].to_numpy() for k in outputs]), axis=1)
         failed = ~np.isfinite(worst)
         worst = np.where(failed, np.inf, worst)  # a failed check is not a pass
-        entry = {"nodes": {a: int(len(nodes[a])) for a in need}, "axis_tolerance": axis_tol,
+        entry: dict[str, Any] = {"nodes": {a: int(len(nodes[a])) for a in need},
+                                 "axis_tolerance": axis_tol,
                  "max_error": {}, "inserted": {}}
         new = {}
         for a in need:

@@ -40,11 +40,12 @@ import numpy as np
 from vimpact.lookup.table import RestitutionTable
 from vimpact.model.scene import DEFAULT_THETA_RATIO
 from vimpact.model.validation import InputError
-from vimpact.sweep import runner, store
+from vimpact.sweep import runner
 from vimpact.sweep.spec import SweepSpec
 from vimpact.tablebuild import refine
 from vimpact.tablebuild.verify import interpolation_error, write_interpolation_error
 from vimpact.tableformat.files import atomic_file
+from vimpact.tableformat.metadata import read_metadata
 
 #: The refined axes of a sweep with ``[grid] tolerance``, in its parts directory (the
 #: leading underscore keeps it out of a Parquet dataset's files).
@@ -200,7 +201,7 @@ def measure_interpolation_error(spec: SweepSpec, out: Path, log=None) -> dict | 
 def _needs_measurement(spec: SweepSpec, out: Path) -> bool:
     if getattr(spec, "grid_tolerance", None) is None or spec.mode != "grid":
         return False
-    return "interpolation_error" not in store.read_metadata(out)
+    return "interpolation_error" not in read_metadata(out)
 
 
 def _finish(spec: SweepSpec, out: Path, log: Callable[[str], None] | None,

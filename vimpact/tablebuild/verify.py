@@ -359,7 +359,7 @@ def interpolation_error(table, numerics=None, n: int = 200, seed: int = 0, theta
     axes = [a for a in ("Q1", "Q2", "nu") if a in err.columns]
     good = np.all(np.isfinite(err[[f"{k}_err" for k in _OUTPUTS if k != "e_x"]].to_numpy()),
                   axis=1)
-    outputs = {}
+    outputs: dict[str, dict] = {}
     for name in _OUTPUTS:
         e = err[f"{name}_err"].to_numpy()
         fin = np.isfinite(e)
