@@ -2,7 +2,6 @@
 docs/physics.md#coulomb-friction: gross slip throughout and full stick (psi = 0)."""
 
 import math
-from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -13,8 +12,20 @@ from tests.sweep import write
 from vimpact.sweep import load_spec, run_sweep
 from vimpact.sweep.parameters import engine_columns
 
-SWEEPS = Path(__file__).resolve().parents[2] / "sweeps"
-EXAMPLE = SWEEPS / "friction_psi.toml"
+#: A grid of the incidence psi: psi = 0 (full stick), 0.5 and 2 (stick and slip
+#: mixed), 10 and 20 (above 4 chi: gross slip during the whole contact).
+EXAMPLE = """
+description = "Kelvin-Voigt, Q1 = 0.1, Coulomb friction mu = 0.3: a grid of the incidence psi"
+model = "kelvin_voigt"
+chunk_size = 10
+output = "friction_psi.parquet"
+
+[grid]
+Q1 = 0.1
+nu = [0.3, 0.5]
+psi = [0.0, 0.5, 2.0, 10.0, 20.0]
+mu = 0.3
+"""
 FRICTION_OUTPUTS = ["mu_eff", "rebound_angle_deg", "gross_slip_fraction", "friction_energy_J"]
 
 RANDOM_FRICTION = """
@@ -45,18 +56,19 @@ def stick_version(text: str) -> str:
 
 @pytest.fixture(scope="module")
 def example_tables(tmp_path_factory):
-    """The shipped example and the same grid without friction, run with run_sweep."""
+    """The psi grid and the same grid without friction, run with run_sweep."""
     tmp = tmp_path_factory.mktemp("friction")
-    friction = pd.read_parquet(run_sweep(EXAMPLE, out=tmp / "friction.parquet", progress=False))
-    stick_spec = write(tmp, stick_version(EXAMPLE.read_text()), "stick.toml")
+    friction = pd.read_parquet(run_sweep(write(tmp, EXAMPLE), out=tmp / "friction.parquet",
+                                         progress=False))
+    stick_spec = write(tmp, stick_version(EXAMPLE), "stick.toml")
     stick = pd.read_parquet(run_sweep(stick_spec, out=tmp / "stick.parquet", progress=False))
     return friction, stick
 
 
-# ---- the shipped example, run end to end --------------------------------------
+# ---- a psi grid, run end to end --------------------------------------
 
-def test_example_spec_layout():
-    spec = load_spec(EXAMPLE)
+def test_example_spec_layout(tmp_path):
+    spec = load_spec(write(tmp_path, EXAMPLE))
     assert spec.has_friction and spec.grid_mu == 0.3
     assert list(spec.axes) == ["psi", "theta_ratio", "nu", "Q1"]  # Q1 fastest, psi slowest
     assert spec.rows == 10

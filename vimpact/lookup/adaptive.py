@@ -305,8 +305,13 @@ class AdaptiveGrid:
     def from_rows(cls, meta: dict, data, names=("e_z", "beta_x")) -> AdaptiveGrid:
         """Rebuild from the ``vimpact.adaptive`` entry and the node rows (a DataFrame).
 
-        Raises :class:`InputError` for an inconsistent table.
+        Raises :class:`InputError` for an inconsistent table. A friction table (the entry
+        has ``friction``) gives a :class:`vimpact.lookup.friction.FrictionGrid`.
         """
+        if isinstance(meta, dict) and "friction" in meta:
+            from vimpact.lookup.friction import FrictionGrid
+
+            return FrictionGrid.from_rows(meta, data)  # type: ignore[return-value]
         if not isinstance(meta, dict) or meta.get("format") != ADAPTIVE_FORMAT:
             raise InputError(f"vimpact.adaptive = {str(meta)[:80]!r} is not allowed: an "
                              f"adaptive table's structure of format {ADAPTIVE_FORMAT}")

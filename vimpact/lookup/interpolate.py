@@ -76,17 +76,30 @@ def cluster_nodes(values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """
     order = np.argsort(values, kind="stable")
     s = values[order]
-    starts = [0]
-    for i in range(1, len(s)):
-        if not same_node(s[starts[-1]], s[i]):
-            starts.append(i)
-    bounds = starts + [len(s)]
-    nodes = np.array([s[(bounds[k] + bounds[k + 1] - 1) // 2] for k in range(len(starts))])
-    labels = np.empty(len(s), dtype=np.int64)
-    for k in range(len(starts)):
-        labels[bounds[k]:bounds[k + 1]] = k
+    start = np.ones(len(s), dtype=bool)  # s[i] begins a cluster
+    if len(s) and s[0] >= 0.0:
+        # non-negative values: one that is not the same node as its lower neighbour is not
+        # the same node as any smaller value (their distance is larger, the tolerance the
+        # same), so a cluster begins there, and an exact repeat never begins one; the
+        # comparison with the cluster's first member is left for the other values only
+        start[1:] = ~same_node(s[:-1], s[1:])
+        open_ = np.flatnonzero(~start & np.r_[False, s[1:] != s[:-1]])
+    else:
+        start[1:] = False
+        open_ = np.arange(1, len(s))
+    # the last cluster start at or before each value among those already decided
+    fixed = np.maximum.accumulate(np.where(start, np.arange(len(s)), 0)) if len(s) else start
+    last = 0
+    for i in open_.tolist():
+        first = max(int(fixed[i - 1]), last)
+        start[i] = not same_node(s[first], s[i])
+        if start[i]:
+            last = i
+    starts = np.flatnonzero(start)
+    bounds = np.append(starts, len(s))
+    nodes = s[(bounds[:-1] + bounds[1:] - 1) // 2]
     index = np.empty(len(values), dtype=np.int64)
-    index[order] = labels
+    index[order] = np.cumsum(start) - 1
     return nodes, index
 
 

@@ -48,7 +48,10 @@ not on ``mu`` and ``v_c0`` apart, so a row with ``psi > 0`` is the reference
 scene with this ``mu`` and ``v_x0 = psi mu (2 - nu) / (2 (1 - nu)) v_z0``; a
 row with ``psi = 0`` is the full-stick limit (``mu = inf``, ``v_x0 = v_z0``),
 the row of the same grid without ``psi``. Without ``psi`` the grid is full
-stick and has no ``mu`` and ``psi`` columns. An axis is a number, a list of
+stick and has no ``mu`` and ``psi`` columns. ``psi_nodes = [n_stick, n_slip]``
+(``refine = "adaptive"``, kelvin_voigt, no ``psi`` axis) makes the spec a friction
+table's: ``vimpact table build`` places its ``psi`` nodes on the kinks of
+``beta_x(psi)`` (:mod:`vimpact.tablebuild.friction`). An axis is a number, a list of
 numbers, or a table ``{ start, stop, per_decade }`` (log-spaced, both ends
 included) or ``{ start, stop, num, log = true|false }`` (``num`` points;
 ``log`` defaults to the rule below). With ``per_decade`` the number of
@@ -380,6 +383,10 @@ class SweepSpec:
         inserted across the grid, :func:`vimpact.tablebuild.refine.refine_grid`) or
         ``"adaptive"`` (cells of ``log Q1`` (x ``log Q2``) split where they fail the
         tolerance, :mod:`vimpact.lookup.adaptive`; built by ``vimpact table build``)
+    grid_psi_nodes : grid mode, adaptive Kelvin-Voigt: ``[grid] psi_nodes = [n_stick,
+        n_slip]``, the incidence nodes of a friction table
+        (:func:`vimpact.lookup.friction.coordinate_nodes`; built by ``vimpact table
+        build``), or None
     grid_levels : grid mode, adaptive: ``([grid] min_level, [grid] max_level)``, the
         level of the uniform start and of the finest cell (a cell of level ``L`` spans
         ``1 / 2**L`` of each adaptive axis's range in log)
@@ -407,6 +414,7 @@ class SweepSpec:
     material_text: str = ""
     grid_refine: str = "tensor"
     grid_levels: tuple[int, int] = (ADAPTIVE_LEVELS[0], ADAPTIVE_LEVELS[1])
+    grid_psi_nodes: tuple[int, int] | None = None
 
     @property
     def n_chunks(self) -> int:
@@ -578,6 +586,7 @@ class SweepSpec:
             "grid_tolerance": self.grid_tolerance,
             **({"grid_refine": self.grid_refine, "grid_levels": list(self.grid_levels)}
                if self.grid_refine != "tensor" else {}),
+            **({"grid_psi_nodes": list(self.grid_psi_nodes)} if self.grid_psi_nodes else {}),
             "units": self.units(),
             "columns": {c: _describe(c) for c in self.columns()},
             "statuses": SWEEP_STATUSES,
@@ -642,12 +651,13 @@ def load_spec(path) -> SweepSpec:
         seed = spec.integer("seed", data.get("seed", 0), 0)
         axes, grid_tolerance, grid_mu = _grid(spec, model, data["grid"])
         grid_refine, grid_levels = _adaptive(spec, model, data["grid"], axes, grid_tolerance)
+        psi_nodes = _psi_nodes(spec, model, data["grid"], axes, grid_refine)
         rows = math.prod(len(v) for v in axes.values())
         if rows > MAX_ROWS:
             raise spec.error("grid", f"{rows} rows; at most {MAX_ROWS} are allowed")
         draws, arms = {}, ()
     if mode == "random":
-        grid_tolerance = grid_mu = None
+        grid_tolerance = grid_mu = psi_nodes = None
         grid_refine, grid_levels = "tensor", ADAPTIVE_LEVELS[:2]
     if chunk_size > MAX_CHUNK_SIZE:
         raise spec.bad("chunk_size", chunk_size, f"at most {MAX_CHUNK_SIZE} rows (a chunk is "
@@ -673,7 +683,8 @@ def load_spec(path) -> SweepSpec:
                      axes=axes, tangential=header.tangential, rotation=header.rotation,
                      layout=layout, grid_tolerance=grid_tolerance,
                      grid_mu=grid_mu, material_text=material_text,
-                     grid_refine=grid_refine, grid_levels=(grid_levels[0], grid_levels[1]))
+                     grid_refine=grid_refine, grid_levels=(grid_levels[0], grid_levels[1]),
+                     grid_psi_nodes=psi_nodes)
 
 
 def _random(spec: TomlSource, model: str, table) -> tuple[dict, tuple, int]:
@@ -773,6 +784,28 @@ def _adaptive(spec: TomlSource, model: str, table: dict, axes: dict,
     return refine, (min_level, max_level)
 
 
+def _psi_nodes(spec: TomlSource, model: str, table: dict, axes: dict,
+               refine: str) -> tuple[int, int] | None:
+    """``[grid] psi_nodes = [n_stick, n_slip]``: a Kelvin-Voigt friction table.
+
+    The incidence nodes of an adaptive friction table
+    (:func:`vimpact.lookup.friction.coordinate_nodes`), placed on the kinks of
+    ``beta_x(psi)``; None without the key.
+    """
+    if "psi_nodes" not in table:
+        return None
+    value = table["psi_nodes"]
+    if refine != "adaptive" or model != "kelvin_voigt" or "psi" in axes:
+        raise spec.error("grid.psi_nodes", 'needs model = "kelvin_voigt", refine = "adaptive" '
+                         "and no psi axis (the friction table places its psi nodes itself)")
+    if not (isinstance(value, list) and len(value) == 2):
+        raise spec.bad("grid.psi_nodes", value, "two integers >= 2 (nodes below psi = 1 "
+                       "and from there to the start of gross slip)")
+    n_stick = spec.integer("grid.psi_nodes", value[0], 2)
+    n_slip = spec.integer("grid.psi_nodes", value[1], 2)
+    return (n_stick, n_slip)
+
+
 def _grid(spec: TomlSource, model: str, table) -> tuple[dict[str, np.ndarray], float | None,
                                                        float | None]:
     """Parse a ``[grid]`` table: its axes, tolerance and friction coefficient.
@@ -785,8 +818,8 @@ def _grid(spec: TomlSource, model: str, table) -> tuple[dict[str, np.ndarray], f
     if not isinstance(table, dict):
         raise spec.bad("grid", table, "a table")
     keys = ((ADHESION_AXIS,) if ADHESION_AXIS in table else ()) + _GRID_KEYS[model]
-    spec.unknown(table, keys + ("tolerance", "mu", "refine", "min_level", "max_level"),
-                 "grid")
+    spec.unknown(table, keys + ("tolerance", "mu", "refine", "min_level", "max_level",
+                                "psi_nodes"), "grid")
     tolerance = None
     if "tolerance" in table:
         tolerance = spec.number("grid.tolerance", table["tolerance"],

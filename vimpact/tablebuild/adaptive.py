@@ -91,6 +91,11 @@ def build_adaptive(spec_path, out=None, *, n_verify: int = 2000, seed: int = 0,
     if spec.mode != "grid" or spec.grid_refine != "adaptive":
         raise InputError(f"spec = {str(spec.path)!r} is not allowed: `table build` needs a "
                          '[grid] spec with refine = "adaptive" and a tolerance')
+    if spec.grid_psi_nodes is not None:
+        from vimpact.tablebuild.friction import build_friction
+
+        return build_friction(spec, out, n_verify=n_verify, seed=seed,
+                              max_seconds=max_seconds, log=log, simulate=simulate)
     start = time.perf_counter()
     axes = ["Q1"] + (["Q2"] if spec.model == "standard_solid" else [])
     bounds = np.array([[spec.axes[a][0], spec.axes[a][-1]] for a in axes], dtype=float)

@@ -44,6 +44,9 @@ BOUND_FACTOR = 1.5
 #: Random held-out points of :func:`interpolation_error` at most (each is one direct
 #: simulation; ``vimpact table verify --n``).
 MAX_POINTS = 100_000
+#: Held-out points of a friction table have ``psi`` uniform in ``[0, FRICTION_PSI_SPAN
+#: psi_s]`` (``psi_s``: where gross slip throughout begins, the table's own).
+FRICTION_PSI_SPAN = 1.25
 #: Kinds of held-out points (see the module text).
 KINDS = ("axis", "centre", "random")
 _OUTPUTS = ("e_z", "beta_x", "e_x")
@@ -182,6 +185,8 @@ def adaptive_held_out_points(grid, n_random: int = 200, seed: int = 0,
     (``kinds`` with ``"centre"`` or ``"random"`` selects them; ``"axis"`` has no
     meaning here). The tensor axis (``nu``) is uniform between its end nodes.
     """
+    friction = getattr(grid, "onset", None)  # a friction table: psi up to 1.25 psi_s
+    grid = getattr(grid, "grid", grid)
     rng = np.random.default_rng(seed)
     frames = []
     lb = grid.log_bounds
@@ -207,8 +212,13 @@ def adaptive_held_out_points(grid, n_random: int = 200, seed: int = 0,
         frames.append(pd.DataFrame(cols).assign(kind="cell", axis=""))
     if not frames:
         names = grid.axes + ([grid.tensor_axis] if grid.tensor_axis else [])
-        return pd.DataFrame({**{a: [] for a in names}, "kind": [], "axis": []})
-    return pd.concat(frames, ignore_index=True)
+        return pd.DataFrame({**{a: [] for a in names}, "kind": [], "axis": []}
+                            | ({"psi": []} if friction else {}))
+    pts = pd.concat(frames, ignore_index=True)
+    if friction is not None:
+        psi_s = friction(pts["Q1"].to_numpy(), pts["nu"].to_numpy())["psi_s"]
+        pts["psi"] = rng.uniform(0.0, FRICTION_PSI_SPAN, len(pts)) * psi_s
+    return pts
 
 
 def _scene_options(table) -> dict:
