@@ -247,14 +247,23 @@ class TensorLookup:
         self.table = table
         self._grids: dict = {}
         self._hermite: dict = {}
+        self._nodes: dict[str, tuple[pd.DataFrame, np.ndarray]] = {}
+
+    def _node_values(self, column: str) -> np.ndarray:
+        """Return :func:`node_values` of ``column``, computed once per ``table.data`` object."""
+        data = self.table.data
+        cached = self._nodes.get(column)
+        if cached is None or cached[0] is not data:
+            cached = self._nodes[column] = (data, node_values(data, column))
+        return cached[1]
 
     def theta_values(self) -> np.ndarray:
         """Return the table's distinct ``theta_ratio`` values (empty: no such column)."""
-        return node_values(self.table.data, "theta_ratio")
+        return self._node_values("theta_ratio")
 
     def psi_values(self) -> np.ndarray:
         """Return the distinct friction incidences ``psi`` of the table (empty: no psi column)."""
-        return node_values(self.table.data, "psi")
+        return self._node_values("psi")
 
     def resolve_theta(self, theta_ratio) -> float | None:
         """Return the theta_ratio slice to use (None: the table has one value / no column).
