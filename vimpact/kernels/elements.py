@@ -677,12 +677,11 @@ def element_impact(spec: KernelSpec):
     """
     integrator, tangential, memory, arms, dashpot, friction = _constants(spec)
 
-    @jit()
     def impact(tau0, g, tau, kappa, mu_t, mu, h, n_elem, dxi, max_steps, rec, rec_every, out):
         _impact(tangential, memory, integrator, arms, dashpot, friction, tau0, g, tau, kappa,
                 mu_t, mu, h, n_elem, dxi, max_steps, rec, rec_every, out)
 
-    return impact
+    return jit()(_named_for(impact, spec))
 
 
 @functools.cache
@@ -708,7 +707,26 @@ def element_kernel(spec: KernelSpec):
     template = _batch_template(_constants(spec))
     run = types.FunctionType(template.__code__, {**globals(), "_spec_impact": element_impact(spec)},
                              template.__name__, None, template.__closure__)
-    return jit(parallel=True)(run)
+    return jit(parallel=True)(_named_for(run, spec))
+
+
+def _named_for(function, spec: KernelSpec):
+    """Return ``function`` with a qualified name that names the effects of ``spec``.
+
+    numba names a compiled function's machine-code symbol after its qualified name
+    and a counter that restarts in every process. Every specialization of a
+    factory shares one qualified name, so a kernel compiled now and a batch loaded
+    from the on-disk cache (compiled in another process, where its callee got the
+    same count) could define the same symbol with different code, and the batch
+    would run the wrong specialization's impact. A name per spec keeps the symbols
+    of different specializations apart (and gives each its own cache index).
+    """
+    integrator, tangential, memory, arms, dashpot, friction = _constants(spec)
+    tag = (f"integrator{integrator}_tangential{int(tangential)}_memory{memory}"
+           f"_arms{int(arms)}_dashpot{int(dashpot)}_friction{int(friction)}")
+    function.__qualname__ = f"{function.__qualname__}_{tag}"
+    function.__name__ = f"{function.__name__}_{tag}"
+    return function
 
 
 def _batch_template(key: tuple):
