@@ -120,6 +120,23 @@ def test_cli_lookup_bad_input_exits_2(tiny, capsys, args, text):
     assert text in err and "Traceback" not in err and len(err.strip().splitlines()) == 1
 
 
+@pytest.mark.parametrize("args, text", [(["--n", "1000000000"], "--n = 1000000000"),
+                                        (["--seed=-1"], "--seed = -1")])
+def test_cli_verify_bad_input_exits_2(tiny, capsys, args, text):
+    assert main(["table", "verify", str(tiny), *args]) == 2
+    err = capsys.readouterr().err
+    assert text in err and len(err.strip().splitlines()) == 1
+
+
+def test_cli_build(tmp_path, capsys):
+    """`vimpact table build` on a spec with a lam axis writes an adhesive table."""
+    spec = tmp_path / "tiny.toml"
+    spec.write_text(TINY)
+    assert main(["table", "build", str(spec), "--n", "3"]) == 0
+    assert is_adhesion_table(tmp_path / "tiny.parquet")
+    assert "stuck misread" in capsys.readouterr().err
+
+
 def test_lam_on_a_restitution_table_exits_2(capsys):
     table = SHIPPED.parent / "kelvin_voigt_table.parquet"
     assert main(["table", "lookup", str(table), "--Q1", "0.1", "--nu", "0.5",

@@ -358,13 +358,17 @@ def _cmd_lookup(a) -> int:
 def _verify_adhesion(a) -> int:
     from vimpact.lookup.adhesion import AdhesionTable
     from vimpact.tablebuild.adhesion import verify_adhesion_table
+    from vimpact.tablebuild.verify import MAX_POINTS
 
+    if a.seed is not None and a.seed < 0:
+        raise ValueError(f"--seed = {a.seed} is not allowed: must be an integer >= 0")
+    if a.n is not None and not 1 <= a.n <= MAX_POINTS:
+        raise ValueError(f"--n = {a.n} is not allowed: must be an integer from 1 to "
+                         f"{MAX_POINTS} (held-out points, twice as many simulations)")
     table = AdhesionTable.open(a.table)
     stored = table.meta("interpolation_error") or {}
     n = stored.get("n", 200) if a.n is None else a.n
     seed = stored.get("seed", 0) if a.seed is None else a.seed
-    if seed < 0 or n < 1:
-        raise ValueError(f"--n = {n}, --seed = {seed} are not allowed: n >= 1, seed >= 0")
     result = verify_adhesion_table(table, n=n, seed=seed)
     if a.write:
         table.metadata["vimpact.interpolation_error"] = json.dumps(result)
