@@ -50,7 +50,7 @@ ADH_U_MAX = 2  # maximum indentation / d
 ADH_U_MIN = 3  # least indentation while in contact / d (negative: the sphere was pulled up)
 ADH_A_MAX = 4  # maximum contact half-width / a_H
 ADH_F_TENSILE = 5  # largest tensile (pulling) force on the sphere / (m v_z0 / T), >= 0
-ADH_STUCK = 6  # 1.0: the sphere did not separate (it turned back towards the surface in contact)
+ADH_STUCK = 6  # 1.0: the sphere does not separate (turned back in contact, or certified)
 ADH_STATUS = 7  # kernel status code (vimpact.kernels.status)
 ADH_STEPS = 8  # time steps taken
 ADH_CONTACTS = 9  # number of separate contact intervals
