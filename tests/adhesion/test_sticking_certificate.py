@@ -130,3 +130,25 @@ def test_creeping_peels_end_as_stuck(Q1, lam):
     out, _ = run(dimensionless(Q1, lam))
     assert out[K.ADH_STEPS] < 0.05 * kernel_inputs(
         SceneColumns.from_scenes([dimensionless(Q1, lam)]), Numerics())["max_steps"][0]
+
+
+@pytest.mark.slow
+def test_certificate_at_the_shipped_table_boundary():
+    """At every Q1 node of the shipped adhesive table, 2e-7 below and above its stored
+    sticking number: below, the sphere separates alike with and without the certificate;
+    above, it sticks, and without the certificate it has not separated after 20 times
+    the steps of the certified end (turn back, or still in contact at that limit)."""
+    from pathlib import Path
+
+    from vimpact.lookup.adhesion import AdhesionTable
+
+    table = AdhesionTable.open(Path(__file__).resolve().parents[2] / "sweeps" / "tables"
+                               / "adhesion_table.parquet")
+    for Q1, lam_s in zip(table.Q1, table.lam_s_nodes):
+        below = dimensionless(Q1, lam_s * (1 - 2e-7))
+        above = dimensionless(Q1, lam_s * (1 + 2e-7))
+        out_lo, out_hi = run(below)[0], run(above)[0]
+        assert separated(out_lo) and not separated(out_hi)
+        np.testing.assert_array_equal(run(below, certify=0)[0], out_lo)
+        ref = run(above, certify=0, max_steps=int(20 * out_hi[K.ADH_STEPS]) + 10_000)[0]
+        assert not separated(ref)
