@@ -163,4 +163,4 @@ def test_total_energy_is_not_monotone_for_these_rules():
     E = rec[:, K.REC_E_GRIFFITH]
     assert E.min() < -0.1 and E[-1] > 1.0  # -0.15 -> 1.25 (units m v_z0^2) while it sticks
     _, rec = run(dimensionless(0.01, 0.5), n_record=200_000)
-    assert rec[-1, K.REC_E_GRIFFITH] > 1.0 > 0.5  # above the impact's kinetic energy 0.5
+    assert rec[-1, K.REC_E_GRIFFITH] > 1.0  # 1.13: above the kinetic energy of the impact, 0.5
