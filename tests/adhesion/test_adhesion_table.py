@@ -137,6 +137,15 @@ def test_cli_build(tmp_path, capsys):
     assert "stuck misread" in capsys.readouterr().err
 
 
+def test_sweep_refuses_an_adhesive_table_spec(tmp_path, capsys):
+    """`vimpact sweep` would write a restitution grid over the table's file: refused."""
+    spec = tmp_path / "tiny.toml"
+    spec.write_text(TINY)
+    assert main(["sweep", str(spec)]) == 2
+    assert "vimpact table build" in capsys.readouterr().err
+    assert not (tmp_path / "tiny.parquet").exists()
+
+
 def test_lam_on_a_restitution_table_exits_2(capsys):
     table = SHIPPED.parent / "kelvin_voigt_table.parquet"
     assert main(["table", "lookup", str(table), "--Q1", "0.1", "--nu", "0.5",
