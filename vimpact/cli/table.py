@@ -83,8 +83,12 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     look.add_argument("table", metavar="TABLE", help="restitution table (.parquet)")
     look.add_argument("--Q1", type=_number_list, required=True, metavar="Q1[,Q1...]",
                       help="damping parameter sqrt(15/32) (eta/G_inf)/T, dimensionless")
-    look.add_argument("--nu", type=_number_list, required=True, metavar="NU[,NU...]",
-                      help="Poisson ratio, dimensionless")
+    look.add_argument("--nu", type=_number_list, metavar="NU[,NU...]",
+                      help="Poisson ratio, dimensionless (required, except for an adhesive "
+                           "table, whose normal impact does not depend on it)")
+    look.add_argument("--lam", type=_number_list, metavar="LAM[,LAM...]",
+                      help="adhesion number sqrt(2 pi a_H dgamma / E*) / d, dimensionless: "
+                           "for adhesive tables (prints e_z, stuck and the sticking lam_s)")
     look.add_argument("--Q2", type=_number_list, metavar="Q2[,Q2...]",
                       help="G1/G2, dimensionless (standard-solid tables only)")
     look.add_argument("--theta-ratio", type=_number_list, metavar="RATIO[,RATIO...]",
@@ -111,9 +115,11 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
             "the metadata entry vimpact.interpolation_error, which lookup and info report."),
         epilog="Example: vimpact table verify kv.parquet --n 500 --write")
     ver.add_argument("table", metavar="TABLE", help="restitution table (.parquet)")
-    ver.add_argument("--n", type=int, default=200, metavar="N",
-                     help="random interior points besides the mid-points (default 200)")
-    ver.add_argument("--seed", type=int, default=0, help="seed of the random points (default 0)")
+    ver.add_argument("--n", type=int, metavar="N",
+                     help="random interior points besides the mid-points (default 200; "
+                          "an adhesive table: the number its build used)")
+    ver.add_argument("--seed", type=int, help="seed of the random points (default 0; an "
+                                              "adhesive table: its build's)")
     ver.add_argument("--method", choices=("cubic", "linear"), default="cubic",
                      help="interpolation measured (default cubic)")
     ver.add_argument("--theta-ratio", type=float, metavar="RATIO",
@@ -131,7 +137,9 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
             "axis with the spec's nu values), then measure the error at --n random held-out "
             "points and --n points inside random cells against direct simulation, and write "
             "the table (node rows plus the cells in the metadata vimpact.adaptive) with that "
-            "error (vimpact.interpolation_error) and the build's time (vimpact.build)."),
+            "error (vimpact.interpolation_error) and the build's time (vimpact.build). A spec "
+            "with a lam axis builds an adhesive table instead (e_z and the stuck flag over lam "
+            "x Q1, Kelvin-Voigt: vimpact.tablebuild.adhesion; docs/physics.md#adhesion)."),
         epilog="Example: vimpact table build sweeps/standard_solid_table.toml")
     bld.add_argument("spec", metavar="SPEC", help="sweep spec (.toml)")
     bld.add_argument("--out", metavar="PATH",
@@ -212,6 +220,7 @@ def _plain(x):
 def _cmd_build(a) -> int:
     import sys
 
+    from vimpact.sweep.spec import ADHESION_AXIS, load_spec
     from vimpact.tablebuild.adaptive import build_adaptive
     from vimpact.tablebuild.verify import MAX_POINTS
 
@@ -222,12 +231,28 @@ def _cmd_build(a) -> int:
         raise ValueError(f"--seed = {a.seed} is not allowed: must be an integer >= 0")
     if a.max_seconds is not None and not a.max_seconds > 0:
         raise ValueError(f"--max-seconds = {a.max_seconds} is not allowed: must be > 0")
-    build_adaptive(a.spec, a.out, n_verify=a.n, seed=a.seed, max_seconds=a.max_seconds,
+    spec = load_spec(a.spec)
+    if ADHESION_AXIS in spec.axes:  # an adhesive table (vimpact.lookup.adhesion)
+        from vimpact.tablebuild.adhesion import build_adhesion_table
+
+        build_adhesion_table(spec, a.out, n_verify=a.n, seed=a.seed,
+                             log=lambda line: print(line, file=sys.stderr, flush=True))
+        return 0
+    build_adaptive(spec, a.out, n_verify=a.n, seed=a.seed, max_seconds=a.max_seconds,
                    log=lambda line: print(line, file=sys.stderr, flush=True))
     return 0
 
 
 def _cmd_info(a) -> int:
+    from vimpact.lookup.adhesion import is_adhesion_table
+
+    if is_adhesion_table(a.table):
+        from vimpact.lookup.adhesion import AdhesionTable
+        from vimpact.lookup.adhesion import format_info as adhesion_info
+
+        info = AdhesionTable.open(a.table).info()
+        print(json.dumps(_plain(info), default=_json_value) if a.json else adhesion_info(info))
+        return 0
     info = _open(a.table).info()
     if a.json:
         print(json.dumps(_plain(info), default=_json_value, allow_nan=False))
@@ -238,7 +263,56 @@ def _cmd_info(a) -> int:
     return 0
 
 
+def _lookup_adhesion(a) -> int:
+    from vimpact.lookup.adhesion import AdhesionTable
+
+    if a.lam is None:
+        raise ValueError("--lam is missing: an adhesive table is looked up at --Q1 and --lam "
+                         "(the adhesion number)")
+    for flag, value in (("--Q2", a.Q2), ("--theta-ratio", a.theta_ratio), ("--psi", a.psi)):
+        if value:
+            raise ValueError(f"{flag} is not allowed for an adhesive table (axes Q1, lam)")
+    if a.nu is not None and not all(0.0 <= x <= 0.5 for x in a.nu):
+        raise ValueError(f"--nu = {a.nu} is not allowed: must be in [0, 0.5]")
+    if a.extrapolate or a.method != "cubic":
+        raise ValueError("--extrapolate, --method linear are not allowed for an adhesive "
+                         "table: its lookup is cubic inside its range")
+    if len({len(a.Q1), len(a.lam)} - {1}) > 1:
+        raise ValueError(f"--Q1 has {len(a.Q1)} values, --lam has {len(a.lam)}: lists must "
+                         "have one length (or be a single value)")
+    table = AdhesionTable.open(a.table)
+    n = max(len(a.Q1), len(a.lam))
+    res = table.lookup(np.broadcast_to(np.array(a.Q1, dtype=float), (n,)),
+                       np.broadcast_to(np.array(a.lam, dtype=float), (n,)))
+    bound = res.pop("error_bound")
+    rows = [{"Q1": float(res["Q1"][i]), "lam": float(res["lam"][i]),
+             "e_z": float(res["e_z"][i]), "stuck": bool(res["stuck"][i]),
+             "lam_s": float(res["lam_s"][i])} for i in range(n)]
+    if a.json:
+        print(json.dumps({"table": a.table, "kind": "adhesion", "model": "kelvin_voigt",
+                          "error_bound": bound, "rows": rows}))
+        return 0
+    print(f"adhesive kelvin_voigt table {a.table}, cubic (normal impact; stuck: the sphere "
+          "does not separate, e_z = 0)")
+    print("  ".join(f"{k:>12}" for k in rows[0]))
+    for row in rows:
+        print("  ".join(f"{str(v) if isinstance(v, bool) else format(v, '.6g'):>12}"
+                        for v in row.values()))
+    if bound:
+        print("interpolation error (max measured at held-out points): "
+              + ", ".join(f"{k} {v:.2g}" for k, v in bound.items() if v is not None))
+    return 0
+
+
 def _cmd_lookup(a) -> int:
+    from vimpact.lookup.adhesion import is_adhesion_table
+
+    if is_adhesion_table(a.table):
+        return _lookup_adhesion(a)
+    if a.lam is not None:
+        raise ValueError("--lam is not allowed: this is not an adhesive table")
+    if a.nu is None:
+        raise ValueError("--nu is missing: the lookup needs the Poisson ratio")
     table = _open(a.table)
     given = {"--Q1": a.Q1, "--nu": a.nu, **({"--Q2": a.Q2} if a.Q2 else {}),
              **({"--theta-ratio": a.theta_ratio} if a.theta_ratio else {}),
@@ -281,8 +355,49 @@ def _cmd_lookup(a) -> int:
     return 0
 
 
+def _verify_adhesion(a) -> int:
+    from vimpact.lookup.adhesion import AdhesionTable
+    from vimpact.tablebuild.adhesion import verify_adhesion_table
+    from vimpact.tablebuild.verify import MAX_POINTS
+
+    if a.seed is not None and a.seed < 0:
+        raise ValueError(f"--seed = {a.seed} is not allowed: must be an integer >= 0")
+    if a.n is not None and not 1 <= a.n <= MAX_POINTS:
+        raise ValueError(f"--n = {a.n} is not allowed: must be an integer from 1 to "
+                         f"{MAX_POINTS} (held-out points, twice as many simulations)")
+    table = AdhesionTable.open(a.table)
+    stored = table.meta("interpolation_error") or {}
+    n = stored.get("n", 200) if a.n is None else a.n
+    seed = stored.get("seed", 0) if a.seed is None else a.seed
+    result = verify_adhesion_table(table, n=n, seed=seed)
+    if a.write:
+        table.metadata["vimpact.interpolation_error"] = json.dumps(result)
+        table.save(a.table)
+    if a.json:
+        print(json.dumps({"measured": result, "stored": stored or None}, default=_json_value))
+        return 0
+    print(f"adhesive table {a.table}: lookup against direct simulation at {result['points']} "
+          f"held-out points (seed {seed}; half in the band around the sticking boundary)")
+    for name, v in result["outputs"].items():
+        was = (stored.get("outputs") or {}).get(name, {}).get("max")
+        if v["max"] is None:
+            print(f"  {name:<9} no points")
+            continue
+        print(f"  {name:<9} max {v['max']:.6g}, rms {v['rms']:.3g}"
+              + (f" (stored max {was:.6g})" if was is not None else ""))
+    print(f"  stuck flag misread at {result['stuck_misread']} points"
+          + (f" (stored {stored['stuck_misread']})" if "stuck_misread" in stored else ""))
+    return 0
+
+
 def _cmd_verify(a) -> int:
+    from vimpact.lookup.adhesion import is_adhesion_table
     from vimpact.tablebuild.verify import MAX_POINTS, interpolation_error, write_interpolation_error
+
+    if is_adhesion_table(a.table):
+        return _verify_adhesion(a)
+    a.n = 200 if a.n is None else a.n
+    a.seed = 0 if a.seed is None else a.seed
     if a.seed < 0:
         raise ValueError(f"--seed = {a.seed} is not allowed: must be an integer >= 0")
     if not 0 <= a.n <= MAX_POINTS:

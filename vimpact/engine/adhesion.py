@@ -53,7 +53,8 @@ class AdhesiveResult:
     Attributes
     ----------
     e_z : normal restitution ``|v_z,end| / v_z0`` (0 when the sphere stuck)
-    stuck : the sphere did not separate (it turned back towards the surface while in contact)
+    stuck : the sphere did not separate (it turned back towards the surface while in
+        contact, or creeps to rest in a contact that provably never changes)
     status : ``"ok"``, ``"stuck"``, ``"half_space"`` (finished, contact above 0.2 R), or
         a status of the table that says why the numbers are NaN (``time_limit``,
         ``row_exceeded``, ``non_finite``)

@@ -50,11 +50,27 @@ ADH_U_MAX = 2  # maximum indentation / d
 ADH_U_MIN = 3  # least indentation while in contact / d (negative: the sphere was pulled up)
 ADH_A_MAX = 4  # maximum contact half-width / a_H
 ADH_F_TENSILE = 5  # largest tensile (pulling) force on the sphere / (m v_z0 / T), >= 0
-ADH_STUCK = 6  # 1.0: the sphere did not separate (it turned back towards the surface in contact)
+ADH_STUCK = 6  # 1.0: the sphere does not separate (turned back in contact, or certified)
 ADH_STATUS = 7  # kernel status code (vimpact.kernels.status)
 ADH_STEPS = 8  # time steps taken
 ADH_CONTACTS = 9  # number of separate contact intervals
 N_ADH_OUT = 10
+
+# columns of the per-step record of :func:`adhesive_record` (kernel units)
+REC_T = 0  # time at the end of the step / T
+REC_U = 1  # indentation / d
+REC_V = 2  # velocity / v_z0
+REC_NC = 3  # elements in contact (half row)
+REC_V_LYAP = 4  # energy of the fixed contact about its equilibrium (_contact_energy)
+REC_E_GRIFFITH = 5  # kinetic + stored in every touched element - dgamma pi a^2
+N_REC = 6
+
+#: Steps between two evaluations of the sticking certificate (:func:`_cannot_separate`).
+CERTIFY_EVERY = 32
+#: Factor on the contact energy in the certificate: covers the step-to-step wobble of
+#: the Verlet energy about its continuous-time value (relative ``(omega h)^2 / 4``, far
+#: below 3 for any stable step), so the continuous-time bounds hold for the stepped motion.
+ENERGY_MARGIN = 4.0
 
 
 @jit()
@@ -103,17 +119,118 @@ def _contact_update(u1, n_c, w, q, g, G, c0, ve, xi2, sqrt_xi, lam, ARMS):
     return n_c
 
 
+@jit(inline="always")
+def _arm_energy(j, w, q, g):
+    """``sum_i g_i (w_j - q_ji)^2`` of element ``j`` (twice its arm energy per stiffness)."""
+    e = 0.0
+    for i in range(g.shape[0]):
+        y = w[j] - q[j, i]
+        e += g[i] * y * y
+    return e
+
+
+@jit()
+def _contact_energy(u, v, n_c, w, q, g, k_el, xi2, ARMS):
+    """Energy of the contact ``[0, n_c)`` held fixed, about its equilibrium; and ``u_eq``.
+
+    ``V = v^2 / 2 + K (u - u_eq)^2 / 2 + k_el / 2 sum_j sum_i g_i (w_j - q_ji)^2`` with
+    ``K = k_el n_c`` and ``u_eq`` the mean of ``xi_j^2`` (where the springs of the
+    relaxed modulus carry no net force). While the contact set does not change,
+    ``dV/dt = -C v^2 - k_el sum g_i y_i^2 / tau_i <= 0`` (the dashpots and the arms'
+    dampers only dissipate).
+    """
+    u_eq = 0.0
+    arms = 0.0
+    for j in range(n_c):
+        u_eq += xi2[j]
+        if ARMS:
+            arms += _arm_energy(j, w, q, g)
+    u_eq /= n_c
+    K = k_el * n_c
+    return 0.5 * v * v + 0.5 * K * (u - u_eq) ** 2 + 0.5 * k_el * arms, u_eq
+
+
+@jit()
+def _cannot_separate(u, v, n_c, touched, w, q, g, G, c0, k_el, xi2, sqrt_xi, lam, ARMS):
+    """True if the contact ``[0, n_c)`` provably never changes again (the sphere sticks).
+
+    Holding the contact set fixed, the motion is linear and passive, so its energy
+    ``V`` (:func:`_contact_energy`) never grows: ``|u - u_eq| <= sqrt(2 V / K)``,
+    ``|v| <= sqrt(2 V)`` and the edge element's arm stress
+    ``|sum g_i y_i| <= sqrt(2 G V / k_el)`` (Cauchy-Schwarz) for all later times. A free
+    element's own energy ``(w^2 + sum g_i y_i^2) / 2`` never grows either (it relaxes
+    under zero force), so ``w >= -r`` for an element beyond the edge. If with these
+    bounds (``V`` times :data:`ENERGY_MARGIN`) the edge element can never reach its
+    detachment stress, and each element beyond it, outwards, either can never join
+    (there the contact update stops) or, without arms, would on joining be stretched
+    beyond its critical stress and leave in the same update (the edge of a creeping
+    peel, whose next element joins and leaves at every step), then the contact set
+    at the end of every later step is this one: the sphere comes to rest at ``u_eq``
+    in contact and never separates. Sufficient, not necessary: a contact on the
+    threshold, or an element with arms that may join, is not certified.
+    """
+    V, u_eq = _contact_energy(u, v, n_c, w, q, g, k_el, xi2, ARMS)
+    Vb = ENERGY_MARGIN * V
+    du = math.sqrt(2.0 * Vb / (k_el * n_c))
+    e = n_c - 1
+    stress_lo = u_eq - du - xi2[e] - c0 * math.sqrt(2.0 * Vb)
+    if ARMS:
+        stress_lo -= math.sqrt(2.0 * G * Vb / k_el)
+    if not stress_lo > -lam * sqrt_xi[e]:
+        return False
+    u_hi = u_eq + du
+    for j in range(n_c, w.shape[0]):
+        r = 0.0
+        if j < touched:
+            r = w[j] * w[j]
+            if ARMS:
+                r += _arm_energy(j, w, q, g)
+            r = math.sqrt(r)
+        gap_lo = -r - (u_hi - xi2[j])
+        if gap_lo > 0.0 and (1.0 + G) * gap_lo >= lam * sqrt_xi[j]:
+            break  # element j never joins: the contact update stops here
+        # element j may join; it must then leave in the same update (a spring-dashpot
+        # element whose stress on the sphere is beyond its critical one at once)
+        if ARMS or not u_hi - xi2[j] + c0 * math.sqrt(2.0 * Vb) <= -lam * sqrt_xi[j]:
+            return False
+    return True
+
+
 @jit()
 def adhesive_impact(tau0, g, tau, lam, h, n_elem, dxi, max_steps, out):
+    """Advance one adhesive normal impact to its end; results into ``out`` (``ADH_*``).
+
+    :func:`adhesive_record` without the record.
+    """
+    _impact(tau0, g, tau, lam, h, n_elem, dxi, max_steps, out, np.zeros((0, N_REC)),
+            CERTIFY_EVERY)
+
+
+@jit()
+def adhesive_record(tau0, g, tau, lam, h, n_elem, dxi, max_steps, out, record, certify_every):
+    """:func:`adhesive_impact` that also writes its first ``len(record)`` steps (``REC_*``).
+
+    ``certify_every``: steps between two checks of the sticking certificate
+    (:data:`CERTIFY_EVERY` in :func:`adhesive_impact`; 0: never, so only the turn back
+    or the time limit end a sphere that does not separate). For the tests of the
+    energy laws and of the end criterion; the record costs a pass over the row per step.
+    """
+    _impact(tau0, g, tau, lam, h, n_elem, dxi, max_steps, out, record, certify_every)
+
+
+@jit()
+def _impact(tau0, g, tau, lam, h, n_elem, dxi, max_steps, out, record, certify_every):
     """Advance one adhesive normal impact to its end; results into ``out`` (``ADH_*``).
 
     Velocity Verlet (kick-drift-kick) with the dashpot implicit in the
     half-step velocity, arms on their exact update for the drift path. The
     sphere starts touching (``u = 0``, ``v = 1``). The impact ends when the
     contact is lost with the sphere moving away above every point the relaxing
-    surface can reach, or when the sphere, in contact, turns back towards the
-    surface after it had started to rebound (it sticks: ``ADH_STUCK = 1``,
-    end velocity 0).
+    surface can reach, or when the sphere sticks (``ADH_STUCK = 1``, end velocity
+    0): in contact, it turns back towards the surface after it had started to
+    rebound, or the contact provably never changes again (:func:`_cannot_separate`,
+    checked every :data:`CERTIFY_EVERY` steps: an overdamped sphere creeps to rest
+    in contact without ever turning back).
 
     Parameters
     ----------
@@ -124,6 +241,8 @@ def adhesive_impact(tau0, g, tau, lam, h, n_elem, dxi, max_steps, out):
     n_elem, dxi : elements in the half row and their spacing / a_H
     max_steps : time limit in steps
     out : (N_ADH_OUT,) result row
+    record : (n, N_REC) per-step record of the first ``n`` steps (``REC_*``; n = 0: none)
+    certify_every : steps between two checks of :func:`_cannot_separate` (0: never)
     """
     n_arms = g.shape[0]
     ARMS = n_arms > 0
@@ -207,9 +326,17 @@ def adhesive_impact(tau0, g, tau, lam, h, n_elem, dxi, max_steps, out):
                 rebounding = True
             elif rebounding:  # turned back towards the surface while in contact
                 stuck = True
-                v = v_new
-                status = STATUS_OK
-                break
+            if (not stuck and certify_every > 0 and step % certify_every == 0
+                    and _cannot_separate(u, v_new, n_c, touched, w, q, g, G, c0, k_el, xi2,
+                                         sqrt_xi, lam, ARMS)):
+                stuck = True
+        if step <= record.shape[0]:
+            _record(record[step - 1], step * h, u, v_new, n_c, touched, w, q, g, k_el, xi2,
+                    lam, dxi, ARMS)
+        if stuck:
+            v = v_new
+            status = STATUS_OK
+            break
         v = v_new
         if n_c == 0 and v < 0.0 and t_first >= 0.0:
             # free flight away: ends once no relaxing surface point can reach the sphere
@@ -231,6 +358,25 @@ def adhesive_impact(tau0, g, tau, lam, h, n_elem, dxi, max_steps, out):
     out[ADH_STATUS] = status
     out[ADH_STEPS] = step
     out[ADH_CONTACTS] = contacts
+
+
+@jit()
+def _record(row, t, u, v, n_c, touched, w, q, g, k_el, xi2, lam, dxi, ARMS):
+    """One row of the per-step record: state, contact energy, Griffith energy."""
+    row[REC_T] = t
+    row[REC_U] = u
+    row[REC_V] = v
+    row[REC_NC] = n_c
+    row[REC_V_LYAP] = _contact_energy(u, v, n_c, w, q, g, k_el, xi2, ARMS)[0] if n_c > 0 \
+        else math.nan
+    stored = 0.0
+    for j in range(touched):
+        stored += w[j] * w[j]
+        if ARMS:
+            stored += _arm_energy(j, w, q, g)
+    # dgamma pi a^2 in kernel units: (15/32) lam^2 (n_c dxi)^2 (docs/physics.md#adhesion)
+    row[REC_E_GRIFFITH] = (0.5 * v * v + 0.5 * k_el * stored
+                           - 0.5 * ELEMENT_STIFFNESS * (lam * n_c * dxi) ** 2)
 
 
 @jit(parallel=True)

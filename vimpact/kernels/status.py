@@ -36,8 +36,9 @@ TABLE: tuple[Status, ...] = (
     Status("normal_only", None, "finished; the scene asked for the normal impact only "
            "(tangential = 'none'): e_x, beta_x not computed (NaN)", True, False),
     Status("stuck", None, "finished; adhesion held the sphere: it turned back towards the "
-           "surface while in contact and does not separate, e_z = 0 (an adhesive impact, "
-           "normal only: e_x, beta_x NaN)", True, False),
+           "surface while in contact, or creeps to rest in a contact that provably never "
+           "changes, and does not separate, e_z = 0 (an adhesive impact, normal only: e_x, "
+           "beta_x NaN)", True, False),
     Status("half_space", None, "finished, but the contact half-width exceeded 0.2 R: outside "
            "the half-space model", True, False),
     Status("time_limit", 1, "the impact had not ended at the time limit (Numerics.max_time); "

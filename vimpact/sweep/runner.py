@@ -380,6 +380,11 @@ def _run(spec, spec_path, out, parts, resume, progress, workers, scheduler, shar
         raise InputError(f'grid.refine = "adaptive" is not allowed for a sweep of '
                          f"{spec.path.name}: an adaptive table is built cell by cell, not in "
                          f"chunks; build it with `vimpact table build {spec.path}`")
+    if spec.mode == "grid" and "lam" in spec.axes and spec.grid_tolerance is not None:
+        raise InputError(f"grid.tolerance with a lam axis is not allowed for a sweep of "
+                         f"{spec.path.name}: it specifies an adhesive lookup table (the "
+                         "sticking boundary and e_z below it); build it with `vimpact table "
+                         f"build {spec.path}`")
     spec = stages.prepare(spec, parts, log)
     if parts.exists():
         done = store.existing_parts(spec, parts)

@@ -295,9 +295,9 @@ def is_complete(spec, out: Path) -> bool:
         meta = decode_metadata(pq.read_schema(target).metadata)
     except Exception:  # noqa: BLE001
         return False
-    # a sweep records its kernels' paths; an adaptive table (`vimpact table build`) is
-    # made cell by cell and has none
-    made = "paths" in meta or meta.get("mode") == "adaptive"
+    # a sweep records its kernels' paths; an adaptive or adhesive table (`vimpact table
+    # build`) is made cell by cell and has none
+    made = "paths" in meta or meta.get("mode") in ("adaptive", "adhesion")
     if not (meta.get("sweep_hash") == spec.sweep_hash and made):
         return False
     try:
