@@ -296,7 +296,7 @@ def verify_adhesion_table(table: AdhesionTable, n: int = 2000, seed: int = 0,
     misread = res["stuck"] != stuck
     both_free = ~stuck & ~res["stuck"]
     err = np.abs(res["e_z"] - e_z)
-    outputs = {}
+    outputs: dict[str, dict] = {}
     with np.errstate(invalid="ignore"):
         s = np.sqrt(np.log(res["lam_s"] / lam))
     sliver = s < S_SLIVER
