@@ -609,9 +609,10 @@ def chunked(spec: SweepSpec, parts: Path, choose: bool = True, units: int = 1,
     return dataclasses.replace(spec, chunk_size=size)
 
 
-#: Seconds to start a local Dask cluster of two workers and load the kernels in them,
-#: about (``vimpact bench sweep_backends`` measures it: 3-6 s on 2 cores)
-CLUSTER_START_SECONDS = 4.0
+#: Seconds to start a local Dask cluster of two workers and have them load the kernels,
+#: about: ``vimpact bench sweep_backends`` measures it (``cluster_ready_s``: 2.3 s on 2
+#: cores, the start alone 1.0 s quiet and 2.2 s under load)
+CLUSTER_START_SECONDS = 3.0
 
 
 def small_for_cluster(spec: SweepSpec, todo: list[int], workers: int) -> str | None:
