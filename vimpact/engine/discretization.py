@@ -28,6 +28,8 @@ def stiffness_ratio(cols) -> np.ndarray:
     an arm whose time is long against the Hertz time is a spring, one whose
     time is short relaxes away. Dimensionless, >= 1, one value per row.
     """
+    if not cols.G_arm.shape[1]:  # no arm column: 1 (what the sum of none gives)
+        return np.ones(cols.G_inf.shape[0])
     g = cols.G_arm / cols.G_inf[:, None]
     tau = cols.tau_arm
     return 1.0 + _arm_sum(g * tau / (tau + cols.t_H[:, None]))
@@ -65,17 +67,17 @@ def refinement(cols, numerics: Numerics, tangential: np.ndarray, integrator: int
     time_factor = time_factor * np.where(tangential, np.maximum(1.0, np.sqrt(stiff_t)), 1.0)
     element_factor = element_factor * np.where(
         tangential, np.maximum(1.0, (stiff_t / SOLID_SPHERE_STIFFNESS) ** 0.25), 1.0)
-    T = cols.T[:, None]
+    arms = cols.G_arm.shape[1] > 0  # (without an arm column its terms are 0: not computed)
     g = cols.G_arm / cols.G_inf[:, None]
-    tau_T = cols.tau_arm / T
+    tau_T = cols.tau_arm / cols.T[:, None]
     h = HERTZ_TIME_FACTOR / numerics.steps / time_factor
-    viscous = _arm_sum(np.where(tau_T < h[:, None], g * tau_T, 0.0))
+    viscous = _arm_sum(np.where(tau_T < h[:, None], g * tau_T, 0.0)) if arms else 0.0
     if integrator == EULER:
         viscous = viscous + cols.dashpot_time / cols.T
     rate = 15.0 / 8.0 * viscous * numerics.row_width * np.maximum(1.0, stiff_t)
     time_factor = time_factor * np.maximum(1.0, h * rate)
     h = HERTZ_TIME_FACTOR / numerics.steps / time_factor
-    springs = 1.0 + _arm_sum(np.where(tau_T >= h[:, None], g, 0.0))
+    springs = 1.0 + (_arm_sum(np.where(tau_T >= h[:, None], g, 0.0)) if arms else 0.0)
     omega = np.sqrt(15.0 / 8.0 * numerics.row_width * springs * np.maximum(1.0, stiff_t))
     time_factor = time_factor * np.maximum(1.0, 2.0 * h * omega)
     return time_factor, element_factor

@@ -117,7 +117,8 @@ def _run(cols: SceneColumns, numerics: Numerics, n_rec: int, rec_every: int,
             arrays = element_arrays(_rows(cols, idx), numerics, path.spec)
             per_t_H = HERTZ_TIME_FACTOR / arrays["h"]
             costly = (per_t_H > MAX_STEPS_PER_T_H) | (arrays["n_elem"] > MAX_ELEMENTS_IN_ROW)
-            for j in np.flatnonzero(costly):
+            n_costly = int(np.count_nonzero(costly))  # (cheaper than any() and flatnonzero)
+            for j in np.flatnonzero(costly) if n_costly else ():
                 refused[idx[j]] = ("too_costly",
                     f"this scene needs {per_t_H[j]:.3g} steps per Hertz time and "
                     f"{numerics.row_width / arrays['dxi'][j]:.3g} elements (refined for its "
@@ -129,9 +130,10 @@ def _run(cols: SceneColumns, numerics: Numerics, n_rec: int, rec_every: int,
                 for j in np.flatnonzero(~costly):
                     refused[idx[j]] = ("tolerance_unreachable", why)
                 costly[:] = True
+                n_costly = len(costly)
             explicit_euler[idx] = path.spec.integrator == layout.EULER
             steps_per_T[idx] = 1.0 / arrays["h"]
-            if costly.any():
+            if n_costly:
                 idx = idx[~costly]
                 arrays = {key: value[~costly] for key, value in arrays.items()}
                 if len(idx) == 0:
