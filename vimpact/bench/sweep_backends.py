@@ -215,16 +215,16 @@ def default_sweep(rows: int = 100_000, repeats: int = 2) -> dict:
     def best(name: str, key: str) -> float:
         return min(x[key] for x in runs[name])
 
-    out = {"rows": spec.rows, "threads": threads, "repeats": repeats, "runs": runs,
-           "one_batch_kernel_s": batch["kernel_s"], "one_batch_total_s": batch["total_s"],
-           "tables_equal": equal}
+    result = {"rows": spec.rows, "threads": threads, "repeats": repeats, "runs": runs,
+              "one_batch_kernel_s": batch["kernel_s"], "one_batch_total_s": batch["total_s"],
+              "tables_equal": equal}
     for name in runs:
-        out[f"{name}_wall_over_kernel"] = best(name, "wall_s") / best(name, "kernel_s")
-        out[f"{name}_wall_over_one_batch_kernel"] = best(name, "wall_s") / batch["kernel_s"]
-    out["chunk_64_over_chosen"] = best("chunk_64", "wall_s") / best("chosen", "wall_s")
-    out["one_thread_over_two"] = best("chosen_1_thread", "wall_s") / best("chosen", "wall_s")
-    out["target_wall_over_kernel"] = 1.2
-    return out
+        result[f"{name}_wall_over_kernel"] = best(name, "wall_s") / best(name, "kernel_s")
+        result[f"{name}_wall_over_one_batch_kernel"] = best(name, "wall_s") / batch["kernel_s"]
+    result["chunk_64_over_chosen"] = best("chunk_64", "wall_s") / best("chosen", "wall_s")
+    result["one_thread_over_two"] = best("chosen_1_thread", "wall_s") / best("chosen", "wall_s")
+    result["target_wall_over_kernel"] = 1.2
+    return result
 
 
 def run(quick: bool) -> dict:
