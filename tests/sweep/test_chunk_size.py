@@ -146,15 +146,16 @@ def test_combine_without_parts_chooses_nothing(tmp_path, monkeypatch):
 
 
 def test_the_rule_work_per_chunk_bounds_and_workers(tmp_path, monkeypatch):
-    spec = load_spec(write(tmp_path, GRID.format(chunk="")))
+    small = load_spec(write(tmp_path, GRID.format(chunk="")))  # 40 rows
+    big = load_spec(write(tmp_path, GRID.format(chunk="").replace("num = 20", "num = 100_000"),
+                          "big.toml"))  # 200,000 rows
     lo, hi = AUTO_CHUNK_ROWS
-    for cost, want in ((1e-7, hi), (1e-1, lo), (1e-4, 10_000)):
+    for cost, want in ((1e-7, hi), (1e-1, lo), (1e-3, 1000)):
         monkeypatch.setattr(runner, "seconds_per_row", lambda s, cost=cost: (cost, 8))
-        assert runner.choose_chunk_size(spec)["chunk_size"] == want
+        assert runner.choose_chunk_size(big)["chunk_size"] == want
     monkeypatch.setattr(runner, "seconds_per_row", lambda s: (1e-7, 8))
-    big = load_spec(write(tmp_path, GRID.format(chunk="").replace("num = 20", "num = 5000"),
-                          "big.toml"))  # 10,000 rows
-    assert runner.choose_chunk_size(big, units=2)["chunk_size"] == 10_000 // 8
+    assert runner.choose_chunk_size(small)["chunk_size"] == 40  # not more than the rows
+    assert runner.choose_chunk_size(big, units=2)["chunk_size"] == 200_000 // 8
 
 
 def test_workers_on_a_small_sweep_says_so(tmp_path, monkeypatch, capsys):

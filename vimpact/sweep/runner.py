@@ -513,8 +513,8 @@ def choose_chunk_size(spec: SweepSpec, units: int = 1) -> dict:
     """Choose the rows per chunk of ``spec`` from the measured cost of its rows.
 
     About :data:`~vimpact.sweep.spec.AUTO_CHUNK_SECONDS` of work per chunk
-    (:func:`seconds_per_row`), within :data:`~vimpact.sweep.spec.AUTO_CHUNK_ROWS`, at
-    most ``MAX_CHUNKS`` chunks, and with ``units`` workers or shards at least
+    (:func:`seconds_per_row`), within :data:`~vimpact.sweep.spec.AUTO_CHUNK_ROWS` and the
+    sweep's rows, at most ``MAX_CHUNKS`` chunks, and with ``units`` workers or shards at least
     :data:`CHUNKS_PER_WORKER` chunks each where the rows allow it.
 
     Returns
@@ -528,7 +528,7 @@ def choose_chunk_size(spec: SweepSpec, units: int = 1) -> dict:
     size = int(min(hi, max(lo, AUTO_CHUNK_SECONDS / cost)))
     if units > 1:
         size = min(size, max(lo, -(-spec.rows // (CHUNKS_PER_WORKER * units))))
-    size = max(size, -(-spec.rows // MAX_CHUNKS), 1)
+    size = max(min(size, spec.rows), -(-spec.rows // MAX_CHUNKS), 1)
     return {"chunk_size": size, "seconds_per_row": cost, "probe_rows": probed, "units": units}
 
 
@@ -603,9 +603,9 @@ def chunked(spec: SweepSpec, parts: Path, choose: bool = True, units: int = 1,
                   "rows": spec.rows}
         size = _record_chunk_size(parts, record)
         if log is not None:
-            log(f"{size} rows per chunk (measured {record['seconds_per_row'] * 1e6:.3g} us "
-                f"per row; about {AUTO_CHUNK_SECONDS:g} s per chunk; set chunk_size in the "
-                "spec to choose it)")
+            log(f"{size} rows per chunk, chosen from {record['seconds_per_row'] * 1e6:.3g} us "
+                f"per row measured (about {AUTO_CHUNK_SECONDS:g} s of work per chunk at most; "
+                "chunk_size in the spec sets it)")
     return dataclasses.replace(spec, chunk_size=size)
 
 
