@@ -176,3 +176,27 @@ def test_workers_on_a_small_sweep_says_so(tmp_path, monkeypatch, capsys):
     monkeypatch.setattr(runner, "seconds_per_row", lambda s, probe_chunks=8: (1.0, 8))
     run_sweep(spec, out=tmp_path / "big.parquet", workers=2, progress=False)
     assert "--workers" not in capsys.readouterr().err
+
+
+def test_chunk_summary_counts_as_numpy_does():
+    """The part summary (Arrow's counts) against a NumPy count of the same columns."""
+    import numpy as np
+    import pyarrow as pa
+
+    rng = np.random.default_rng(4)
+    n = 5000
+    status = rng.choice(["ok", "normal_only", "invalid", "unstable"], n).astype(object)
+    path = rng.choice(["continuum[kelvin_voigt,normal]", "elements[verlet,dashpot]", "z"], n)
+    path = np.where(status == "invalid", None, path).astype(object)
+    rows = np.arange(n) + 1000
+    table = pa.table({"row": rows, "status": pa.array(status, pa.string()),
+                      "path": pa.array(path, pa.string())})
+    got = runner.chunk_summary(table)
+    names, counts = np.unique(status.astype(str), return_counts=True)
+    assert list(got["counts"].items()) == [(str(a), int(b)) for a, b in zip(names, counts)]
+    has = path != None  # noqa: E711 - elementwise
+    labels, first, count = np.unique(path[has].astype(str), return_index=True,
+                                     return_counts=True)
+    assert list(got["paths"].items()) == [
+        (str(lab), {"rows": int(c), "first_row": int(rows[has][f])})
+        for lab, f, c in zip(labels, first, count)]

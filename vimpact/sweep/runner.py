@@ -178,20 +178,20 @@ def guard_nan(cols: dict, status: np.ndarray, error: np.ndarray, vc0_zero: np.nd
 def chunk_summary(table) -> dict:
     """Return the small summary a part stores and a task returns.
 
-    Rows per status (``counts``) and rows and first row per kernel path (``paths``).
+    Rows per status (``counts``) and rows and first row per kernel path (``paths``),
+    each sorted by name; counted by Arrow (a Python list of the paths cost 0.1 s per
+    1e5 rows).
     """
-    status = table.column("status").to_numpy(zero_copy_only=False)
-    names, counts = np.unique(status.astype(str), return_counts=True)
-    path = np.asarray(table.column("path").to_pylist(), dtype=object)
-    rows = table.column("row").to_numpy()
+    import pyarrow.compute as pc
+
+    counts = {str(c["values"]): int(c["counts"])
+              for c in pc.value_counts(table.column("status")).to_pylist()}
+    path, rows = table.column("path"), table.column("row")
     paths = {}
-    has = ~_isnull(path)
-    if has.any():
-        labels, first, count = np.unique(path[has].astype(str), return_index=True,
-                                         return_counts=True)
-        paths = {str(lab): {"rows": int(c), "first_row": int(rows[has][f])}
-                 for lab, f, c in zip(labels, first, count)}
-    return {"counts": {str(a): int(b) for a, b in zip(names, counts)}, "paths": paths}
+    for c in pc.value_counts(pc.drop_null(path)).to_pylist():
+        first = pc.index(path, c["values"]).as_py()
+        paths[str(c["values"])] = {"rows": int(c["counts"]), "first_row": int(rows[first].as_py())}
+    return {"counts": dict(sorted(counts.items())), "paths": dict(sorted(paths.items()))}
 
 
 def explain_paths(spec: SweepSpec, first_rows: dict[str, int]) -> dict[str, list[str]]:
