@@ -1,6 +1,6 @@
 """Full-size run of the ``sweep_backends`` benchmark: writes
 ``benchmarks/results/sweep_backends.json`` (``python -m benchmarks.sweep_backends
-[--part backends|large|both] [--rows N] [--quick]``; a part not run keeps its earlier entry).
+[--part backends|large|default|both] [--rows N] [--quick]``; a part not run keeps its earlier entry).
 
 The code is :mod:`vimpact.bench.sweep_backends` (also ``vimpact bench sweep_backends``);
 its names are re-exported here.
@@ -13,14 +13,15 @@ import json
 from pathlib import Path
 
 from vimpact.bench.sweep_backends import *  # noqa: F401,F403
-from vimpact.bench.sweep_backends import backends, large, machine
+from vimpact.bench.sweep_backends import backends, default_sweep, large, machine
 
 RESULTS = Path(__file__).parent / "results"
 
 
 def main(argv=None) -> dict:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--part", choices=("backends", "large", "both"), default="both")
+    parser.add_argument("--part", choices=("backends", "large", "default", "both"),
+                        default="both")
     parser.add_argument("--rows", type=int, default=1_000_000, help="rows of the large sweep")
     parser.add_argument("--quick", action="store_true", help="small sizes (a smoke run)")
     parser.add_argument("--out", type=Path, default=RESULTS)
@@ -35,6 +36,11 @@ def main(argv=None) -> dict:
         data["large"] = large(2000 if args.quick else args.rows, 500 if args.quick else 10_000)
         data["large"]["command"] = "python -m benchmarks.sweep_backends --part large"
         print(json.dumps(data["large"], indent=1))
+    if args.part in ("default", "both"):
+        data["default"] = default_sweep(10_000 if args.quick else 100_000,
+                                        1 if args.quick else 2)
+        data["default"]["command"] = "python -m benchmarks.sweep_backends --part default"
+        print(json.dumps({k: x for k, x in data["default"].items() if k != "runs"}, indent=1))
     args.out.mkdir(parents=True, exist_ok=True)
     path.write_text(json.dumps(data, indent=1))
     return data

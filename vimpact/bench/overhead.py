@@ -139,10 +139,11 @@ def _measure(columns: dict, numerics, repeats: int) -> dict:
     }
 
 
-#: main before the one-impact fast path of :func:`vimpact.simulate` (a scalar unpack of
-#: the one row, no second validation of a ``Scene``, derived columns computed once):
-#: its engine is timed side by side with the current one where the source is at hand
-BEFORE_COMMIT = "7dbf0d8"
+#: main before the one-row route of :func:`vimpact.simulate` (Python scalars instead of
+#: one-element array arithmetic, no thread count set per impact, no reduction over an
+#: empty arm column); 7dbf0d8 was the commit before the scalar unpack of the one row.
+#: Its engine is timed side by side with the current one where the source is at hand
+BEFORE_COMMIT = "c993144"
 #: Python CPU time outside the kernel of one ``simulate()`` call, us
 TARGET_ONE_IMPACT_US = 100.0
 

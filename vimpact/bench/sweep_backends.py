@@ -15,18 +15,34 @@ source checkout ``python -m benchmarks.sweep_backends [--part backends|large|bot
   overhead per row, and the peak resident memory of this process and its
   children (``resource.getrusage``).
 
+- ``default``: a Kelvin-Voigt normal-only grid of 1e5 rows (default numerics) whose
+  spec sets no ``chunk_size`` (the runner chooses it from the measured cost per row,
+  :func:`vimpact.sweep.runner.choose_chunk_size`) against the same spec with
+  ``chunk_size = 64`` (the fixed default before), in turns, and the chosen chunking on
+  1 and on 2 numba threads; each against the kernel time of its own run and against
+  ``simulate_batch`` on the same rows in one call (target: sweep wall <= 1.2x the kernel
+  time; 2 threads never slower than 1). The tables must be equal.
+
+The cluster's start (``backends``: ``cluster_start_s``, and ``cluster_ready_s`` with its
+workers' first sweep, which loads the kernels, less the same sweep in process) is what
+``--workers`` on a small sweep is measured against
+(:data:`vimpact.sweep.runner.CLUSTER_START_SECONDS`).
+
 The repository's script writes ``benchmarks/results/sweep_backends.json`` (a
 part not run keeps its earlier entry).
 """
 
 from __future__ import annotations
 
+import dataclasses
 import os
 import platform
 import resource
 import tempfile
 import time
 from pathlib import Path
+
+import numpy as np
 
 from .machine import max_threads
 
@@ -83,8 +99,12 @@ def backends(rows: int, chunk: int) -> dict:
         start_s = time.perf_counter() - t0
         try:
             address = cluster.scheduler_address
+            t0 = time.perf_counter()
             run_sweep(warm, out=tmp / "w1.parquet", progress=False)
+            warm_in = time.perf_counter() - t0
+            t0 = time.perf_counter()  # the workers load the kernels (numba's cache)
             run_sweep(warm, out=tmp / "w2.parquet", progress=False, scheduler=address)
+            warm_dask = time.perf_counter() - t0
             t0 = time.perf_counter()
             a = run_sweep(spec, out=tmp / "inprocess.parquet", progress=False)
             t_in = time.perf_counter() - t0
@@ -98,6 +118,9 @@ def backends(rows: int, chunk: int) -> dict:
     return {"rows": rows, "chunk_size": chunk, "numerics": "fast",
             "in_process_2_threads_s": t_in, "dask_2_workers_x_1_thread_s": t_dask,
             "dask_over_in_process": t_dask / t_in, "cluster_start_s": start_s,
+            "first_sweep_s": {"in_process": warm_in, "dask": warm_dask},
+            # what --workers costs before its first chunk runs at speed
+            "cluster_ready_s": start_s + warm_dask - warm_in,
             "rows_per_s": {"in_process": rows / t_in, "dask": rows / t_dask},
             "tables_identical": identical}
 
@@ -126,6 +149,94 @@ def large(rows: int, chunk: int) -> dict:
             "table_bytes": size, "statuses": counts}
 
 
+DEFAULT_SPEC = """
+description = "benchmark: Kelvin-Voigt normal-only grid"
+model = "kelvin_voigt"
+tangential = "none"
+{chunk}
+[grid]
+Q1 = {{ start = 1e-3, stop = 1.0, num = {q1} }}
+nu = {{ start = 0.0, stop = 0.5, num = 100 }}
+"""
+
+
+def default_sweep(rows: int = 100_000, repeats: int = 2) -> dict:
+    """Time the default (chosen) chunking against ``chunk_size = 64``, and 1 vs 2 threads.
+
+    Each configuration ``repeats`` times in turns after a warm-up; per run the wall time,
+    the kernel time and ``simulate_batch`` time of its chunks
+    (``run_sweep(timings=...)``) and the chunk size it used; each round starts with one
+    ``simulate_batch`` call on all the sweep's rows (the kernel at its best: one launch).
+    Ratios are taken within a round (the load changes between rounds).
+    """
+    import numba
+
+    from vimpact.engine.simulate import simulate_batch
+    from vimpact.sweep import load_spec, read_metadata, run_sweep
+    from vimpact.sweep.parameters import engine_columns
+
+    threads = min(2, max_threads())
+    q1 = max(1, rows // 100)
+    runs: dict[str, list[dict]] = {"chosen": [], "chunk_64": [], "chosen_1_thread": []}
+    with tempfile.TemporaryDirectory() as folder:
+        tmp = Path(folder)
+        chosen = tmp / "chosen.toml"
+        chosen.write_text(DEFAULT_SPEC.format(chunk="", q1=q1))
+        fixed = tmp / "fixed.toml"
+        fixed.write_text(DEFAULT_SPEC.format(chunk="chunk_size = 64", q1=q1))
+        warm = tmp / "warm.toml"
+        warm.write_text(DEFAULT_SPEC.format(chunk="", q1=2))
+        run_sweep(warm, out=tmp / "warm.parquet", progress=False)
+        spec = load_spec(chosen)
+        params = dataclasses.replace(spec, chunk_size=spec.rows).chunk_parameters(0)
+        cols = engine_columns(spec, params)[0][0][1]
+        batches: list[dict] = []
+        tables = {}
+        try:
+            for r in range(repeats):
+                numba.set_num_threads(threads)
+                batch: dict = {}
+                simulate_batch(cols, spec.numerics, timings=batch)
+                batches.append(batch)
+                for name, path, nt in (("chosen", chosen, threads), ("chunk_64", fixed, threads),
+                                       ("chosen_1_thread", chosen, 1)):
+                    numba.set_num_threads(nt)
+                    out = tmp / f"{name}_{r}.parquet"
+                    timings: dict = {}
+                    t0 = time.perf_counter()
+                    run_sweep(path, out=out, progress=False, timings=timings)
+                    wall = time.perf_counter() - t0
+                    runs[name].append({"wall_s": wall, "kernel_s": timings["kernel_s"],
+                                       "simulate_batch_s": timings["total_s"], "threads": nt,
+                                       "chunk_size": read_metadata(out)["chunk_size"],
+                                       "one_batch_kernel_s": batch["kernel_s"]})
+                    tables[name] = out
+        finally:
+            numba.set_num_threads(max_threads())
+        import pyarrow.parquet as pq
+
+        frames = [pq.read_table(p).to_pandas() for p in tables.values()]
+        equal = all(f.equals(frames[0]) for f in frames[1:])
+
+    def ratio(name: str, key: str) -> float:
+        """Return the smallest over the rounds of wall time / ``key`` of the round."""
+        return min(x["wall_s"] / x[key] for x in runs[name])
+
+    def turns(a: str, b: str) -> float:
+        """Return the median over the rounds of the wall time of ``a`` / that of ``b``."""
+        return float(np.median([x["wall_s"] / y["wall_s"] for x, y in zip(runs[a], runs[b])]))
+
+    result = {"rows": spec.rows, "threads": threads, "repeats": repeats, "runs": runs,
+              "one_batch": batches, "tables_equal": equal}
+    for name in runs:
+        result[f"{name}_wall_over_kernel"] = ratio(name, "kernel_s")
+        result[f"{name}_wall_over_one_batch_kernel"] = ratio(name, "one_batch_kernel_s")
+    result["chunk_64_over_chosen"] = turns("chunk_64", "chosen")
+    result["one_thread_over_two"] = turns("chosen_1_thread", "chosen")
+    result["target_wall_over_kernel"] = 1.2
+    return result
+
+
 def run(quick: bool) -> dict:
     """Measure both parts.
 
@@ -134,7 +245,8 @@ def run(quick: bool) -> dict:
     """
     return {"machine": machine(),
             "backends": backends(200 if quick else 2000, 20 if quick else 100),
-            "large": large(2000 if quick else 1_000_000, 500 if quick else 10_000)}
+            "large": large(2000 if quick else 1_000_000, 500 if quick else 10_000),
+            "default": default_sweep(10_000 if quick else 100_000, 1 if quick else 2)}
 
 
 def plot(data: dict, path) -> None:
@@ -166,7 +278,18 @@ def figures(data: dict) -> dict:
     from vimpact.bench.machine import figure
 
     b, big = data["backends"], data["large"]
-    return {"dask_over_in_process": figure(b["dask_over_in_process"], "-"),
+    extra = {}
+    if "default" in data:
+        d = data["default"]
+        extra = {"default_sweep_wall_over_kernel": figure(d["chosen_wall_over_kernel"], "-"),
+                 "default_sweep_chunk_64_over_chosen": figure(d["chunk_64_over_chosen"], "-",
+                                                              better="higher"),
+                 "default_sweep_one_thread_over_two": figure(d["one_thread_over_two"], "-",
+                                                             better="higher")}
+    if "cluster_ready_s" in b:
+        extra["cluster_ready_s"] = figure(b["cluster_ready_s"], "s")
+    return {**extra, "cluster_start_s": figure(b["cluster_start_s"], "s"),
+            "dask_over_in_process": figure(b["dask_over_in_process"], "-"),
             "large_wall_over_kernel": figure(big["wall_over_kernel"], "-"),
             "large_rows_per_s": figure(big["rows_per_s"], "1/s", better="higher"),
             "large_overhead_us_per_row": figure(big["overhead_us_per_row"], "us/row")}

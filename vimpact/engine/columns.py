@@ -202,6 +202,8 @@ class SceneColumns:
     @_once
     def has_arms(self) -> np.ndarray:
         """Rows with at least one Maxwell arm, bool."""
+        if self.G_arm.shape[1] == 0:  # (np.any over no column costs more than this)
+            return np.zeros(len(self), dtype=bool)
         return np.any(self.G_arm > 0.0, axis=1)
 
     @_once
@@ -212,13 +214,16 @@ class SceneColumns:
     @property
     def Q1(self) -> np.ndarray:
         """``sqrt(15/32) (eta / G_inf) / T`` (NaN for a Prony series), dimensionless."""
-        arm_viscous = (self.G_arm * self.tau_arm).sum(axis=1) / self.G_inf
+        arm_viscous = ((self.G_arm * self.tau_arm).sum(axis=1) / self.G_inf if self.G_arm.shape[1]
+                       else 0.0)  # no arm column: a sum of none
         viscous = np.where(self.model == MODEL_STANDARD_SOLID, arm_viscous, self.dashpot_time)
         return np.where(self.model == MODEL_PRONY, np.nan, Q1_PER_TAU * viscous / self.T)
 
     @property
     def Q2(self) -> np.ndarray:
         """``G1 / G2`` for a standard solid (inf without arm), NaN otherwise."""
+        if not self.G_arm.shape[1]:  # no arm column: inf for a standard solid (none), else NaN
+            return np.where(self.model == MODEL_STANDARD_SOLID, np.inf, np.nan)
         G2 = self.G_arm.sum(axis=1)
         with np.errstate(divide="ignore"):
             q2 = np.where(G2 > 0.0, self.G_inf / np.where(G2 > 0.0, G2, 1.0), np.inf)
@@ -238,8 +243,10 @@ class SceneColumns:
         G_arm, tau_arm = np.zeros((n, k)), np.zeros((n, k))
         reasons = np.full(n, None, dtype=object)
         numbers, codes, flags = [], [], []  # a tuple per row, one array each at the end
+        bad = False
         for i, s in enumerate(scenes):
             if not isinstance(s, Scene):  # a bad entry is a bad row, not a lost batch
+                bad = True
                 reasons[i] = message(f"scenes[{i}]", s, "a vimpact.Scene")
                 numbers.append(_NEUTRAL_ROW)
                 codes.append((0, 0, 0))
@@ -260,7 +267,8 @@ class SceneColumns:
         cols = dict(zip(_SCENE_NUMBERS, number), G_arm=G_arm, tau_arm=tau_arm,
                     tangential=code[0], memory=code[1], model=code[2], rotation=flag[0],
                     allow_large_contact=flag[1], reasons=reasons)
-        _neutralize(cols)
+        if bad:
+            _neutralize(cols)
         # no check_scales: a Scene checked the same ranges when it was made
         # (ScaleError), and a row that is not a Scene is already marked
         return cls(**cols)

@@ -28,9 +28,11 @@ def stiffness_ratio(cols) -> np.ndarray:
     an arm whose time is long against the Hertz time is a spring, one whose
     time is short relaxes away. Dimensionless, >= 1, one value per row.
     """
+    if not cols.G_arm.shape[1]:  # no arm column: 1 (what the sum of none gives)
+        return np.ones(cols.G_inf.shape[0])
     g = cols.G_arm / cols.G_inf[:, None]
     tau = cols.tau_arm
-    return 1.0 + (g * tau / (tau + cols.t_H[:, None])).sum(axis=1)
+    return 1.0 + _arm_sum(g * tau / (tau + cols.t_H[:, None]))
 
 
 def refinement(cols, numerics: Numerics, tangential: np.ndarray, integrator: int
@@ -65,17 +67,17 @@ def refinement(cols, numerics: Numerics, tangential: np.ndarray, integrator: int
     time_factor = time_factor * np.where(tangential, np.maximum(1.0, np.sqrt(stiff_t)), 1.0)
     element_factor = element_factor * np.where(
         tangential, np.maximum(1.0, (stiff_t / SOLID_SPHERE_STIFFNESS) ** 0.25), 1.0)
-    T = cols.T[:, None]
+    arms = cols.G_arm.shape[1] > 0  # (without an arm column its terms are 0: not computed)
     g = cols.G_arm / cols.G_inf[:, None]
-    tau_T = cols.tau_arm / T
+    tau_T = cols.tau_arm / cols.T[:, None]
     h = HERTZ_TIME_FACTOR / numerics.steps / time_factor
-    viscous = np.where(tau_T < h[:, None], g * tau_T, 0.0).sum(axis=1)
+    viscous = _arm_sum(np.where(tau_T < h[:, None], g * tau_T, 0.0)) if arms else 0.0
     if integrator == EULER:
         viscous = viscous + cols.dashpot_time / cols.T
     rate = 15.0 / 8.0 * viscous * numerics.row_width * np.maximum(1.0, stiff_t)
     time_factor = time_factor * np.maximum(1.0, h * rate)
     h = HERTZ_TIME_FACTOR / numerics.steps / time_factor
-    springs = 1.0 + np.where(tau_T >= h[:, None], g, 0.0).sum(axis=1)
+    springs = 1.0 + (_arm_sum(np.where(tau_T >= h[:, None], g, 0.0)) if arms else 0.0)
     omega = np.sqrt(15.0 / 8.0 * numerics.row_width * springs * np.maximum(1.0, stiff_t))
     time_factor = time_factor * np.maximum(1.0, 2.0 * h * omega)
     return time_factor, element_factor
@@ -86,7 +88,7 @@ def time_limit(cols, numerics: Numerics) -> np.ndarray:
 
     ``max_time`` Hertz times, stretched by the slow creep back of a viscous surface.
     """
-    viscous = cols.dashpot_time + (cols.G_arm * cols.tau_arm).sum(axis=1) / cols.G_inf  # s
+    viscous = cols.dashpot_time + _arm_sum(cols.G_arm * cols.tau_arm) / cols.G_inf  # s
     stretch = np.minimum(10.0 * viscous / cols.T, MAX_TIME_STRETCH)
     return numerics.max_time * HERTZ_TIME_FACTOR * (1.0 + stretch)
 
@@ -106,6 +108,15 @@ def element_row(cols, numerics: Numerics, tangential: np.ndarray, integrator: in
         "n_elem": _count(numerics.row_width * per_a_H),
         "max_steps": _count(time_limit(cols, numerics) / h),
     }
+
+
+def _arm_sum(x: np.ndarray) -> np.ndarray:
+    """Sum over the arms (axis 1) of ``(n, k)`` values; zeros without an arm column.
+
+    The same numbers (a sum of none), without NumPy's reduction, which costs more than
+    the one-row arithmetic around it (:func:`vimpact.simulate`).
+    """
+    return x.sum(axis=1) if x.shape[1] else np.zeros(x.shape[0])
 
 
 def _count(x: np.ndarray) -> np.ndarray:

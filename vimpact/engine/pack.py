@@ -30,9 +30,11 @@ def arm_arrays(cols: SceneColumns, keep: bool = True) -> tuple[np.ndarray, np.nd
     a row first, and their count ``n_arms`` (``keep=False``: no arms at all).
     """
     n = len(cols)
+    if not keep or not cols.G_arm.shape[1]:  # (no arm column: no reduction to pay for)
+        return np.zeros((n, 0)), np.zeros((n, 0)), np.zeros(n, dtype=np.int64)
     real = cols.G_arm > 0.0
     n_arms = real.sum(axis=1).astype(np.int64)
-    width = int(n_arms.max(initial=0)) if keep else 0
+    width = int(n_arms.max(initial=0))
     if not width:
         return np.zeros((n, 0)), np.zeros((n, 0)), np.zeros(n, dtype=np.int64)
     order = np.argsort(~real, axis=1, kind="stable")[:, :width]  # real arms first

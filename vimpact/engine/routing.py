@@ -16,6 +16,7 @@ A scene names its effects (tangential problem or not, rotation, rheology);
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -65,7 +66,7 @@ class KernelPath:
     spec: KernelSpec | None
     reasons: tuple[str, ...]
 
-    @property
+    @functools.cached_property  # (a frozen dataclass: kept in the instance's __dict__)
     def name(self) -> str:
         """Short label, e.g. ``elements[verlet,tangential:incremental,dashpot]``."""
         if self.kind == CONTINUUM_STICK:
@@ -120,6 +121,8 @@ class Routes:
 
 def route(cols: SceneColumns, numerics: Numerics) -> Routes:
     """The cheapest kernel for every row of ``cols`` (vectorized; the one routing rule)."""
+    if len(cols) == 1:
+        return _route_row(cols, numerics)
     valid = cols.valid
     tangential = cols.computes_tangential & valid
     arms = cols.has_arms
@@ -137,18 +140,59 @@ def route(cols: SceneColumns, numerics: Numerics) -> Routes:
     group = np.full(len(cols), -1, dtype=np.int64)
     keys = key[key >= 0]
     for k in (np.unique(keys) if len(keys) > 16 else sorted(set(keys.tolist()))):
-        rows = key == k
-        if k >> 5 == 1:
-            path = CONTINUUM_KV
-        elif k >> 5 == 2:
-            path = CONTINUUM_FULL_STICK
-        else:
-            path = Path(ELEMENTS, KernelSpec(numerics.integrator_code, bool(k >> 4 & 1),
-                                             int(k >> 3 & 1), bool(k >> 2 & 1), bool(k >> 1 & 1),
-                                             bool(k & 1)), ())
-        group[rows] = len(paths)
-        paths.append(path)
+        group[key == k] = len(paths)
+        paths.append(_path_of_key(int(k), numerics.integrator_code))
     return Routes(group, tuple(paths))
+
+
+#: :class:`Routes` of one row, by its path (``None``: an invalid row)
+_ONE_ROW: dict = {}
+
+
+def _route_row(cols: SceneColumns, numerics: Numerics) -> Routes:
+    """:func:`route` of a one-row batch (:func:`vimpact.simulate`), on Python scalars.
+
+    The same masks (:func:`friction_rows`, :func:`continuum_stick`) and the same key
+    as :func:`route`, without the array arithmetic that costs more than the rest of
+    the call on one row; ``tests/engine/test_routing.py`` checks the two agree.
+    """
+    if cols.reasons[0] is not None:
+        path = None
+    else:
+        tangential = bool(cols.computes_tangential[0])
+        arms = bool(cols.has_arms[0])
+        friction_mask = cols.computes_tangential & friction_rows(cols)
+        friction = bool(friction_mask[0])
+        continuum = not arms and not tangential and numerics.continuum
+        stick = not continuum and bool(continuum_stick(cols, numerics, friction_mask)[0])
+        kind = 1 if continuum else 2 if stick else 0
+        key = (kind << 5 if kind else
+               tangential << 4 | (int(cols.memory[0]) if tangential else 0) << 3 | arms << 2
+               | bool(cols.eta0[0] > 0.0) << 1 | friction)
+        path = _path_of_key(key, numerics.integrator_code)
+    routes = _ONE_ROW.get(path)
+    if routes is None:  # (the group array is shared: callers read it, never write it)
+        group = np.full(1, -1 if path is None else 0, dtype=np.int64)
+        group.flags.writeable = False
+        routes = _ONE_ROW[path] = Routes(group, () if path is None else (path,))
+    return routes
+
+
+def _path_of_key(key: int, integrator: int) -> Path:
+    """The path of a routing key of :func:`route` (``kind << 5`` for a continuum kernel,
+    else the effect bits of the element kernel)."""
+    if key >> 5 == 1:
+        return CONTINUUM_KV
+    if key >> 5 == 2:
+        return CONTINUUM_FULL_STICK
+    return _element_path(integrator, key)
+
+
+@functools.cache
+def _element_path(integrator: int, key: int) -> Path:
+    """The element path of a routing key of :func:`route` (made once per key: a few dozen)."""
+    return Path(ELEMENTS, KernelSpec(integrator, bool(key >> 4 & 1), int(key >> 3 & 1),
+                                     bool(key >> 2 & 1), bool(key >> 1 & 1), bool(key & 1)), ())
 
 
 def continuum_stick(cols: SceneColumns, numerics: Numerics, friction: np.ndarray) -> np.ndarray:

@@ -95,8 +95,6 @@ def _run(cols: SceneColumns, numerics: Numerics, n_rec: int, rec_every: int,
     row the path name, explicit Euler, steps per ``T`` and refusal that
     :func:`~vimpact.engine.unpack.unpack` takes (:func:`run_columns`).
     """
-    import numba
-
     n = len(cols)
     routes = route(cols, numerics)
     out = np.zeros((n, layout.N_OUT))
@@ -106,8 +104,12 @@ def _run(cols: SceneColumns, numerics: Numerics, n_rec: int, rec_every: int,
     steps_per_T = np.zeros(n)
     refused = np.full(n, None, dtype=object)
     kernel_s = 0.0
-    threads = max(1, numba.get_num_threads())
-    queue = [(path, np.flatnonzero(routes.group == k)) for k, path in enumerate(routes.paths)]
+    # one row runs on a serial kernel (run_path): no thread to count or to set
+    threads = _threads() if n > 1 else 1
+    if n == 1:  # (one scene: simulate(); np.flatnonzero costs more than the rest of this)
+        queue = [(routes.paths[0], np.zeros(1, dtype=np.int64))] if routes.paths else []
+    else:
+        queue = [(path, np.flatnonzero(routes.group == k)) for k, path in enumerate(routes.paths)]
     while queue:
         path, idx = queue.pop(0)
         arrays = None
@@ -115,7 +117,8 @@ def _run(cols: SceneColumns, numerics: Numerics, n_rec: int, rec_every: int,
             arrays = element_arrays(_rows(cols, idx), numerics, path.spec)
             per_t_H = HERTZ_TIME_FACTOR / arrays["h"]
             costly = (per_t_H > MAX_STEPS_PER_T_H) | (arrays["n_elem"] > MAX_ELEMENTS_IN_ROW)
-            for j in np.flatnonzero(costly):
+            n_costly = int(np.count_nonzero(costly))  # (cheaper than any() and flatnonzero)
+            for j in np.flatnonzero(costly) if n_costly else ():
                 refused[idx[j]] = ("too_costly",
                     f"this scene needs {per_t_H[j]:.3g} steps per Hertz time and "
                     f"{numerics.row_width / arrays['dxi'][j]:.3g} elements (refined for its "
@@ -127,9 +130,10 @@ def _run(cols: SceneColumns, numerics: Numerics, n_rec: int, rec_every: int,
                 for j in np.flatnonzero(~costly):
                     refused[idx[j]] = ("tolerance_unreachable", why)
                 costly[:] = True
+                n_costly = len(costly)
             explicit_euler[idx] = path.spec.integrator == layout.EULER
             steps_per_T[idx] = 1.0 / arrays["h"]
-            if costly.any():
+            if n_costly:
                 idx = idx[~costly]
                 arrays = {key: value[~costly] for key, value in arrays.items()}
                 if len(idx) == 0:
@@ -140,21 +144,25 @@ def _run(cols: SceneColumns, numerics: Numerics, n_rec: int, rec_every: int,
             if arrays is not None:
                 arrays = {key: value[order] for key, value in arrays.items()}
         sub = _rows(cols, idx)
-        sub_out = np.zeros((len(idx), layout.N_OUT))
-        sub_rec = np.zeros((len(idx), n_rec, layout.N_REC))
+        whole = sub is cols  # all rows in order: the kernel writes the batch's own buffers
+        sub_out = out if whole else np.zeros((len(idx), layout.N_OUT))
+        sub_rec = rec if whole else np.zeros((len(idx), n_rec, layout.N_REC))
         t0 = time.perf_counter()
-        if 0 < len(idx) < threads:  # a thread per row at most: waking idle ones only costs
+        if 1 < len(idx) < threads:  # a thread per row at most: waking idle ones only costs
+            import numba
+
             numba.set_num_threads(len(idx))
             try:
                 run_path(path, sub, numerics, sub_rec, rec_every, sub_out, arrays)
             finally:
                 numba.set_num_threads(threads)
-        else:
+        else:  # (one row: a serial kernel, whatever the thread count)
             run_path(path, sub, numerics, sub_rec, rec_every, sub_out, arrays)
         kernel_s += time.perf_counter() - t0
-        out[idx] = sub_out
-        if n_rec:
-            rec[idx] = sub_rec
+        if not whole:
+            out[idx] = sub_out
+            if n_rec:
+                rec[idx] = sub_rec
         path_names[idx] = path.name
         if path.kind == CONTINUUM_STICK:
             status = sub_out[:, layout.OUT_STATUS]
@@ -166,6 +174,13 @@ def _run(cols: SceneColumns, numerics: Numerics, n_rec: int, rec_every: int,
     if timings is not None:
         timings["kernel_s"] = timings.get("kernel_s", 0.0) + kernel_s
     return out, rec, path_names, explicit_euler, steps_per_T, refused
+
+
+def _threads() -> int:
+    """Numba's thread count for the next parallel launch (>= 1)."""
+    import numba
+
+    return max(1, numba.get_num_threads())
 
 
 def _rows(cols: SceneColumns, idx: np.ndarray) -> SceneColumns:

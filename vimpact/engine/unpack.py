@@ -263,10 +263,14 @@ def unpack_row(cols: SceneColumns, out: np.ndarray, path_name: str, explicit_eul
         "n_steps": int(out[layout.OUT_STEPS].astype(np.int64)), "path": path_name,
         "error": error,
     }
-    for name, v in result.items():
-        if isinstance(v, np.generic):
-            result[name] = v.item()
-    return {name: result[name] for name in RESULT_FIELDS}
+    # Python scalars (the numbers are NumPy float64, a subclass of float: float() is
+    # exact; n_steps is an int and the strings are str already), in field order
+    row = {}
+    for name in RESULT_FIELDS:
+        v = result[name]
+        row[name] = float(v) if type(v) is np.float64 else (
+            v.item() if isinstance(v, np.generic) else v)
+    return row
 
 
 def clip_round_off(values: dict[str, np.ndarray], ok: np.ndarray, passive: np.ndarray) -> None:

@@ -46,9 +46,16 @@ import numpy as np
 from vimpact.model.validation import InputError
 from vimpact.sweep import store
 from vimpact.sweep.progress import Progress
-from vimpact.sweep.spec import SweepSpec, load_spec
+from vimpact.sweep.spec import (
+    AUTO_CHUNK_ROWS,
+    AUTO_CHUNK_SECONDS,
+    CHUNK_SIZE_FILE,
+    MAX_CHUNKS,
+    SweepSpec,
+    load_spec,
+)
 from vimpact.tableformat import files
-from vimpact.tableformat.metadata import COMMON_METADATA
+from vimpact.tableformat.metadata import COMMON_METADATA, decode_metadata
 from vimpact.tableformat.schema import (
     ADHESION_RESULTS,
     LABELS,
@@ -175,20 +182,20 @@ def guard_nan(cols: dict, status: np.ndarray, error: np.ndarray, vc0_zero: np.nd
 def chunk_summary(table) -> dict:
     """Return the small summary a part stores and a task returns.
 
-    Rows per status (``counts``) and rows and first row per kernel path (``paths``).
+    Rows per status (``counts``) and rows and first row per kernel path (``paths``),
+    each sorted by name; counted by Arrow (a Python list of the paths cost 0.1 s per
+    1e5 rows).
     """
-    status = table.column("status").to_numpy(zero_copy_only=False)
-    names, counts = np.unique(status.astype(str), return_counts=True)
-    path = np.asarray(table.column("path").to_pylist(), dtype=object)
-    rows = table.column("row").to_numpy()
+    import pyarrow.compute as pc
+
+    counts = {str(c["values"]): int(c["counts"])
+              for c in pc.value_counts(table.column("status")).to_pylist()}
+    path, rows = table.column("path"), table.column("row")
     paths = {}
-    has = ~_isnull(path)
-    if has.any():
-        labels, first, count = np.unique(path[has].astype(str), return_index=True,
-                                         return_counts=True)
-        paths = {str(lab): {"rows": int(c), "first_row": int(rows[has][f])}
-                 for lab, f, c in zip(labels, first, count)}
-    return {"counts": {str(a): int(b) for a, b in zip(names, counts)}, "paths": paths}
+    for c in pc.value_counts(pc.drop_null(path)).to_pylist():
+        first = pc.index(path, c["values"]).as_py()
+        paths[str(c["values"])] = {"rows": int(c["counts"]), "first_row": int(rows[first].as_py())}
+    return {"counts": dict(sorted(counts.items())), "paths": dict(sorted(paths.items()))}
 
 
 def explain_paths(spec: SweepSpec, first_rows: dict[str, int]) -> dict[str, list[str]]:
@@ -386,6 +393,13 @@ def _run(spec, spec_path, out, parts, resume, progress, workers, scheduler, shar
                          "sticking boundary and e_z below it); build it with `vimpact table "
                          f"build {spec.path}`")
     spec = stages.prepare(spec, parts, log)
+    if workers is not None:
+        units = workers
+    elif scheduler is not None and not isinstance(scheduler, str):
+        units = max(1, sum(scheduler.nthreads().values()))
+    else:
+        units = shard[1] if shard is not None else 1
+    spec = chunked(spec, parts, not combine, units, log)
     if parts.exists():
         done = store.existing_parts(spec, parts)
         if done and not (resume or combine):
@@ -408,6 +422,10 @@ def _run(spec, spec_path, out, parts, resume, progress, workers, scheduler, shar
     bar = Progress(spec.rows, rows_done, spec.path.stem, progress)
     finished = False
     try:
+        if workers is not None and todo:
+            too_small = small_for_cluster(spec, todo, workers)
+            if too_small:
+                print(f"vimpact sweep: {too_small}", file=sys.stderr, flush=True)
         if workers is not None or scheduler is not None:
             _run_dask(spec, todo, parts, bar, done, workers, scheduler)
         else:
@@ -440,7 +458,7 @@ def _combine(spec: SweepSpec, parts: Path, out: Path, log, stages: SweepStages) 
     combination fails, so that ``--resume`` still finds them.
     """
     saved = {}
-    for name in stages.kept:
+    for name in (*stages.kept, CHUNK_SIZE_FILE):
         kept = Path(parts) / name
         if kept.is_file():
             saved[name] = kept.read_text()
@@ -455,6 +473,173 @@ def _combine(spec: SweepSpec, parts: Path, out: Path, log, stages: SweepStages) 
                     f.write(text)
         raise
     stages.finish(spec, out, log, False)
+
+
+# ---- chunk size: chosen from the measured cost of the rows --------------------------
+
+#: A cost probe runs rows until their batches took this long, s (or :data:`PROBE_ROWS`).
+PROBE_SECONDS = 0.02
+#: Rows of a cost probe at most.
+PROBE_ROWS = 4096
+#: Chunks per worker (or shard) at least when the runner chooses the chunk size: the
+#: tasks then even out between workers that finish at different times.
+CHUNKS_PER_WORKER = 4
+
+
+def seconds_per_row(spec: SweepSpec, probe_chunks: int = 8) -> tuple[float, int]:
+    """Measure what a row of ``spec`` costs in :func:`vimpact.simulate_batch`, s.
+
+    Rows of ``probe_chunks`` places spread over the sweep, run as one batch as a chunk
+    runs them (their kernels compiled or loaded first, :func:`warm_kernels`), their
+    number doubled until the batch takes :data:`PROBE_SECONDS` (or :data:`PROBE_ROWS`
+    rows, or the whole sweep), so that its fixed cost is a small part. Returns the
+    wall time per row and the rows timed.
+    """
+    from vimpact.engine.simulate import simulate_batch
+    from vimpact.sweep.parameters import engine_columns
+
+    warm_kernels(spec)
+    per_place = 8
+    while True:
+        probe = dataclasses.replace(spec, chunk_size=per_place)
+        places = np.unique(np.linspace(0, probe.n_chunks - 1,
+                                       min(probe_chunks, probe.n_chunks)).astype(int))
+        pieces = [probe.chunk_parameters(int(chunk)) for chunk in places]
+        params = {k: np.concatenate([p[k] for p in pieces]) for k in pieces[0]}
+        rows = len(params["nu"])
+        timings: dict = {}
+        for _, cols in engine_columns(probe, params)[0]:
+            try:
+                simulate_batch(cols, spec.numerics, timings=timings)
+            except Exception:  # noqa: BLE001 - the chunk will record it
+                pass
+        took = timings.get("total_s", 0.0)
+        if took >= PROBE_SECONDS or rows >= min(PROBE_ROWS, spec.rows):
+            return max(took, 1e-9) / max(rows, 1), rows
+        per_place *= 2
+
+
+def choose_chunk_size(spec: SweepSpec, units: int = 1) -> dict:
+    """Choose the rows per chunk of ``spec`` from the measured cost of its rows.
+
+    About :data:`~vimpact.sweep.spec.AUTO_CHUNK_SECONDS` of work per chunk
+    (:func:`seconds_per_row`), within :data:`~vimpact.sweep.spec.AUTO_CHUNK_ROWS` and the
+    sweep's rows, at most ``MAX_CHUNKS`` chunks, and with ``units`` workers or shards at least
+    :data:`CHUNKS_PER_WORKER` chunks each where the rows allow it.
+
+    Returns
+    -------
+    dict
+        ``chunk_size``, ``seconds_per_row`` (s), ``probe_rows`` (what was measured)
+        and ``units``: the record :func:`chunked` stores.
+    """
+    cost, probed = seconds_per_row(spec)
+    lo, hi = AUTO_CHUNK_ROWS
+    size = int(min(hi, max(lo, AUTO_CHUNK_SECONDS / cost)))
+    if units > 1:
+        size = min(size, max(lo, -(-spec.rows // (CHUNKS_PER_WORKER * units))))
+    size = max(min(size, spec.rows), -(-spec.rows // MAX_CHUNKS), 1)
+    return {"chunk_size": size, "seconds_per_row": cost, "probe_rows": probed, "units": units}
+
+
+def recorded_chunk_size(spec: SweepSpec, parts: Path) -> int | None:
+    """Return the chunk size an earlier run of ``spec`` chose, or ``None``.
+
+    From :data:`~vimpact.sweep.spec.CHUNK_SIZE_FILE` in ``parts`` (a run of the same
+    sweep hash and rows), else from the metadata of a part of this sweep.
+    """
+    import json
+
+    import pyarrow.parquet as pq
+
+    try:
+        record = json.loads((Path(parts) / CHUNK_SIZE_FILE).read_text())
+        if record.get("sweep_hash") == spec.sweep_hash and record.get("rows") == spec.rows:
+            return int(record["chunk_size"])
+    except (OSError, ValueError, TypeError, KeyError, AttributeError):
+        pass
+    for part in sorted(Path(parts).glob("part-*.parquet")) if Path(parts).is_dir() else ():
+        try:
+            meta = decode_metadata(pq.read_schema(part).metadata)
+        except Exception:  # noqa: BLE001 - a damaged part: existing_parts reports it
+            continue
+        if meta.get("sweep_hash") == spec.sweep_hash and isinstance(meta.get("chunk_size"), int):
+            return int(meta["chunk_size"])
+    return None
+
+
+def _record_chunk_size(parts: Path, record: dict) -> int:
+    """Store ``record`` as ``parts/CHUNK_SIZE_FILE`` unless a run got there first.
+
+    Shards start side by side: the first record stays. Returns the chunk size in the
+    file either way.
+    """
+    import json
+
+    parts.mkdir(parents=True, exist_ok=True)
+    final = parts / CHUNK_SIZE_FILE
+    tmp = parts / f".{CHUNK_SIZE_FILE}.{socket.gethostname()}.{os.getpid()}.tmp"
+    with open(tmp, "w") as f:
+        json.dump(record, f)
+        f.flush()
+        os.fsync(f.fileno())
+    try:
+        os.link(tmp, final)  # atomic, and never over a file another run wrote
+        store.fsync_dir(parts)
+    except FileExistsError:
+        return int(json.loads(final.read_text())["chunk_size"])
+    finally:
+        tmp.unlink()
+    return int(record["chunk_size"])
+
+
+def chunked(spec: SweepSpec, parts: Path, choose: bool = True, units: int = 1,
+            log: Callable[[str], None] | None = None) -> SweepSpec:
+    """Return ``spec`` with the chunk size its chunks are made with.
+
+    A spec that sets ``chunk_size`` (or a random one, whose draws depend on it) as it
+    is; a grid without: the size an earlier run of the sweep recorded in ``parts``
+    (:func:`recorded_chunk_size`), else, if ``choose``, one chosen now
+    (:func:`choose_chunk_size`) and recorded before any chunk is made, so that
+    ``--resume``, shards and ``--combine`` cut the same chunks.
+    """
+    if not spec.chooses_chunk_size:
+        return spec
+    size = recorded_chunk_size(spec, parts)
+    if size is None:
+        if not choose:
+            return spec
+        record = {**choose_chunk_size(spec, units), "sweep_hash": spec.sweep_hash,
+                  "rows": spec.rows}
+        size = _record_chunk_size(parts, record)
+        if log is not None:
+            log(f"{size} rows per chunk, chosen from {record['seconds_per_row'] * 1e6:.3g} us "
+                f"per row measured (about {AUTO_CHUNK_SECONDS:g} s of work per chunk at most; "
+                "chunk_size in the spec sets it)")
+    return dataclasses.replace(spec, chunk_size=size)
+
+
+#: Seconds to start a local Dask cluster of two workers and have them load the kernels,
+#: about: ``vimpact bench sweep_backends`` measures it (``cluster_ready_s``: 2.3 s on 2
+#: cores, the start alone 1.0 s quiet and 2.2 s under load)
+CLUSTER_START_SECONDS = 3.0
+
+
+def small_for_cluster(spec: SweepSpec, todo: list[int], workers: int) -> str | None:
+    """Return why ``--workers`` does not pay for ``todo``, or ``None`` when it may.
+
+    A sweep whose chunks take less time in process (:func:`seconds_per_row` on all
+    threads) than starting a cluster (:data:`CLUSTER_START_SECONDS`) finishes sooner
+    without one.
+    """
+    cost, _ = seconds_per_row(spec, probe_chunks=4)
+    rows = sum(spec.chunk_rows(c)[1] - spec.chunk_rows(c)[0] for c in todo)
+    work = cost * rows
+    if work >= CLUSTER_START_SECONDS:
+        return None
+    return (f"--workers {workers}: this sweep ({rows} rows, about {work:.2g} s of work in "
+            f"process) is too small to pay for starting a cluster (about "
+            f"{CLUSTER_START_SECONDS:g} s); without --workers it runs sooner")
 
 
 def warm_kernels(spec: SweepSpec, rows_per_chunk: int = 2, chunks: int = 4) -> None:
@@ -667,6 +852,7 @@ def _run_dask(spec, todo, parts, bar, done, workers, scheduler) -> None:
             cluster.close()
 
 
-__all__ = ["PLAIN", "SweepInterrupted", "SweepStages", "check_workers", "chunk_summary",
-           "compute_chunk", "connect_scheduler", "explain_paths", "guard_nan", "local_cluster",
-           "max_local_workers", "run_chunk", "run_sweep", "warm_kernels"]
+__all__ = ["PLAIN", "SweepInterrupted", "SweepStages", "check_workers", "choose_chunk_size",
+           "chunk_summary", "chunked", "compute_chunk", "connect_scheduler", "explain_paths",
+           "guard_nan", "local_cluster", "max_local_workers", "recorded_chunk_size",
+           "run_chunk", "run_sweep", "seconds_per_row", "small_for_cluster", "warm_kernels"]

@@ -20,8 +20,8 @@ parameters)::
     nu = [0.0, 0.1, 0.2, 0.3, 0.4, 0.5]
 
 Top-level keys: ``model`` (required), ``description``, ``seed``,
-``chunk_size`` (default 64; at most :data:`MAX_CHUNK_SIZE` rows, and at most
-:data:`MAX_CHUNKS` chunks per sweep), ``output`` (default: the spec's name with
+``chunk_size`` (at most :data:`MAX_CHUNK_SIZE` rows, and at most
+:data:`MAX_CHUNKS` chunks per sweep; default below), ``output`` (default: the spec's name with
 ``.parquet`` beside it), ``layout``, ``tangential_memory``, ``tangential``,
 ``rotation``, ``numerics`` (a table, or a preset name as a string) and exactly
 one of ``[random]`` or ``[grid]``. Unknown keys and bad values are errors
@@ -97,6 +97,17 @@ otherwise; ``log`` overrides that (``log = true`` needs ``lo > 0``).
 Draws are not checked against the physics: a drawn combination that is not a
 valid scene becomes a row with status ``invalid`` and the reason in the
 ``error`` column.
+
+Chunk size when the spec sets none: a grid's rows do not depend on the chunking, so
+the runner chooses it from the measured cost of the rows
+(:func:`vimpact.sweep.runner.choose_chunk_size`: about :data:`AUTO_CHUNK_SECONDS` of
+work per chunk, :data:`AUTO_CHUNK_ROWS` rows at least and at most), once per sweep,
+before the first chunk, and records it in the parts directory
+(:data:`CHUNK_SIZE_FILE`) so that ``--resume``, shards and ``--combine`` use the same
+chunks; the table's metadata ``chunk_size`` holds it. Random draws are made per chunk
+(below), so a random spec without ``chunk_size`` keeps :data:`DEFAULT_CHUNK_SIZE` (64)
+and its rows stay those of earlier versions; set ``chunk_size`` (e.g. 10000) for a
+faster random sweep, knowing it draws other rows.
 
 Random draws per chunk (schema version 3): the rows of chunk ``c`` are drawn
 from ``numpy.random.default_rng(SeedSequence(seed, spawn_key=(c,)))``, each key
@@ -175,7 +186,16 @@ from vimpact.tableformat.schema import (
     SWEEP_STATUSES,
 )
 
+#: Rows per chunk of a random spec without ``chunk_size`` (its draws are made per chunk),
+#: and of a grid spec until the runner has chosen its size.
 DEFAULT_CHUNK_SIZE = 64
+#: Work per chunk the runner aims at when a grid spec sets no ``chunk_size``, s (a
+#: chunk's fixed costs, a parallel launch and a part file, are then a few percent).
+AUTO_CHUNK_SECONDS = 1.0
+#: Rows per chunk the runner chooses at least and at most (memory: about a kilobyte a row).
+AUTO_CHUNK_ROWS = (16, 100_000)
+#: File in the parts directory that records the chunk size the runner chose (JSON).
+CHUNK_SIZE_FILE = "_chunk_size.json"
 #: Rows of one sweep at most (a grid axis has at most as many points).
 MAX_ROWS = 10**12
 #: Chunks (part files) of one sweep at most: the runners list the chunks to do and the
@@ -390,6 +410,8 @@ class SweepSpec:
     grid_levels : grid mode, adaptive: ``([grid] min_level, [grid] max_level)``, the
         level of the uniform start and of the finest cell (a cell of level ``L`` spans
         ``1 / 2**L`` of each adaptive axis's range in log)
+    chunk_size_given : the spec sets ``chunk_size``; if not, a grid's runner chooses it
+        (module docstring) and ``chunk_size`` is :data:`DEFAULT_CHUNK_SIZE` until then
     """
 
     path: Path
@@ -415,6 +437,12 @@ class SweepSpec:
     grid_refine: str = "tensor"
     grid_levels: tuple[int, int] = (ADAPTIVE_LEVELS[0], ADAPTIVE_LEVELS[1])
     grid_psi_nodes: tuple[int, int] | None = None
+    chunk_size_given: bool = True
+
+    @property
+    def chooses_chunk_size(self) -> bool:
+        """Whether the runner chooses the chunk size (a grid spec without ``chunk_size``)."""
+        return not self.chunk_size_given and self.mode == "grid"
 
     @property
     def n_chunks(self) -> int:
@@ -684,7 +712,7 @@ def load_spec(path) -> SweepSpec:
                      layout=layout, grid_tolerance=grid_tolerance,
                      grid_mu=grid_mu, material_text=material_text,
                      grid_refine=grid_refine, grid_levels=(grid_levels[0], grid_levels[1]),
-                     grid_psi_nodes=psi_nodes)
+                     grid_psi_nodes=psi_nodes, chunk_size_given="chunk_size" in data)
 
 
 def _random(spec: TomlSource, model: str, table) -> tuple[dict, tuple, int]:
