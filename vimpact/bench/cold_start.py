@@ -26,6 +26,7 @@ import sys
 import tempfile
 import time
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -47,7 +48,7 @@ COMMANDS = {
               "--nu", "0.4", "--R", "0.01", "--m", "0.03", "--vz0", "1", "--vx0", "0.5"],
     "sweep": ["sweep", "{spec}", "--out", "{out}"],
 }
-CONFIGS = {"full": dict(commands=list(COMMANDS), repeats=1),
+CONFIGS: dict[str, dict[str, Any]] = {"full": dict(commands=list(COMMANDS), repeats=1),
            "quick": dict(commands=["readme"], repeats=1)}
 
 
@@ -75,7 +76,7 @@ def run(quick: bool = False) -> dict:
         spec = Path(tmp) / "cold_start_sweep.toml"
         spec.write_text(SWEEP_SPEC)
         for name in cfg["commands"]:
-            rec = {"args": COMMANDS[name], "cold": [], "warm": []}
+            rec: dict = {"args": COMMANDS[name], "cold": [], "warm": []}
             for k in range(cfg["repeats"]):
                 cache = Path(tmp) / f"cache_{name}_{k}"
                 cache.mkdir()
@@ -110,6 +111,7 @@ def figures(data: dict) -> dict:
 
 
 def report(data: dict) -> str:
+    """Return the cold and warm times of every command as a text table (s)."""
     lines = [f"{'command':<10}{'cold wall s':>12}{'cold CPU s':>12}{'warm wall s':>13}"
              f"{'warm CPU s':>12}  target {data['target_wall_s']:g} s wall",
              ]

@@ -43,8 +43,11 @@ PSI_FULL_STICK = 1e-12
 
 
 def friction_rows(cols: SceneColumns) -> np.ndarray:
-    """Rows whose Coulomb friction the kernels must model: a tangential problem, a
-    finite ``mu`` and an incidence ``psi`` of at least :data:`PSI_FULL_STICK`."""
+    """Return the rows whose Coulomb friction the kernels must model, bool.
+
+    Those with a tangential problem, a finite ``mu`` and an incidence ``psi`` of at
+    least :data:`PSI_FULL_STICK`.
+    """
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         psi = cols.kappa / cols.mu * np.abs(cols.v_c0) / cols.v_z0  # kappa = 2(1-nu)/(2-nu)
     return cols.computes_tangential & np.isfinite(cols.mu) & (psi >= PSI_FULL_STICK)
@@ -120,7 +123,7 @@ class Routes:
 
 
 def route(cols: SceneColumns, numerics: Numerics) -> Routes:
-    """The cheapest kernel for every row of ``cols`` (vectorized; the one routing rule)."""
+    """Return the cheapest kernel for every row of ``cols`` (vectorized; the one routing rule)."""
     if len(cols) == 1:
         return _route_row(cols, numerics)
     valid = cols.valid
@@ -179,8 +182,11 @@ def _route_row(cols: SceneColumns, numerics: Numerics) -> Routes:
 
 
 def _path_of_key(key: int, integrator: int) -> Path:
-    """The path of a routing key of :func:`route` (``kind << 5`` for a continuum kernel,
-    else the effect bits of the element kernel)."""
+    """Return the path of a routing key of :func:`route`.
+
+    The key is ``kind << 5`` for a continuum kernel, else the effect bits of the
+    element kernel.
+    """
     if key >> 5 == 1:
         return CONTINUUM_KV
     if key >> 5 == 2:
@@ -190,18 +196,21 @@ def _path_of_key(key: int, integrator: int) -> Path:
 
 @functools.cache
 def _element_path(integrator: int, key: int) -> Path:
-    """The element path of a routing key of :func:`route` (made once per key: a few dozen)."""
+    """Return the element path of a routing key of :func:`route` (made once per key)."""
     return Path(ELEMENTS, KernelSpec(integrator, bool(key >> 4 & 1), int(key >> 3 & 1),
                                      bool(key >> 2 & 1), bool(key >> 1 & 1), bool(key & 1)), ())
 
 
 def continuum_stick(cols: SceneColumns, numerics: Numerics, friction: np.ndarray) -> np.ndarray:
-    """Rows the full-stick continuum kernel can take: continuum allowed, no
-    friction (``friction``: :func:`friction_rows`, as :func:`route` has it),
-    incremental memory (or no tangential problem), whatever the arms (it updates
-    each arm exactly over a step, docs/physics.md#arms-of-any-relaxation-time). Its
-    run-time assumptions (one contact interval, no re-entry) are checked by the
-    kernel, which hands a row back otherwise."""
+    """Return the rows the full-stick continuum kernel can take, bool.
+
+    Those with the continuum allowed, no friction (``friction``: :func:`friction_rows`,
+    as :func:`route` has it), incremental memory (or no tangential problem), whatever
+    the arms (it updates each arm exactly over a step,
+    docs/physics.md#arms-of-any-relaxation-time). Its run-time assumptions (one
+    contact interval, no re-entry) are checked by the kernel, which hands a row back
+    otherwise.
+    """
     tangential = cols.computes_tangential
     incremental = cols.memory == TANGENTIAL_MEMORY.index("incremental")
     return numerics.continuum & cols.valid & ~friction & (incremental | ~tangential)
@@ -215,8 +224,10 @@ def handover_reason(status: int) -> str:
 
 
 def choose_path(scene: Scene, numerics: Numerics) -> Path:
-    """The kernel :func:`route` picks for ``scene``, with the reasons in words
-    (an adhesive scene: the adhesive kernel, which :func:`vimpact.simulate` runs)."""
+    """Return the kernel :func:`route` picks for ``scene``, with the reasons in words.
+
+    An adhesive scene gets the adhesive kernel, which :func:`vimpact.simulate` runs.
+    """
     if scene.adhesion > 0.0:
         return Path(ADHESION, None, (
             f"work of adhesion {scene.adhesion:g} J/m^2: adhesive normal impact on the MDR "
@@ -289,8 +300,11 @@ def choose_path(scene: Scene, numerics: Numerics) -> Path:
 
 
 def refinement(scene: Scene, numerics: Numerics, spec: KernelSpec) -> tuple[float, float]:
-    """:func:`vimpact.engine.discretization.refinement` of one scene on the kernel ``spec``
-    (time-step and element-spacing factors, >= 1)."""
+    """Return the time-step and element-spacing factors (>= 1) of one scene on ``spec``.
+
+    :func:`vimpact.engine.discretization.refinement` of the one-row columns of
+    ``scene`` on the kernel ``spec``.
+    """
     cols = SceneColumns.from_scenes([scene])
     ft, fe = discretization.refinement(cols, numerics, np.array([bool(spec.tangential)]),
                                        spec.integrator)

@@ -151,8 +151,10 @@ def adaptive_eval(points, k, lo, hi, child, leaf_of, leaf_nodes, tnodes, values,
 
 @jit(inline="always")
 def _hyman_slope(x, y, i, first, last):
-    """Slope at node ``i`` of the shape-preserving cubic Hermite interpolant of ``y(x)`` on
-    the nodes ``first .. last`` (one segment between two kinks; nothing across them).
+    """Return the slope at node ``i`` of the shape-preserving cubic through ``y(x)``.
+
+    The cubic Hermite interpolant on the nodes ``first .. last`` (one segment between
+    two kinks; nothing across them).
 
     The three-point (parabola) slope, third-order accurate; where the nodes are monotone
     over the two intervals on each side of ``i`` it is limited to ``3 min(|s_left|,
@@ -205,10 +207,12 @@ def _hyman_slope(x, y, i, first, last):
 
 @jit(inline="always")
 def hyman_eval(x, y, kinks, xq):
-    """Shape-preserving cubic Hermite interpolant of ``y(x)`` at ``xq`` (see
-    :func:`_hyman_slope`); ``kinks`` are the node indices where the curve may have a
+    """Return the shape-preserving cubic Hermite interpolant of ``y(x)`` at ``xq``.
+
+    See :func:`_hyman_slope`. ``kinks`` are the node indices where the curve may have a
     kink (the first and last node included): each segment between two is interpolated
-    on its own. ``xq`` is clamped to ``[x[0], x[-1]]``."""
+    on its own. ``xq`` is clamped to ``[x[0], x[-1]]``.
+    """
     n = x.shape[0]
     if xq <= x[0]:
         return y[0]

@@ -152,7 +152,7 @@ def _contact_energy(u, v, n_c, w, q, g, k_el, xi2, ARMS):
 
 @jit()
 def _cannot_separate(u, v, n_c, touched, w, q, g, G, c0, k_el, xi2, sqrt_xi, lam, ARMS):
-    """True if the contact ``[0, n_c)`` provably never changes again (the sphere sticks).
+    """Return True if the contact ``[0, n_c)`` provably never changes again (the sphere sticks).
 
     Holding the contact set fixed, the motion is linear and passive, so its energy
     ``V`` (:func:`_contact_energy`) never grows: ``|u - u_eq| <= sqrt(2 V / K)``,
