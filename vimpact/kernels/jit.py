@@ -11,9 +11,11 @@ before numba starts them.
 
 from __future__ import annotations
 
+from typing import Literal
+
 import numba
 
 
-def jit(parallel: bool = False, inline: str = "never"):
+def jit(parallel: bool = False, inline: Literal["never", "always"] = "never"):
     """Return the decorator that compiles one of the package's numba kernels."""
     return numba.njit(cache=True, error_model="numpy", parallel=parallel, inline=inline)
