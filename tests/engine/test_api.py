@@ -39,6 +39,18 @@ def test_single_impact_half_space_is_an_error_batch_is_a_status():
     assert df.e_z[0] == df.e_z[2]
 
 
+def test_error_column_has_one_dtype_whether_or_not_a_row_failed():
+    def batch(G_inf):
+        return v.simulate_batch({"G_inf_Pa": G_inf, "nu": [0.3, 0.3], "eta0_Pa_s": [10.0, 10.0],
+                                 "R_m": [0.01, 0.01], "m_kg": [0.01, 0.01],
+                                 "v_z0_m_s": [1.0, 1.0]}, v.Numerics.preset("fast"))
+
+    clean, mixed = batch([1e6, 2e6]), batch([1e6, -1.0])
+    assert clean["error"].dtype == mixed["error"].dtype == "str"
+    assert clean["error"].isna().all()
+    assert mixed["error"].isna().tolist() == [True, False] and "G_inf" in mixed["error"][1]
+
+
 def test_time_limit_is_a_status_not_a_hang():
     # the time limit is the element path's (the continuum paths bound their steps)
     df = v.simulate_batch([v.Scene.from_dimensionless(0.1, 0.5)],

@@ -92,6 +92,7 @@ def simulate_pair_batch(pairs: Sequence[tuple[Body, Body | Wall]], numerics=None
             rows[i].update(zip(("v_z1", "v_x1", "omega1", "v_z2", "v_x2", "omega2", "J_z",
                                 "J_x"), (*end1, *end2, J_z, J_x)))
     out = pd.DataFrame(rows, columns=columns)
+    out["error"] = out["error"].astype("str")  # as simulate_batch's: missing when none
     return out.rename(columns={"t_contact": "t_contact_s"})
 
 

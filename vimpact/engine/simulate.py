@@ -224,7 +224,8 @@ def simulate_batch(scenes, numerics: Numerics | str | None = None, *,
         (units in :data:`vimpact.UNITS`) and ``error``. A row that fails (bad input:
         status ``invalid`` with the reason in ``error``; half-space exceeded, time
         limit, ...) gets its status and NaN outputs; the others are unaffected.
-        Nothing is raised for a bad row.
+        Nothing is raised for a bad row. ``error`` has pandas' string dtype; a row
+        without an error has a missing value there (``isna`` is True).
     """
     t0 = time.perf_counter()
     numerics = _numerics(numerics)
@@ -234,6 +235,8 @@ def simulate_batch(scenes, numerics: Numerics | str | None = None, *,
     else:
         result, _, _ = run_columns(cols, numerics, timings=timings)
         frame = pd.DataFrame(result, copy=False)
+    # one dtype whether or not a row failed (pandas infers object for all-None)
+    frame["error"] = frame["error"].astype("str")
     if timings is not None:
         timings["total_s"] = timings.get("total_s", 0.0) + time.perf_counter() - t0
     return frame
