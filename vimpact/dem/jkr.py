@@ -20,6 +20,21 @@ over the given speeds, sticking counted as ``e_z = 0``; the residual is
 reported as it is. LAMMPS' wall mixes ``E`` as a body of the same material
 (``E* = E / (2 (1 - nu^2))``, :mod:`vimpact.dem.lammps`), so the exported ``E`` is
 ``2 (1 - nu^2) E*``.
+
+A pair (``pair_coeff i j jkr ...``) is the same law with the pair's effective
+radius ``R1 R2 / (R1 + R2)`` and mass ``m1 m2 / (m1 + m2)`` in place of ``R``
+and ``m`` (:meth:`JkrLaw.pair`): LAMMPS' ``jkr`` builds the contact radius, the
+force, the pull-off distance and the damping ``eta_n0 a m_eff`` from ``R_eff``
+and ``m_eff``, and mixes ``E`` of a ``pair_coeff`` line by the same
+``E / (2 (1 - nu^2))`` as a wall; vimpact's pair is the sphere of ``R_eff``,
+``m_eff`` on the halved half-space of the pair (:mod:`vimpact.model.pair`), the
+target the pair line is fitted to.
+
+Tangential: LAMMPS' ``jkr`` caps the tangential force at ``mu_s |F_ne + 2
+F_pulloff|`` with ``F_ne`` the elastic JKR force (no damping) and ``F_pulloff =
+3 pi cohesion R_eff``; its non-adhesive models cap at ``mu_s |F_n|`` with the
+damping included. The exported tangential constants are fitted with the
+non-adhesive cap (:mod:`vimpact.dem.lammps`), not with this one.
 """
 
 from __future__ import annotations
@@ -57,6 +72,18 @@ class JkrLaw:
     m: float
     cohesion: float
     eta_n0: float
+
+    @classmethod
+    def pair(cls, E_star: float, R1: float, m1: float, R2: float, m2: float, cohesion: float,
+             eta_n0: float) -> JkrLaw:
+        """Return the law of a ``pair_coeff`` contact of two spheres.
+
+        Radii ``R1``, ``R2`` (m) and masses ``m1``, ``m2`` (kg) enter as the effective
+        radius ``R1 R2 / (R1 + R2)`` and mass ``m1 m2 / (m1 + m2)``; ``E_star`` (Pa) is
+        the pair's effective modulus, ``cohesion`` (J/m^2) and ``eta_n0`` (1/(m s)) as
+        in the line.
+        """
+        return cls(E_star, R1 * R2 / (R1 + R2), m1 * m2 / (m1 + m2), cohesion, eta_n0)
 
     @property
     def pulloff(self) -> float:
@@ -220,14 +247,36 @@ def lammps_restitution(fit: JkrFit, v: float, steps_per_contact: int = 4000) -> 
 
     0 if the sphere is still in contact at the end.
     """
-    from vimpact.dem.lammps import collision_script, run_lammps
-
     L = fit.law
     rho = L.m / (4.0 / 3.0 * math.pi * L.R**3)
-    t_c = 5.0 * (L.m**2 / (L.E_star**2 * L.R * v)) ** 0.2
-    script = collision_script(fit.coeffs(), L.R, rho, v, t_c, steps_per_contact=steps_per_contact)
-    script = script.replace("variable v2 equal 0.0", "variable v2 equal z[1]")
-    v1, z1 = run_lammps(script, ["v1", "v2"])
-    if L.R - z1 > L.pulloff:  # overlap above the pull-off distance: still in contact
-        return 0.0
-    return v1 / v
+    return lammps_jkr_restitution(fit.coeffs(), L, L.R, rho, v,
+                                  steps_per_contact=steps_per_contact)
+
+
+def lammps_jkr_restitution(coeffs: str, law: JkrLaw, R1: float, rho1: float, v: float, *,
+                           R2: float | None = None, rho2: float | None = None,
+                           steps_per_contact: int = 4000) -> float:
+    """Run one head-on ``jkr`` collision in LAMMPS; return its ``e_z`` (0 if it stuck).
+
+    Sphere 1 (radius ``R1``, m; density ``rho1``, kg/m^3) hits a wall (``R2`` None) or
+    a second sphere (``R2``, ``rho2``; equal and opposite momenta) at approach speed
+    ``v`` (m/s), with the model text ``coeffs`` (``jkr ...``) as the ``pair_coeff`` and
+    the wall's. ``law`` (the contact's :class:`JkrLaw`, with the pair's effective
+    radius and mass for a pair) sets the time step (``steps_per_contact`` per five
+    Hertz time scales) and the pull-off distance: the collision stuck when the overlap
+    at the end is above it.
+    """
+    from vimpact.dem.lammps import collision_script, run_lammps
+
+    t_c = 5.0 * (law.m**2 / (law.E_star**2 * law.R * v)) ** 0.2
+    script = collision_script(coeffs, R1, rho1, v, t_c, R2=R2, rho2=rho2,
+                              steps_per_contact=steps_per_contact)
+    names = ["v1", "v2", "z1", "z2"]
+    script += ("variable z1 equal z[1]\n"
+               + ("variable z2 equal 0.0\n" if R2 is None else "variable z2 equal z[2]\n"))
+    v1, v2, z1, z2 = run_lammps(script, names)
+    if R2 is None:
+        overlap, e = R1 - z1, v1 / v
+    else:
+        overlap, e = R1 + R2 - (z2 - z1), (v2 - v1) / v
+    return 0.0 if overlap > law.pulloff else e
