@@ -401,12 +401,14 @@ def run_lammps(script: str, variables: list[str], timeout: float = 120.0) -> lis
 
 def collision_script(coeffs: str, R1: float, rho1: float, v: float, t_contact: float, *,
                      R2: float | None = None, rho2: float | None = None,
-                     steps_per_contact: int = 4000) -> str:
+                     steps_per_contact: int = 4000, v_t: float = 0.0) -> str:
     """Return a LAMMPS input of one head-on collision.
 
     Type 1 (radius ``R1``, m; density ``rho1``, kg/m^3) hits a wall (``R2`` None) or
     a type-2 sphere at relative speed ``v`` (m/s); ``t_contact`` (s) sets the time
-    step. Defines the variables ``v1``, ``v2`` (z velocities after, m/s).
+    step. Defines the variables ``v1``, ``v2`` (z velocities after, m/s). ``v_t``
+    (m/s, wall only): the sphere also moves along ``x`` at that speed (an oblique
+    impact without spin); ``vx1`` is its ``x`` velocity after.
     """
     dt = t_contact / steps_per_contact
     gap = 0.02 * R1
@@ -419,11 +421,15 @@ def collision_script(coeffs: str, R1: float, rho1: float, v: float, t_contact: f
     if R2 is None:
         lines += [f"create_atoms 1 single 0 0 {R1 + gap:.12g}",
                   f"set atom 1 diameter {2 * R1:.12g} density {rho1:.12g}",
-                  f"velocity all set 0 0 {-v:.12g}",
+                  f"velocity all set {v_t:.12g} 0 {-v:.12g}",
                   f"pair_coeff * * {coeffs}",
                   f"fix w all wall/gran granular {coeffs} zplane 0.0 NULL",
-                  "variable v1 equal vz[1]", "variable v2 equal 0.0"]
+                  "variable v1 equal vz[1]", "variable v2 equal 0.0",
+                  "variable vx1 equal vx[1]"]
     else:
+        if v_t != 0.0:
+            raise ValueError(f"v_t = {v_t!r} is not allowed for a pair: only a wall impact "
+                             "is oblique here (v_t = 0)")
         lines += [f"create_atoms 1 single 0 0 {-(R1 + gap / 2):.12g}",
                   f"create_atoms 2 single 0 0 {R2 + gap / 2:.12g}",
                   f"set atom 1 diameter {2 * R1:.12g} density {rho1:.12g}",
