@@ -57,7 +57,7 @@ PULLOFF_PREFIX = (3.0 * math.pi**2 / 16.0) ** (1.0 / 3.0)
 
 @dataclass(frozen=True)
 class JkrLaw:
-    """LAMMPS' ``jkr`` law for one sphere on a wall (SI units).
+    """LAMMPS' ``jkr`` law for one sphere on a wall (SI units); a pair: :meth:`pair`.
 
     Attributes
     ----------
