@@ -98,3 +98,40 @@ def test_jkr_lines_run_in_lammps_as_the_report_predicts(tmp_path, capsys):
             assert R - z1 > law.pulloff  # still in contact
         else:
             assert v1 / v == pytest.approx(law.restitution(v), abs=2e-3)
+
+
+@pytest.mark.slow
+def test_jkr_pair_line_runs_in_lammps_as_the_report_predicts(tmp_path):
+    """The pair line written for an adhesive sphere pair (``"a-a"``), run in LAMMPS head on
+    with two equal spheres: the e_z of the law with the pair's effective radius R/2 and mass
+    m/2 above its sticking velocity, sticking below it, and vimpact's pair e_z to the
+    report's residual."""
+    from vimpact.dem.export import export
+    from vimpact.dem.jkr import lammps_jkr_restitution
+
+    problem = problem_from_toml(TOML.replace('"a-floor" = 0.5', '"a-a" = 0.5'), "pair")
+    ex = export(problem, "lammps", out_dir=tmp_path)
+    f = next(f for f in ex.fits if f.contact.key == "a-a")
+    t = ex.targets["a-a"]
+    p = f.params
+    assert f.res_e_z.max_abs < 0.03  # measured 7.5e-3 on these 4 speeds
+    text = (tmp_path / "lammps_pair.in").read_text()
+    coeffs = re.search(r"pair_coeff 1 1 (jkr .*?)   #", text).group(1)
+    why = lammps.lammps_available()
+    if why is not None:
+        pytest.skip(f"LAMMPS: {why}")
+    R, rho = 0.01, 955.0
+    m = rho * 4.0 / 3.0 * math.pi * R**3
+    E_star = p["E_jkr_Pa"] / (2.0 * (1.0 - p["nu"] ** 2))
+    assert E_star == pytest.approx(f.contact.E_star, rel=1e-9)  # the pair's, half the wall's
+    law = JkrLaw.pair(E_star, R, m, R, m, p["cohesion"], p["eta_n0"])
+    for v, e_vimpact in zip(t.v, t.e_z):
+        e = lammps_jkr_restitution(coeffs, law, R, rho, float(v), R2=R, rho2=rho)
+        # measured: LAMMPS - law at most 2.8e-4, LAMMPS - vimpact at most 7.5e-3
+        assert e == pytest.approx(law.restitution(float(v)), abs=2e-3)
+        assert e == pytest.approx(e_vimpact, abs=0.03)
+    v_stick = p["v_stick_lammps_m_s"]
+    assert 0.5 < v_stick / p["v_stick_vimpact_m_s"] < 1.5
+    assert lammps_jkr_restitution(coeffs, law, R, rho, 0.7 * v_stick, R2=R, rho2=rho) == 0.0
+    e = lammps_jkr_restitution(coeffs, law, R, rho, 1.3 * v_stick, R2=R, rho2=rho)
+    assert e == pytest.approx(law.restitution(1.3 * v_stick), abs=2e-3) and e > 0.3

@@ -20,6 +20,21 @@ over the given speeds, sticking counted as ``e_z = 0``; the residual is
 reported as it is. LAMMPS' wall mixes ``E`` as a body of the same material
 (``E* = E / (2 (1 - nu^2))``, :mod:`vimpact.dem.lammps`), so the exported ``E`` is
 ``2 (1 - nu^2) E*``.
+
+A pair (``pair_coeff i j jkr ...``) is the same law with the pair's effective
+radius ``R1 R2 / (R1 + R2)`` and mass ``m1 m2 / (m1 + m2)`` in place of ``R``
+and ``m`` (:meth:`JkrLaw.pair`): LAMMPS' ``jkr`` builds the contact radius, the
+force, the pull-off distance and the damping ``eta_n0 a m_eff`` from ``R_eff``
+and ``m_eff``, and mixes ``E`` of a ``pair_coeff`` line by the same
+``E / (2 (1 - nu^2))`` as a wall; vimpact's pair is the sphere of ``R_eff``,
+``m_eff`` on the halved half-space of the pair (:mod:`vimpact.model.pair`), the
+target the pair line is fitted to.
+
+Tangential: LAMMPS' ``jkr`` caps the tangential force at ``mu_s |F_ne + 2
+F_pulloff|`` with ``F_ne`` the elastic JKR force (no damping) and ``F_pulloff =
+3 pi cohesion R_eff``; its non-adhesive models cap at ``mu_s |F_n|`` with the
+damping included. The exported tangential constants are fitted with the
+non-adhesive cap (:mod:`vimpact.dem.lammps`), not with this one.
 """
 
 from __future__ import annotations
@@ -42,7 +57,7 @@ PULLOFF_PREFIX = (3.0 * math.pi**2 / 16.0) ** (1.0 / 3.0)
 
 @dataclass(frozen=True)
 class JkrLaw:
-    """LAMMPS' ``jkr`` law for one sphere on a wall (SI units).
+    """LAMMPS' ``jkr`` law for one sphere on a wall (SI units); a pair: :meth:`pair`.
 
     Attributes
     ----------
@@ -57,6 +72,18 @@ class JkrLaw:
     m: float
     cohesion: float
     eta_n0: float
+
+    @classmethod
+    def pair(cls, E_star: float, R1: float, m1: float, R2: float, m2: float, cohesion: float,
+             eta_n0: float) -> JkrLaw:
+        """Return the law of a ``pair_coeff`` contact of two spheres.
+
+        Radii ``R1``, ``R2`` (m) and masses ``m1``, ``m2`` (kg) enter as the effective
+        radius ``R1 R2 / (R1 + R2)`` and mass ``m1 m2 / (m1 + m2)``; ``E_star`` (Pa) is
+        the pair's effective modulus, ``cohesion`` (J/m^2) and ``eta_n0`` (1/(m s)) as
+        in the line.
+        """
+        return cls(E_star, R1 * R2 / (R1 + R2), m1 * m2 / (m1 + m2), cohesion, eta_n0)
 
     @property
     def pulloff(self) -> float:
@@ -220,14 +247,132 @@ def lammps_restitution(fit: JkrFit, v: float, steps_per_contact: int = 4000) -> 
 
     0 if the sphere is still in contact at the end.
     """
-    from vimpact.dem.lammps import collision_script, run_lammps
-
     L = fit.law
     rho = L.m / (4.0 / 3.0 * math.pi * L.R**3)
-    t_c = 5.0 * (L.m**2 / (L.E_star**2 * L.R * v)) ** 0.2
-    script = collision_script(fit.coeffs(), L.R, rho, v, t_c, steps_per_contact=steps_per_contact)
-    script = script.replace("variable v2 equal 0.0", "variable v2 equal z[1]")
-    v1, z1 = run_lammps(script, ["v1", "v2"])
-    if L.R - z1 > L.pulloff:  # overlap above the pull-off distance: still in contact
-        return 0.0
-    return v1 / v
+    return lammps_jkr_restitution(fit.coeffs(), L, L.R, rho, v,
+                                  steps_per_contact=steps_per_contact)
+
+
+def lammps_jkr_restitution(coeffs: str, law: JkrLaw, R1: float, rho1: float, v: float, *,
+                           R2: float | None = None, rho2: float | None = None,
+                           steps_per_contact: int = 4000) -> float:
+    """Run one head-on ``jkr`` collision in LAMMPS; return its ``e_z`` (0 if it stuck).
+
+    Sphere 1 (radius ``R1``, m; density ``rho1``, kg/m^3) hits a wall (``R2`` None) or
+    a second sphere (``R2``, ``rho2``; equal and opposite momenta) at approach speed
+    ``v`` (m/s), with the model text ``coeffs`` (``jkr ...``) as the ``pair_coeff`` and
+    the wall's. ``law`` (the contact's :class:`JkrLaw`, with the pair's effective
+    radius and mass for a pair) sets the time step (``steps_per_contact`` per five
+    Hertz time scales) and the pull-off distance: the collision stuck when the overlap
+    at the end is above it.
+    """
+    from vimpact.dem.lammps import collision_script, run_lammps
+
+    t_c = 5.0 * (law.m**2 / (law.E_star**2 * law.R * v)) ** 0.2
+    script = collision_script(coeffs, R1, rho1, v, t_c, R2=R2, rho2=rho2,
+                              steps_per_contact=steps_per_contact)
+    names = ["v1", "v2", "z1", "z2"]
+    script += ("variable z1 equal z[1]\n"
+               + ("variable z2 equal 0.0\n" if R2 is None else "variable z2 equal z[2]\n"))
+    v1, v2, z1, z2 = run_lammps(script, names)
+    if R2 is None:
+        overlap, e = R1 - z1, v1 / v
+    else:
+        overlap, e = R1 + R2 - (z2 - z1), (v2 - v1) / v
+    return 0.0 if overlap > law.pulloff else e
+
+
+#: the caps of the tangential force :func:`oblique_wall_impact` can apply: LAMMPS' ``jkr``
+#: one and the clipped normal force the non-adhesive models (and the tangential fit) use
+TANGENTIAL_CAPS = ("jkr", "clipped")
+
+
+def oblique_wall_impact(law: JkrLaw, k_t: float, x_gamma_t: float, mu_s: float, v: float,
+                        angle_deg: float, *, cap: str = "jkr", steps_per_contact: int = 2000,
+                        F: float = 3.5) -> tuple[float, float]:
+    """Step LAMMPS' ``jkr ... tangential mindlin k_t x_gamma_t mu_s`` oblique wall impact.
+
+    A sphere without spin arrives at normal speed ``v`` (m/s), ``angle_deg`` from the
+    normal (tangential speed ``v tan(angle)``), stepped with velocity Verlet as ``fix
+    nve/sphere`` steps it (``steps_per_contact`` per five Hertz time scales). Normal: the
+    force of ``law`` (contact from overlap 0 to its pull-off overlap). Tangential (LAMMPS'
+    ``mindlin``): the history ``s`` grows by the contact-point velocity ``w`` times the
+    step, the force is ``k_t a s + x_gamma_t eta_n0 a m w`` (``a`` the JKR contact radius,
+    ``k_t`` in Pa) and, above ``mu_s`` times the cap, is set to the cap and ``s`` to its
+    elastic part. ``cap``: ``"jkr"``, LAMMPS' ``|F_ne + 2 F_pulloff|`` (``F_ne`` the
+    elastic JKR force, ``F_pulloff = 3 pi cohesion R``), or ``"clipped"``, the normal force
+    with its damping clipped at zero (the non-adhesive models' cap). ``F = 1 + m R^2 /
+    Theta`` (3.5: a solid sphere) moves the contact point per unit tangential impulse.
+
+    Returns
+    -------
+    (e, beta) : normal restitution and ``beta = -w_end / w_0``; ``e = 0`` (and ``beta``
+    at the last step) if the sphere is still in contact after 50 contact lengths.
+    """
+    if cap not in TANGENTIAL_CAPS:
+        raise InputError(f"cap = {cap!r} is not allowed: one of {', '.join(TANGENTIAL_CAPS)}")
+    m, R = law.m, law.R
+    t_c = 5.0 * (m**2 / (law.E_star**2 * R * v)) ** 0.2
+    h = t_c / steps_per_contact
+    f_pulloff = 3.0 * math.pi * law.cohesion * R
+    w_coh = 2.0 * law.cohesion
+
+    def forces(d: float, rate: float, s: float, w: float) -> tuple[float, float, float]:
+        a = law.radius(d)
+        f_e = (4.0 * law.E_star * a**3 / (3.0 * R)
+               - math.sqrt(8.0 * math.pi * w_coh * law.E_star * a**3))
+        damp_n = law.eta_n0 * a * m
+        f_n = f_e + damp_n * rate
+        limit = mu_s * (abs(f_e + 2.0 * f_pulloff) if cap == "jkr" else max(f_n, 0.0))
+        k = k_t * a
+        f_t = k * s + x_gamma_t * damp_n * w
+        if abs(f_t) > limit:
+            lim = math.copysign(limit, f_t)
+            if s != 0.0 and k > 0.0:
+                s = (lim - x_gamma_t * damp_n * w) / k
+                f_t = lim
+            else:
+                f_t = 0.0
+        return f_n / m, f_t / m, s
+
+    w0 = v * math.tan(math.radians(angle_deg))
+    d, rate, s, ux, om = 0.0, v, 0.0, w0, 0.0
+    a_n, a_t = 0.0, 0.0
+    for _ in range(50 * steps_per_contact):
+        rate_h = rate - 0.5 * h * a_n
+        ux_h = ux - 0.5 * h * a_t
+        om_h = om + 0.5 * h * (F - 1.0) * a_t
+        d += h * rate_h
+        w_h = ux_h - om_h
+        s += h * w_h
+        a_n, a_t, s = forces(d, rate_h, s, w_h)
+        rate = rate_h - 0.5 * h * a_n
+        ux = ux_h - 0.5 * h * a_t
+        om = om_h + 0.5 * h * (F - 1.0) * a_t
+        if d < law.pulloff:
+            return -rate / v, -(ux - om) / w0
+    return 0.0, -(ux - om) / w0
+
+
+def lammps_oblique_wall_impact(coeffs: str, law: JkrLaw, rho: float, v: float,
+                               angle_deg: float, steps_per_contact: int = 4000
+                               ) -> tuple[float, float]:
+    """Run one oblique ``jkr`` wall impact in LAMMPS; return ``(e, beta)``.
+
+    ``e`` and ``beta`` as :func:`oblique_wall_impact` defines them. The sphere of
+    ``law`` (density ``rho``, kg/m^3; no spin) arrives at normal speed ``v`` (m/s),
+    ``angle_deg`` from the normal, on ``fix wall/gran granular`` with the model text
+    ``coeffs``. ``beta`` from the tangential impulse: the contact point's velocity
+    changes ``1 + m R^2 / Theta = 3.5`` times the centre's (LAMMPS' solid sphere).
+    """
+    from vimpact.dem.lammps import collision_script, run_lammps
+
+    v_t = v * math.tan(math.radians(angle_deg))
+    t_c = 5.0 * (law.m**2 / (law.E_star**2 * law.R * v)) ** 0.2
+    script = collision_script(coeffs, law.R, rho, v, t_c, steps_per_contact=steps_per_contact,
+                              v_t=v_t)
+    script += "variable z1 equal z[1]\n"
+    v1, vx1, z1 = run_lammps(script, ["v1", "vx1", "z1"])
+    if law.R - z1 > law.pulloff:
+        return 0.0, -(v_t + 3.5 * (vx1 - v_t)) / v_t
+    return v1 / v, -(v_t + 3.5 * (vx1 - v_t)) / v_t

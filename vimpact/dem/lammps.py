@@ -114,6 +114,8 @@ def fit(problem: DemProblem, targets: dict[str, Targets]) -> list[ContactFit]:
         res_e = Residual.of(e, t.e_z)
         if c.adhesion > 0.0:
             e, res_e = _fit_adhesive(c, t, params, notes)
+            if t.oblique is not None:
+                b_ob, res_b = _adhesive_oblique_beta(c, t.oblique, params, notes)
         elif len(set(t.level.tolist())) > 1:
             notes.append("size range: A is fitted at the nominal size; LAMMPS multiplies "
                          "eta_n0 by m_eff, so at the other sizes the damping is off by "
@@ -160,8 +162,46 @@ def _fit_adhesive(c: Contact, t: Targets, params: dict, notes: list[str]
                  + f" m/s (sticking counted as e_z = 0); sticking velocity vimpact "
                  f"{jf.v_stick_vimpact:.4g} m/s, LAMMPS' law {jf.v_stick_law:.4g} m/s (nominal "
                  "sizes); the tangential constants are those fitted with the non-adhesive "
-                 "normal law (LAMMPS' jkr raises its Coulomb limit by twice the pull-off force)")
+                 "normal law and its cap mu_s max(F_n, 0), not with jkr's")
     return e, Residual.of(e, t.e_z)
+
+
+#: steps per five Hertz time scales of the stepped oblique jkr impacts in the report
+ADHESIVE_BETA_STEPS = 2000
+
+
+def _adhesive_oblique_beta(c: Contact, ob: Oblique, params: dict, notes: list[str]
+                           ) -> tuple[np.ndarray, Residual]:
+    """Return the ``beta_x`` the ``jkr`` line gives at the oblique points of ``ob``, and its residual.
+
+    LAMMPS' ``jkr`` caps the tangential force at ``mu_s |F_ne + 2 F_pulloff|`` (``F_ne``
+    the elastic JKR force, ``F_pulloff = 3 pi cohesion R_eff``), not at the clipped
+    normal force the tangential constants were fitted with; both are stepped
+    (:func:`vimpact.dem.jkr.oblique_wall_impact`, the contact-point mass factor of the
+    contact) and the note says by how much the raised cap moves ``beta_x``. The residual
+    is against vimpact's ``beta_x``, which has no adhesion.
+    """
+    from vimpact.dem import linear
+    from vimpact.dem.jkr import JkrLaw, oblique_wall_impact
+
+    law = JkrLaw(c.E_star, ob.R, ob.m, params["cohesion"], params["eta_n0"])
+    F = linear.mass_factor(c)
+
+    def beta(cap: str) -> np.ndarray:
+        return np.array([oblique_wall_impact(law, params["k_t"], params["x_gamma_t"],
+                                             params["mu_s"], float(v), float(a), cap=cap, F=F,
+                                             steps_per_contact=ADHESIVE_BETA_STEPS)[1]
+                         for v, a in zip(ob.v, ob.angle_deg)])
+    b, b_clipped = beta("jkr"), beta("clipped")
+    res = Residual.of(b, ob.beta_x)
+    notes.append(f"beta_x of the jkr line: LAMMPS caps the tangential force at mu_s |F_ne + 2 "
+                 f"F_pulloff| (F_pulloff = 3 pi cohesion R_eff = {3.0 * math.pi * law.cohesion * ob.R:.4g}"
+                 f" N), not at the clipped normal force k_t and x_gamma_t were fitted with; "
+                 f"stepped with LAMMPS' cap, beta_x is off vimpact's (which has no adhesion) by "
+                 f"{res} (residual_beta_x); with the fitted cap it would be off by "
+                 f"{Residual.of(b_clipped, ob.beta_x)}, so the raised cap alone moves beta_x by up "
+                 f"to {float(np.max(np.abs(b - b_clipped))):.3g}")
+    return b, res
 
 
 def _tangential_beta(c: Contact, t: Targets, A: float, params: dict, k_t: float,
@@ -401,12 +441,14 @@ def run_lammps(script: str, variables: list[str], timeout: float = 120.0) -> lis
 
 def collision_script(coeffs: str, R1: float, rho1: float, v: float, t_contact: float, *,
                      R2: float | None = None, rho2: float | None = None,
-                     steps_per_contact: int = 4000) -> str:
+                     steps_per_contact: int = 4000, v_t: float = 0.0) -> str:
     """Return a LAMMPS input of one head-on collision.
 
     Type 1 (radius ``R1``, m; density ``rho1``, kg/m^3) hits a wall (``R2`` None) or
     a type-2 sphere at relative speed ``v`` (m/s); ``t_contact`` (s) sets the time
-    step. Defines the variables ``v1``, ``v2`` (z velocities after, m/s).
+    step. Defines the variables ``v1``, ``v2`` (z velocities after, m/s). ``v_t``
+    (m/s, wall only): the sphere also moves along ``x`` at that speed (an oblique
+    impact without spin); ``vx1`` is its ``x`` velocity after.
     """
     dt = t_contact / steps_per_contact
     gap = 0.02 * R1
@@ -419,11 +461,15 @@ def collision_script(coeffs: str, R1: float, rho1: float, v: float, t_contact: f
     if R2 is None:
         lines += [f"create_atoms 1 single 0 0 {R1 + gap:.12g}",
                   f"set atom 1 diameter {2 * R1:.12g} density {rho1:.12g}",
-                  f"velocity all set 0 0 {-v:.12g}",
+                  f"velocity all set {v_t:.12g} 0 {-v:.12g}",
                   f"pair_coeff * * {coeffs}",
                   f"fix w all wall/gran granular {coeffs} zplane 0.0 NULL",
-                  "variable v1 equal vz[1]", "variable v2 equal 0.0"]
+                  "variable v1 equal vz[1]", "variable v2 equal 0.0",
+                  "variable vx1 equal vx[1]"]
     else:
+        if v_t != 0.0:
+            raise ValueError(f"v_t = {v_t!r} is not allowed for a pair: only a wall impact "
+                             "is oblique here (v_t = 0)")
         lines += [f"create_atoms 1 single 0 0 {-(R1 + gap / 2):.12g}",
                   f"create_atoms 2 single 0 0 {R2 + gap / 2:.12g}",
                   f"set atom 1 diameter {2 * R1:.12g} density {rho1:.12g}",
@@ -494,9 +540,17 @@ def level_prediction(fit: ContactFit, R: float, m: float, v) -> np.ndarray:
     """Return the ``e_z`` LAMMPS' law gives with ``fit``'s lines for another pair size.
 
     The pair has effective radius ``R`` (m) and mass ``m`` (kg); speeds ``v`` in
-    m/s. ``eta_n0`` is fixed, so the dissipation time is ``A m / m_nom``.
+    m/s. ``eta_n0`` is fixed, so the dissipation time is ``A m / m_nom``. An adhesive
+    contact: its ``jkr`` law at ``R``, ``m`` (:class:`vimpact.dem.jkr.JkrLaw`).
     """
     from vimpact.dem.laws import viscoelastic_hertz_restitution
+
+    if "cohesion" in fit.params:
+        from vimpact.dem.jkr import JkrLaw
+
+        law = JkrLaw(fit.params["E_star_Pa"], R, m, fit.params["cohesion"], fit.params["eta_n0"])
+        speeds = np.asarray(v, dtype=float)
+        return np.array([law.restitution(float(x)) for x in speeds.ravel()]).reshape(speeds.shape)
 
     _, m_nom = fit.contact.nominal()
     return viscoelastic_hertz_restitution(fit.params["A_s"] * m / m_nom, fit.params["E_star_Pa"],
@@ -554,13 +608,14 @@ def round_trip_files(problem: DemProblem, speeds, steps_per_contact: int = STEPS
                     case = {"contact": c.key, "level": lvl, "v": float(v),
                             "predicted": float(level_prediction(f, R, m, v))}
                     if oblique:
+                        point = Oblique(np.array([float(v)]), np.array([float(ang)]), R, m,
+                                        c.mu, np.array([np.nan]), np.array([np.nan]))
+                        b_pred = (_adhesive_oblique_beta(c, point, f.params, [])[0]
+                                  if "cohesion" in f.params else
+                                  oblique_beta(c, point, f.params["A_s"], f.params,
+                                               f.params["k_t"], f.params["x_gamma_t"]))
                         case.update(angle=float(ang), vt=vt, F=linear.mass_factor(c),
-                                    predicted_beta=float(oblique_beta(
-                                        c, Oblique(np.array([float(v)]), np.array([float(ang)]),
-                                                   R, m, c.mu, np.array([np.nan]),
-                                                   np.array([np.nan])),
-                                        f.params["A_s"], f.params, f.params["k_t"],
-                                        f.params["x_gamma_t"])[0]))
+                                    predicted_beta=float(b_pred[0]))
                     if c.is_wall:
                         atoms.append((c.first.index, (x, 0.0, b1.R + gap), b1.R,
                                       c.first.density, (vt, 0.0, -float(v))))
