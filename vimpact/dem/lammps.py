@@ -29,6 +29,12 @@ that friction over the set-up's impact angles, running LAMMPS' law with its Coul
 cap as LAMMPS steps it (:func:`vimpact.dem.laws.hertz_mindlin_coulomb`); without
 friction, in full stick (:func:`vimpact.dem.laws.viscoelastic_hertz_mindlin`). Checked
 by running LAMMPS on oblique wall and pair impacts (tests/dem/test_round_trip.py).
+
+Adhesive contacts (``[adhesion]`` in the set-up) get LAMMPS' ``jkr`` normal model
+instead, with its cohesion and damping fitted to vimpact's adhesive ``e_z(v)``
+(:mod:`vimpact.dem.jkr`; pairs by their effective radius and mass). Their tangential
+constants are fitted without adhesion, while ``jkr`` raises the Coulomb limit by
+twice the pull-off force; the report states the ``beta_x`` that limit gives.
 """
 
 from __future__ import annotations
