@@ -1,7 +1,9 @@
 """The end of a sweep reads each part once and never reads the table it wrote back.
 
-A one-chunk file-layout sweep is written straight to its table (no part); the
-table is the one a part would have been combined into, byte for byte. Parts are
+A one-chunk file-layout sweep is written straight to its table (no part); a small
+one computed in one process is written from its chunks in memory (its parts, kept
+for --resume, are not read back); either table is the one its parts would have
+been combined into, byte for byte. Parts are
 read (and hashed) once for their check, held in memory up to ``store.HOLD_ROWS``
 rows and written from there; a larger table reads them once more to write them,
 hashing the rows again: a part changed between its check and the write is
@@ -90,11 +92,20 @@ def test_parts_are_read_once_and_the_table_is_not_read_back(tmp_path, monkeypatc
                          out=tmp_path / "one.parquet", progress=False)
     reads = Reads(monkeypatch)
     out = run_sweep(spec, out=tmp_path / "t.parquet", progress=False)
-    assert reads.scanned == [f"part-0000{k}.parquet" for k in range(3)] and reads.read == []
+    # computed in this process: written from memory, its parts (for --resume) not read
+    assert reads.scanned == [] and reads.read == []
+    assert not parts_dir(out).exists()
     assert integrity.verify_table(out).startswith("ok: 6 rows, 3 row group(s)")
     # chunking changes the row groups, not the content hash
     assert metadata.read_metadata(out)["content_sha256"] \
         == metadata.read_metadata(straight)["content_sha256"]
+    # the same parts from shards, then --combine: each read once, the same table
+    other = tmp_path / "combined.parquet"
+    run_sweep(spec, out=other, shard=(0, 1), progress=False)
+    reads.scanned.clear()
+    assert run_sweep(spec, out=other, combine=True, progress=False) == other
+    assert reads.scanned == [f"part-0000{k}.parquet" for k in range(3)] and reads.read == []
+    assert other.read_bytes() == out.read_bytes()
 
 
 def test_above_hold_rows_a_part_changed_after_its_check_is_refused(tmp_path, monkeypatch):
@@ -160,9 +171,9 @@ def test_full_disk_in_a_one_chunk_sweep_says_nothing_is_kept(tmp_path, monkeypat
     assert integrity.verify_table(out).endswith("content hash verified")
 
 
-def test_straight_write_refuses_a_sweep_of_several_chunks(tmp_path):
+def test_a_write_from_memory_needs_every_chunk(tmp_path):
     spec = load_spec(write(tmp_path, GRID_KV.format(chunk=2)))
     table = spec.schema().empty_table()
-    with pytest.raises(ValueError, match="only the one chunk"):
+    with pytest.raises(ValueError, match="from all its chunks"):
         store.combine(spec, tmp_path / "p", tmp_path / "t.parquet", dict,
-                      fresh=(table, {"counts": {}, "paths": {}}))
+                      fresh=[(table, {"counts": {}, "paths": {}})])

@@ -422,7 +422,7 @@ def _run(spec, spec_path, out, parts, resume, progress, workers, scheduler, shar
     rows_done = sum(spec.chunk_rows(c)[1] - spec.chunk_rows(c)[0] for c in done)
     bar = Progress(spec.rows, rows_done, spec.path.stem, progress)
     finished = False
-    fresh = None
+    fresh: list | None = None
     try:
         if workers is not None and todo:
             too_small = small_for_cluster(spec, todo, workers)
@@ -431,15 +431,18 @@ def _run(spec, spec_path, out, parts, resume, progress, workers, scheduler, shar
         if workers is not None or scheduler is not None:
             _run_dask(spec, todo, parts, bar, done, workers, scheduler)
         else:
-            # the one chunk of a file-layout table goes straight to the table: no part
-            straight = shard is None and layout == "file" and todo == [0] == list(
-                range(spec.n_chunks))
+            # a small file-layout table is written from its chunks in memory (parts
+            # not read back); one chunk goes straight to the table (no part)
+            if shard is None and layout == "file" and todo == list(range(spec.n_chunks)) \
+                    and (spec.n_chunks == 1 or spec.rows <= store.HOLD_ROWS):
+                fresh = []
             for chunk in todo:
                 table = compute_chunk(spec, chunk, timings)
-                if straight:
-                    fresh = (table, chunk_summary(table))
-                else:
-                    store.write_part(spec, table, parts, chunk, chunk_summary(table))
+                summary = chunk_summary(table)
+                if fresh is not None:
+                    fresh.append((table, summary))
+                if spec.n_chunks > 1 or fresh is None:
+                    store.write_part(spec, table, parts, chunk, summary)
                     done[chunk] = store.part_path(parts, chunk, spec.n_chunks)
                 start, stop = spec.chunk_rows(chunk)
                 bar.update(stop - start)
@@ -461,8 +464,8 @@ def _combine(spec: SweepSpec, parts: Path, out: Path, log, stages: SweepStages,
              fresh=None) -> None:
     """Run :func:`vimpact.sweep.store.combine`, then ``stages.finish``.
 
-    ``fresh``: the ``(table, summary)`` of a one-chunk sweep, written straight to the
-    table.
+    ``fresh``: the ``(table, summary)`` of every chunk, computed in this process:
+    the table is written from them (:func:`vimpact.sweep.store.combine`).
 
     The stages' own files
     (``stages.kept``) leave the parts directory first (the directory must hold only

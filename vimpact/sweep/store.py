@@ -72,7 +72,6 @@ from vimpact.tableformat.integrity import (
     ContentHash,
     Damaged,
     check_metadata_hash,
-    content_hash,
     first_line,
     open_checked,
     rows_in_footer,
@@ -354,13 +353,15 @@ def combine(spec, parts: Path, out: Path, explain_paths, fresh=None) -> None:
     changed in between). A sweep of one part keeps it in memory from the check: one
     read (and so do the parts of a table of at most :data:`HOLD_ROWS` rows: memory
     stays bounded by a chunk, or by that many rows). ``fresh``: ``(table, summary)``
-    of the only chunk of a file-layout sweep, just computed, written straight to
-    ``OUT`` (no part: its content hash is computed from the rows in memory).
+    of every chunk of a file-layout table, just computed in this process (at most
+    :data:`HOLD_ROWS` rows, or one chunk), in chunk order: the table is written from
+    them with its content hash computed from the rows in memory and the parts are
+    not read (:func:`_write_fresh`); a one-chunk sweep has no part.
     """
     import pyarrow.parquet as pq
 
     if fresh is not None:
-        _write_fresh(spec, parts, out, explain_paths, *fresh)
+        _write_fresh(spec, parts, out, explain_paths, fresh)
         return
     whole = ContentHash()
     held: list | None = [] if spec.table_layout == "file" and (
@@ -435,30 +436,53 @@ def _remove_parts_dir(parts: Path) -> None:
     fsync_dir(parts.parent)
 
 
-def _write_fresh(spec, parts: Path, out: Path, explain_paths, table, summary_: dict) -> None:
-    """Write the only chunk of a file-layout sweep, just computed, straight to ``out``.
+def _write_fresh(spec, parts: Path, out: Path, explain_paths, fresh: list) -> None:
+    """Write a file-layout table from its chunks in memory, all just computed.
 
-    Its content hash is computed from the rows in memory; the table is the one
-    :func:`combine` would make from its part, byte for byte. A failed write (disk
-    full) keeps nothing: the chunk is computed again by the next run.
+    ``fresh``: ``(table, summary)`` of every chunk in chunk order. The content hash
+    is computed from the rows in memory, the parts (if any) are not read: the table
+    is the one :func:`combine` would make from them, byte for byte, and they are
+    removed once it is written and its footer checked. One chunk has no part: a
+    failed write (disk full) keeps nothing, the chunk is computed again by the next
+    run.
     """
-    if spec.n_chunks != 1 or spec.table_layout != "file" or table.num_rows != spec.rows:
-        raise ValueError(f"only the one chunk of a file-layout sweep is written straight "
-                         f"to the table ({spec.n_chunks} chunk(s), layout "
-                         f"{spec.table_layout!r}, {table.num_rows} of {spec.rows} rows)")
-    paths = _explained({name: {"rows": e["rows"], "first_row": e["first_row"]}
-                        for name, e in summary_["paths"].items()}, explain_paths)
-    digest = content_hash(table)
+    tables = [table for table, _ in fresh]
+    if spec.table_layout != "file" or len(fresh) != spec.n_chunks \
+            or [t.num_rows for t in tables] != [b - a for a, b in map(
+                spec.chunk_rows, range(spec.n_chunks))]:
+        raise ValueError(f"a file-layout table is written from memory only from all its "
+                         f"chunks ({spec.n_chunks} chunk(s), layout {spec.table_layout!r}, "
+                         f"{len(fresh)} given)")
+    paths: dict = {}
+    for _, summary_ in fresh:
+        for name, entry in summary_["paths"].items():
+            if name not in paths:
+                paths[name] = {"rows": 0, "first_row": entry["first_row"]}
+            paths[name]["rows"] += entry["rows"]
+    paths = _explained(paths, explain_paths)
+    whole = ContentHash()
+    for table in tables:
+        whole.update(table)
+    digest = whole.hexdigest()
     meta = encode_metadata({**spec.metadata(), "paths": paths})
     out.parent.mkdir(parents=True, exist_ok=True)
+    written = [part_path(parts, c, spec.n_chunks) for c in range(spec.n_chunks)
+               if spec.n_chunks > 1]
+    if written:
+        check_room(out, parts, sum(p.stat().st_size for p in written))
     try:
-        write_atomic(table.replace_schema_metadata(meta), out, content_sha256=digest)
+        write_atomic(tables[0].replace_schema_metadata(meta), out, more=tables[1:],
+                     content_sha256=digest)
     except OSError as exc:
+        if written:
+            raise _kept(exc, parts) from exc
         full = exc.errno in (errno.ENOSPC, errno.EDQUOT)
         raise OSError(exc.errno, f"{exc.strerror or first_line(exc)}; the sweep's one chunk "
                       f"was to be written straight to {out}, nothing is kept: "
                       f"{'make room and ' if full else ''}run it again") from exc
-    _check_written(out, None, spec.rows, digest)
+    _check_written(out, parts if written else None, spec.rows, digest)
+    for path in written:
+        path.unlink()
     if parts.is_dir():
         _remove_parts_dir(parts)
 
