@@ -401,7 +401,8 @@ def _run(spec, spec_path, out, parts, resume, progress, workers, scheduler, shar
         units = shard[1] if shard is not None else 1
     spec = chunked(spec, parts, not combine, units, log)
     if parts.exists():
-        done = store.existing_parts(spec, parts)
+        # --combine: store.combine verifies the parts (a part read once)
+        done = {} if combine else store.existing_parts(spec, parts)
         if done and not (resume or combine):
             raise ValueError(
                 f"{parts} holds {len(done)} finished chunk(s) of an earlier run: use --resume "
@@ -421,6 +422,7 @@ def _run(spec, spec_path, out, parts, resume, progress, workers, scheduler, shar
     rows_done = sum(spec.chunk_rows(c)[1] - spec.chunk_rows(c)[0] for c in done)
     bar = Progress(spec.rows, rows_done, spec.path.stem, progress)
     finished = False
+    fresh: list | None = None
     try:
         if workers is not None and todo:
             too_small = small_for_cluster(spec, todo, workers)
@@ -429,17 +431,26 @@ def _run(spec, spec_path, out, parts, resume, progress, workers, scheduler, shar
         if workers is not None or scheduler is not None:
             _run_dask(spec, todo, parts, bar, done, workers, scheduler)
         else:
+            # a small file-layout table is written from its chunks in memory (parts
+            # not read back); one chunk goes straight to the table (no part)
+            if shard is None and layout == "file" and todo == list(range(spec.n_chunks)) \
+                    and (spec.n_chunks == 1 or spec.rows <= store.HOLD_ROWS):
+                fresh = []
             for chunk in todo:
                 table = compute_chunk(spec, chunk, timings)
-                store.write_part(spec, table, parts, chunk, chunk_summary(table))
-                done[chunk] = store.part_path(parts, chunk, spec.n_chunks)
+                summary = chunk_summary(table)
+                if fresh is not None:
+                    fresh.append((table, summary))
+                if spec.n_chunks > 1 or fresh is None:
+                    store.write_part(spec, table, parts, chunk, summary)
+                    done[chunk] = store.part_path(parts, chunk, spec.n_chunks)
                 start, stop = spec.chunk_rows(chunk)
                 bar.update(stop - start)
         finished = True
         bar.close()
         if shard is not None:
             return parts
-        _combine(spec, parts, out, log, stages)
+        _combine(spec, parts, out, log, stages, fresh)
     except KeyboardInterrupt:
         bar.close(finished)
         hint = f"vimpact sweep {spec_path}" + (f" --out {out}" if out != spec.output else "")
@@ -449,8 +460,12 @@ def _run(spec, spec_path, out, parts, resume, progress, workers, scheduler, shar
     return out
 
 
-def _combine(spec: SweepSpec, parts: Path, out: Path, log, stages: SweepStages) -> None:
+def _combine(spec: SweepSpec, parts: Path, out: Path, log, stages: SweepStages,
+             fresh=None) -> None:
     """Run :func:`vimpact.sweep.store.combine`, then ``stages.finish``.
+
+    ``fresh``: the ``(table, summary)`` of every chunk, computed in this process:
+    the table is written from them (:func:`vimpact.sweep.store.combine`).
 
     The stages' own files
     (``stages.kept``) leave the parts directory first (the directory must hold only
@@ -464,7 +479,7 @@ def _combine(spec: SweepSpec, parts: Path, out: Path, log, stages: SweepStages) 
             saved[name] = kept.read_text()
             kept.unlink()
     try:
-        store.combine(spec, parts, out, lambda first: explain_paths(spec, first))
+        store.combine(spec, parts, out, lambda first: explain_paths(spec, first), fresh)
     except BaseException:
         if Path(parts).is_dir():
             for name, text in saved.items():

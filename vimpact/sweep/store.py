@@ -13,7 +13,9 @@ Layouts (``layout`` in the spec; ``"auto"``: a file up to
   and ``vimpact table`` read it directly.
 
 Memory is bounded by the chunk size in both layouts: a part is written as it
-is finished, and the file layout is combined one part (one row group) at a time.
+is finished, and the file layout is combined one part (one row group) at a time
+(a table of at most :data:`HOLD_ROWS` rows, no more than the largest chunk the
+runner chooses, is held whole between the check of its parts and its write).
 
 Every write is atomic (a temporary file in the same directory, fsync,
 ``os.replace``, fsync of the directory), so a run killed anywhere (kill -9)
@@ -32,10 +34,14 @@ metadata entries ``vimpact.metadata_sha256``
 part is trusted only after :func:`verify_part` has read it back (page checksums
 checked, hash recomputed): ``--resume`` moves a part that fails to
 ``<parts>/_corrupt/`` (one line on stderr names it and the reason) and computes it
-again; the combination verifies every part, then the table it wrote
-(:func:`~vimpact.tableformat.integrity.verify_table`), before it removes any part. A
-table without a stored hash (written before it existed) is accepted with the hash
-check skipped.
+again; the combination verifies every part as it reads it (once: a part is read and
+hashed once, unless the table is larger than :data:`HOLD_ROWS` rows, when it is read
+once more to be written and its rows are hashed again as they are written), writes
+the table with the content hash of the rows verified, and checks the footer it wrote
+(metadata hash, content hash, rows) before it removes any part. The one chunk of a
+one-chunk file-layout sweep is written straight to the table, its hash computed from
+the rows in memory (no part). A table without a stored hash (written before it
+existed) is accepted with the hash check skipped.
 
 Metadata: the Parquet key-value metadata ``vimpact.<key>``, written and read with the
 one codec of :mod:`vimpact.tableformat.metadata`, which the reader
@@ -54,6 +60,7 @@ import sys
 from pathlib import Path
 
 from vimpact.model.validation import InputError
+from vimpact.sweep.spec import AUTO_CHUNK_ROWS
 from vimpact.tableformat.files import (
     fsync_dir,
     refuse_symlink,
@@ -92,11 +99,12 @@ def summary(path) -> dict[str, int]:
 
 # ---- part verification---------------------------------------------------------------
 
-def _check_part(path: Path, spec, hasher: ContentHash | None = None) -> tuple[str, str | None]:
+def _check_part(path: Path, spec, hasher: ContentHash | None = None,
+                keep: list | None = None) -> tuple[str, str | None]:
     """Check a part: ``("ok", None)``, ``("foreign", why)`` or ``("bad", why)``.
 
     ``"foreign"``: a part of another sweep (its own vimpact metadata, another sweep
-    hash).
+    hash). ``hasher`` receives its rows, ``keep`` its row groups (:func:`scan`).
     """
     path = Path(path)
     try:
@@ -132,7 +140,7 @@ def _check_part(path: Path, spec, hasher: ContentHash | None = None) -> tuple[st
     if rows_in_footer(pf) != stop - start:
         return "bad", f"holds {rows_in_footer(pf)} rows, chunk {chunk} has {stop - start}"
     try:
-        _, _, rows = scan(path, hasher)
+        _, _, rows = scan(path, hasher, keep)
     except Damaged as exc:
         return "bad", str(exc)
     if rows != stop - start:
@@ -187,11 +195,13 @@ def existing_parts(spec, parts: Path) -> dict[int, Path]:
     return _existing_parts(spec, parts)
 
 
-def _existing_parts(spec, parts: Path, hasher: ContentHash | None = None) -> dict[int, Path]:
+def _existing_parts(spec, parts: Path, hasher: ContentHash | None = None,
+                    keep: list | None = None) -> dict[int, Path]:
     """Return :func:`existing_parts`, the good parts' rows fed to ``hasher``.
 
     ``hasher`` receives the rows of the good parts in chunk order (the content hash
-    of the table when no chunk is missing).
+    of the table when no chunk is missing); ``keep`` their rows (one ``pyarrow``
+    table per good part, in chunk order).
     """
     found: dict[int, Path] = {}
     if not parts.is_dir():
@@ -206,7 +216,8 @@ def _existing_parts(spec, parts: Path, hasher: ContentHash | None = None) -> dic
             raise ValueError(f"{entry} is in the way: it is not a part of this sweep and "
                              f"would be read as rows of the dataset {parts}; move it away")
     for path in sorted(parts.glob("part-*.parquet")):
-        kind, why = _check_part(path, spec, hasher)
+        groups: list | None = [] if keep is not None else None
+        kind, why = _check_part(path, spec, hasher, groups)
         if kind == "foreign":
             raise ValueError(f"{path} {why}; remove {parts} to start over")
         if kind == "bad":
@@ -219,6 +230,9 @@ def _existing_parts(spec, parts: Path, hasher: ContentHash | None = None) -> dic
                   "computing it again", file=sys.stderr)
             continue
         found[int(path.name[len("part-"):-len(".parquet")])] = path
+        if keep is not None and groups is not None:
+            import pyarrow as pa
+            keep.append(pa.concat_tables(groups))
     return found
 
 
@@ -313,7 +327,13 @@ def is_complete(spec, out: Path) -> bool:
     return True
 
 
-def combine(spec, parts: Path, out: Path, explain_paths) -> None:
+#: Rows of a file-layout table whose parts :func:`combine` holds in memory from their
+#: check to the write (one read of each part); a larger table is read twice, one part
+#: at a time (as many rows as the largest chunk the runner chooses).
+HOLD_ROWS = AUTO_CHUNK_ROWS[1]
+
+
+def combine(spec, parts: Path, out: Path, explain_paths, fresh=None) -> None:
     """Finish the table from the parts.
 
     Verify every part (:func:`existing_parts`:
@@ -322,14 +342,31 @@ def combine(spec, parts: Path, out: Path, explain_paths) -> None:
     into the ``paths`` metadata (``explain_paths(first_rows) -> {path: reasons}``);
     then write ``OUT`` (file: the parts concatenated with page checksums and the
     content hash of all rows) or ``OUT/_common_metadata`` (dataset, with the
-    content hash over its parts), verify what was written (:func:`verify_table`)
+    content hash over its parts), check what was written (:func:`_check_written`)
     and only then remove the parts (file layout; damaged parts moved aside stay
     in ``<parts>/_corrupt``).
+
+    Each part is read and hashed once to be verified (its own hash and the table's
+    from one canonical form); the file layout reads it once more to write it (one
+    part in memory at a time), hashing the rows again as they are written: the
+    table replaces nothing unless they give the hash verified before (a part
+    changed in between). A sweep of one part keeps it in memory from the check: one
+    read (and so do the parts of a table of at most :data:`HOLD_ROWS` rows: memory
+    stays bounded by a chunk, or by that many rows). ``fresh``: ``(table, summary)``
+    of every chunk of a file-layout table, just computed in this process (at most
+    :data:`HOLD_ROWS` rows, or one chunk), in chunk order: the table is written from
+    them with its content hash computed from the rows in memory and the parts are
+    not read (:func:`_write_fresh`); a one-chunk sweep has no part.
     """
     import pyarrow.parquet as pq
 
+    if fresh is not None:
+        _write_fresh(spec, parts, out, explain_paths, fresh)
+        return
     whole = ContentHash()
-    found = _existing_parts(spec, parts, whole)
+    held: list | None = [] if spec.table_layout == "file" and (
+        spec.n_chunks == 1 or spec.rows <= HOLD_ROWS) else None
+    found = _existing_parts(spec, parts, whole, held)
     missing = [c for c in range(spec.n_chunks) if c not in found]
     if missing:
         shown = ", ".join(map(str, missing[:10])) + (" ..." if len(missing) > 10 else "")
@@ -348,38 +385,106 @@ def combine(spec, parts: Path, out: Path, explain_paths) -> None:
             if name not in paths:
                 paths[name] = {"rows": 0, "first_row": entry["first_row"]}
             paths[name]["rows"] += entry["rows"]
-    reasons = explain_paths({name: e["first_row"] for name, e in paths.items()})
-    paths = {name: {**e, "reasons": reasons[name]} for name, e in paths.items()}
+    paths = _explained(paths, explain_paths)
     digest = whole.hexdigest()
     if spec.table_layout == "dataset":
         meta = encode_metadata({**spec.metadata(), "paths": paths, CONTENT_HASH_KEY: digest})
         write_atomic(spec.schema().empty_table().replace_schema_metadata(meta),
                      out / COMMON_METADATA, schema_only=True)
-        _verify_written(out, parts)
+        _check_written(out / COMMON_METADATA, parts, spec.rows, digest)
         return
     meta = encode_metadata({**spec.metadata(), "paths": paths})
     # one row group per part, read one at a time: memory bounded by the chunk size
 
     def read(chunk):
+        if held is not None:  # read for its check
+            return held[chunk]
         return pq.read_table(found[chunk], page_checksum_verification=True)
     first = read(0).replace_schema_metadata(meta)
     rest = (read(c) for c in range(1, spec.n_chunks))
     out.parent.mkdir(parents=True, exist_ok=True)
     check_room(out, parts, sum(found[c].stat().st_size for c in range(spec.n_chunks)))
     try:
-        write_atomic(first, out, more=rest, content_sha256=digest)
+        write_atomic(first, out, more=rest, content_sha256=digest, recheck=held is None)
     except OSError as exc:
         raise _kept(exc, parts) from exc
-    _verify_written(out, parts)
+    except Damaged as exc:
+        raise ValueError(f"{exc}; the parts in {parts} are kept: run again with "
+                         "--resume") from None
+    _check_written(out, parts, spec.rows, digest)
     for chunk in range(spec.n_chunks):
         found[chunk].unlink()
+    _remove_parts_dir(parts)
+
+
+def _explained(paths: dict, explain_paths) -> dict:
+    """Return the ``paths`` metadata with each path's routing reasons."""
+    reasons = explain_paths({name: e["first_row"] for name, e in paths.items()})
+    return {name: {**e, "reasons": reasons[name]} for name, e in paths.items()}
+
+
+def _remove_parts_dir(parts: Path) -> None:
+    """Remove the parts directory of a finished file-layout table (kept if not empty)."""
     remove_temporaries(parts)
     try:
         parts.rmdir()
+    except FileNotFoundError:
+        pass
     except OSError:  # something else is there (damaged parts moved aside): kept
         print(f"vimpact sweep: {parts} is kept: it holds files that are not finished parts "
               f"({', '.join(sorted(p.name for p in parts.iterdir()))})", file=sys.stderr)
     fsync_dir(parts.parent)
+
+
+def _write_fresh(spec, parts: Path, out: Path, explain_paths, fresh: list) -> None:
+    """Write a file-layout table from its chunks in memory, all just computed.
+
+    ``fresh``: ``(table, summary)`` of every chunk in chunk order. The content hash
+    is computed from the rows in memory, the parts (if any) are not read: the table
+    is the one :func:`combine` would make from them, byte for byte, and they are
+    removed once it is written and its footer checked. One chunk has no part: a
+    failed write (disk full) keeps nothing, the chunk is computed again by the next
+    run.
+    """
+    tables = [table for table, _ in fresh]
+    if spec.table_layout != "file" or len(fresh) != spec.n_chunks \
+            or [t.num_rows for t in tables] != [b - a for a, b in map(
+                spec.chunk_rows, range(spec.n_chunks))]:
+        raise ValueError(f"a file-layout table is written from memory only from all its "
+                         f"chunks ({spec.n_chunks} chunk(s), layout {spec.table_layout!r}, "
+                         f"{len(fresh)} given)")
+    paths: dict = {}
+    for _, summary_ in fresh:
+        for name, entry in summary_["paths"].items():
+            if name not in paths:
+                paths[name] = {"rows": 0, "first_row": entry["first_row"]}
+            paths[name]["rows"] += entry["rows"]
+    paths = _explained(paths, explain_paths)
+    whole = ContentHash()
+    for table in tables:
+        whole.update(table)
+    digest = whole.hexdigest()
+    meta = encode_metadata({**spec.metadata(), "paths": paths})
+    out.parent.mkdir(parents=True, exist_ok=True)
+    written = [part_path(parts, c, spec.n_chunks) for c in range(spec.n_chunks)
+               if spec.n_chunks > 1]
+    if written:
+        check_room(out, parts, sum(p.stat().st_size for p in written))
+    try:
+        write_atomic(tables[0].replace_schema_metadata(meta), out, more=tables[1:],
+                     content_sha256=digest)
+    except OSError as exc:
+        if written:
+            raise _kept(exc, parts) from exc
+        full = exc.errno in (errno.ENOSPC, errno.EDQUOT)
+        raise OSError(exc.errno, f"{exc.strerror or first_line(exc)}; the sweep's one chunk "
+                      f"was to be written straight to {out}, nothing is kept: "
+                      f"{'make room and ' if full else ''}run it again") from exc
+    _check_written(out, parts if written else None, spec.rows, digest)
+    for path in written:
+        path.unlink()
+    if parts.is_dir():
+        _remove_parts_dir(parts)
 
 
 #: Free disk kept beyond the parts' size when a file-layout table is combined, bytes.
@@ -403,13 +508,31 @@ def check_room(out: Path, parts: Path, parts_bytes: int) -> None:
                       "continue with --resume")
 
 
-def _verify_written(out: Path, parts: Path) -> None:
-    """:func:`verify_table` of a table just written; the parts are kept if it fails."""
+def _check_written(out: Path, parts: Path | None, rows: int, digest: str) -> None:
+    """Check the footer of a table (or ``_common_metadata``) just written.
+
+    ``ValueError`` if it fails, saying that the ``parts`` it was made from are kept
+    (``None``: written from memory, nothing kept).
+
+    The file ends with a Parquet footer that reads, its metadata gives its stored
+    metadata hash, it stores the content hash ``digest`` (computed from the verified
+    parts, or from the rows in memory, as they were written) and, a file, ``rows``
+    rows. The data are not read back: :func:`verify_table` does that for a reader.
+    """
     try:
-        verify_table(out)
-    except InputError as exc:
-        raise ValueError(f"{exc}; it was just written from the parts in {parts}, which are "
-                         "kept: run again with --resume") from None
+        pf = open_checked(out)
+        raw = pf.schema_arrow.metadata
+        check_metadata_hash(raw)
+        meta = decode_metadata(raw)
+        if meta.get(CONTENT_HASH_KEY) != digest:
+            raise Damaged(f"content hash {str(meta.get(CONTENT_HASH_KEY))[:12]}... stored, "
+                          f"{digest[:12]}... written")
+        if out.name != COMMON_METADATA and rows_in_footer(pf) != rows:
+            raise Damaged(f"{rows_in_footer(pf)} rows in its footer, {rows} written")
+    except Damaged as exc:
+        after = ("run the sweep again" if parts is None else f"it was just written from "
+                 f"the parts in {parts}, which are kept: run again with --resume")
+        raise ValueError(f"{out} fails its check: {exc}; {after}") from None
 
 
 # ---- the output: checks and lock ----------------------------------------------------

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import contextlib
 import errno
+import itertools
 import os
 import socket
 from pathlib import Path
@@ -19,6 +20,8 @@ from pathlib import Path
 from vimpact.model.validation import InputError
 from vimpact.tableformat.integrity import (
     CONTENT_HASH_KEY,
+    ContentHash,
+    Damaged,
     content_hash,
     first_line,
     with_metadata_hash,
@@ -96,7 +99,7 @@ def atomic_file(path, name: str = "--out", mode: str = "wb"):
 
 
 def write_atomic(table, path: Path, *, schema_only: bool = False, more=(),
-                 content_sha256: str | None = None) -> None:
+                 content_sha256: str | None = None, recheck: bool = False) -> None:
     """Write the ``pyarrow`` ``table`` (or only its schema) to ``path`` atomically.
 
     A temporary file in the same directory, fsync, ``os.replace``, fsync of the directory.
@@ -109,7 +112,11 @@ def write_atomic(table, path: Path, *, schema_only: bool = False, more=(),
     all rows, which the caller computed while verifying them). ``more``: further
     tables (same schema) appended one row group each, read one at a time, so that
     memory stays bounded by the largest of them. ``schema_only``: the schema with
-    its metadata as it is (a dataset's ``_common_metadata``).
+    its metadata as it is (a dataset's ``_common_metadata``). ``recheck``: the rows
+    are hashed again as they are written (``table`` and each of ``more``, one at a
+    time) and ``path`` is replaced only if they give ``content_sha256``
+    (:class:`~vimpact.tableformat.integrity.Damaged` otherwise): for rows read from
+    files that were verified before, which could have changed since.
 
     Raises ``OSError`` naming ``path`` when the write fails (e.g. ``ENOSPC``, disk
     full); the temporary file is removed and an earlier ``path`` stays as it was.
@@ -128,6 +135,7 @@ def write_atomic(table, path: Path, *, schema_only: bool = False, more=(),
     if any(k.startswith(META_PREFIX.encode()) if isinstance(k, bytes) else
            str(k).startswith(META_PREFIX) for k in (table.schema.metadata or {})):
         table = with_metadata_hash(table)
+    again = ContentHash() if recheck and not schema_only else None
     try:
         with atomic_file(path, str(path)) as f:
             if schema_only:
@@ -135,11 +143,20 @@ def write_atomic(table, path: Path, *, schema_only: bool = False, more=(),
             elif more:
                 with pq.ParquetWriter(f, table.schema, write_page_checksum=True,
                                       compression=COMPRESSION) as writer:
-                    writer.write_table(table)
-                    for other in more:
-                        writer.write_table(other.replace_schema_metadata(table.schema.metadata))
+                    for k, piece in enumerate(itertools.chain([table], more)):
+                        if again is not None:
+                            again.update(piece)
+                        writer.write_table(piece if k == 0 else
+                                           piece.replace_schema_metadata(table.schema.metadata))
             else:
+                if again is not None:
+                    again.update(table)
                 pq.write_table(table, f, write_page_checksum=True, compression=COMPRESSION)
+            if again is not None and again.hexdigest() != content_sha256:
+                raise Damaged(f"the rows written to {path} do not give the content hash "
+                              f"{str(content_sha256)[:12]}... (data "
+                              f"{again.hexdigest()[:12]}...): "
+                              "a source changed while it was written; nothing was replaced")
     except OSError as exc:
         raise OSError(exc.errno, f"{exc.strerror or first_line(exc)} while writing "
                       f"{path}") from exc

@@ -59,23 +59,30 @@ class ContentHash:
         self.rows = 0
         self._streams: list[tuple] = []
 
-    def update(self, table) -> ContentHash:
+    def update(self, table, also: ContentHash | None = None) -> ContentHash:
         """Add the rows of the ``pyarrow`` table (or record batch) ``table``.
 
-        Same column names, in the same order, as the rows before.
+        Same column names, in the same order, as the rows before. ``also``: a second
+        hash that receives the same rows (e.g. a part's own hash and the hash of the
+        whole table), from one canonical form of each column.
         """
         names = list(table.column_names)
-        if self.names is None:
-            self.names = names
-        if names != self.names:
-            raise ValueError(f"content hash: columns {names} differ from {self.names}")
-        if not self._streams:
-            self._streams = [(hashlib.sha256(), hashlib.sha256(), hashlib.sha256())
-                             for _ in names]
-        for column, streams in zip(table.columns, self._streams):
-            for stream, piece in zip(streams, _canonical(column)):
-                stream.update(piece)
-        self.rows += table.num_rows
+        hashers = [self] if also is None else [self, also]
+        for hasher in hashers:
+            if hasher.names is None:
+                hasher.names = names
+            if names != hasher.names:
+                raise ValueError(f"content hash: columns {names} differ from {hasher.names}")
+            if not hasher._streams:
+                hasher._streams = [(hashlib.sha256(), hashlib.sha256(), hashlib.sha256())
+                                   for _ in names]
+        for k, column in enumerate(table.columns):
+            pieces = _canonical(column)
+            for hasher in hashers:
+                for stream, piece in zip(hasher._streams[k], pieces):
+                    stream.update(piece)
+        for hasher in hashers:
+            hasher.rows += table.num_rows
         return self
 
     def hexdigest(self) -> str:
@@ -218,13 +225,16 @@ def open_checked(path: Path):
         raise Damaged(f"footer unreadable ({first_line(exc)})") from None
 
 
-def scan(path: Path, hasher: ContentHash | None = None) -> tuple[dict, str, int]:
+def scan(path: Path, hasher: ContentHash | None = None,
+         keep: list | None = None) -> tuple[dict, str, int]:
     """Read every row group of the Parquet file ``path`` with page checksums checked.
 
     Returns the decoded ``vimpact.*`` metadata, the :class:`ContentHash` of the
-    data and the number of rows; ``hasher`` (optional) receives the rows too.
-    Raises :class:`Damaged` for a file that cannot be read back or whose stored
-    hash (if any) differs from its data.
+    data and the number of rows; ``hasher`` (optional) receives the rows too (each
+    column put in canonical form once for both). ``keep`` (a list, optional)
+    receives the row groups read (``pyarrow`` tables), so that a caller that needs
+    the data reads the file once. Raises :class:`Damaged` for a file that cannot be
+    read back or whose stored hash (if any) differs from its data.
     """
     pf = open_checked(path)
     try:
@@ -240,9 +250,9 @@ def scan(path: Path, hasher: ContentHash | None = None) -> tuple[dict, str, int]
             why = first_line(exc)
             what = "page checksum failed" if "checksum" in why.lower() else "data unreadable"
             raise Damaged(f"{what} in row group {group} ({why})") from None
-        own.update(table)
-        if hasher is not None:
-            hasher.update(table)
+        own.update(table, also=hasher)
+        if keep is not None:
+            keep.append(table)
     digest = own.hexdigest()
     stored = meta.get(CONTENT_HASH_KEY)
     if stored is not None and stored != digest:
