@@ -225,3 +225,35 @@ def test_standard_solid_reaches_kelvin_voigt_linearly_in_Q2():
     assert np.all(np.abs(d[1e-4]) <= 0.17 * 1e-4)
     ratio = d[1e-4] / d[1e-5]
     assert np.all((ratio > 8.0) & (ratio < 12.0)), ratio
+
+
+def test_a_band_that_has_not_measured_the_limit_says_how(kelvin_voigt, tmp_path):
+    band = _table(kelvin_voigt, (1e-5, 1e-3), 3e-5)  # reaches the limit, no measurement
+    shutil.copy(KV_TABLE, tmp_path / KELVIN_VOIGT_FILE)
+    table = RestitutionTable.open(band.save(tmp_path / BAND_FILE))
+    with pytest.raises(InputError, match="records its distance to that limit"):
+        table.lookup(1.0, 0.3, Q2=1e-6)
+
+
+def test_the_build_records_the_limit_of_a_table_that_reaches_it(tmp_path):
+    """`table build` of a standard solid reaching Q2 = 1e-5 measures its distance to the
+    Kelvin-Voigt limit (here of an analytic stand-in for the simulation, linear in Q2)."""
+    from vimpact.tablebuild.adaptive import build_adaptive
+
+    def fake(model, Q1, nu, Q2=None, **kw):
+        q2 = np.zeros(len(Q1)) if Q2 is None else np.asarray(Q2)
+        e_z = 0.9 / (1.0 + np.asarray(Q1)) + 0.1 * q2
+        beta_x = 0.2 * np.log(Q1) * (1 + np.asarray(nu)) / 10 - 0.05 * q2
+        return pd.DataFrame({"e_z": e_z, "beta_x": beta_x, "e_x": np.abs(beta_x),
+                             "status": "ok"})
+
+    spec = tmp_path / "band.toml"
+    spec.write_text('model = "standard_solid"\noutput = "band.parquet"\n[grid]\n'
+                    'Q1 = { start = 0.1, stop = 1, num = 2 }\n'
+                    'Q2 = { start = 1e-5, stop = 1e-3, num = 2 }\nnu = [0.0, 0.5]\n'
+                    'tolerance = 1e-3\nrefine = "adaptive"\nmin_level = 1\nmax_level = 4\n')
+    table, _ = build_adaptive(spec, n_verify=5, simulate=fake)
+    limit = table.meta("kelvin_voigt_limit")
+    assert limit["Q2"] == pytest.approx(1e-5)
+    assert limit["max"]["e_z"] == pytest.approx(1e-6) and limit["max"]["beta_x"] == \
+        pytest.approx(5e-7)

@@ -30,7 +30,8 @@ from vimpact.model.validation import InputError
 if TYPE_CHECKING:
     from vimpact.lookup.table import RestitutionTable
 
-__all__ = ["BAND_FILE", "BAND_SPEC", "KELVIN_VOIGT_FILE", "below_range", "neighbour_below"]
+__all__ = ["BAND_FILE", "BAND_SPEC", "KELVIN_VOIGT_FILE", "KELVIN_VOIGT_Q2", "below_range",
+           "neighbour_below", "reaches_kelvin_voigt"]
 
 #: The band table's file name, looked for beside a standard-solid table.
 BAND_FILE = "standard_solid_band.parquet"
@@ -38,6 +39,11 @@ BAND_FILE = "standard_solid_band.parquet"
 BAND_SPEC = "sweeps/standard_solid_band.toml"
 #: The Kelvin-Voigt table's file name, looked for beside the band table.
 KELVIN_VOIGT_FILE = "kelvin_voigt_table.parquet"
+#: A standard-solid table whose ``Q2`` range reaches down to this value (or below)
+#: is continued by the Kelvin-Voigt table: there both outputs are within
+#: ``0.17 Q2 <= 1.7e-6`` of their Kelvin-Voigt values at every ``Q1`` in 1e-3 ... 100
+#: (measured by direct simulation; the table records its own measurement).
+KELVIN_VOIGT_Q2 = 1e-5
 
 _OPENED: dict[tuple[str, int], RestitutionTable] = {}
 
@@ -58,6 +64,11 @@ def _q2_range(table: RestitutionTable) -> tuple[float, float]:
     return float(lo), float(hi)
 
 
+def reaches_kelvin_voigt(table: RestitutionTable) -> bool:
+    """Whether an adaptive standard-solid table reaches down to :data:`KELVIN_VOIGT_Q2`."""
+    return _q2_range(table)[0] <= KELVIN_VOIGT_Q2 * (1.0 + 1e-9)
+
+
 def neighbour_below(table: RestitutionTable) -> RestitutionTable | None:
     """Return the table that answers below ``table``'s ``Q2`` range, or None.
 
@@ -69,15 +80,17 @@ def neighbour_below(table: RestitutionTable) -> RestitutionTable | None:
     Returns
     -------
     RestitutionTable or None
-        The Kelvin-Voigt table beside ``table`` if ``table`` records its distance to
-        the Kelvin-Voigt limit (``vimpact.kelvin_voigt_limit``); otherwise the band
-        table beside it, if its ``Q2`` range ends where ``table``'s begins; None if
-        there is none.
+        The Kelvin-Voigt table beside ``table`` if ``table`` reaches down to
+        :data:`KELVIN_VOIGT_Q2` and records its distance to the Kelvin-Voigt limit
+        (``vimpact.kelvin_voigt_limit``); otherwise the band table beside it, if its
+        ``Q2`` range ends where ``table``'s begins; None if there is none.
     """
     if table.path is None or table.model != "standard_solid" or not table.is_adaptive:
         return None
     folder = table.path.parent
-    if table.meta("kelvin_voigt_limit") is not None:
+    if reaches_kelvin_voigt(table):
+        if table.meta("kelvin_voigt_limit") is None:
+            return None
         kv = folder / KELVIN_VOIGT_FILE
         if kv.is_file():
             found = _open(kv)
@@ -97,7 +110,13 @@ def neighbour_below(table: RestitutionTable) -> RestitutionTable | None:
 
 def _refusal(table: RestitutionTable, q2: float) -> InputError:
     lo, hi = _q2_range(table)
-    if table.meta("kelvin_voigt_limit") is not None:
+    if reaches_kelvin_voigt(table) and table.meta("kelvin_voigt_limit") is None:
+        return InputError(
+            f"Q2 = {q2:.6g} is outside the table's range: it covers Q2 in [{lo:.6g}, "
+            f"{hi:.6g}]; below, the Kelvin-Voigt table answers once this table records "
+            "its distance to that limit (`python -m vimpact.tablebuild.band TABLE`; "
+            "`vimpact table build` records it)")
+    if reaches_kelvin_voigt(table):
         return InputError(
             f"Q2 = {q2:.6g} is outside the table's range: it covers Q2 in [{lo:.6g}, "
             f"{hi:.6g}]; below, the Kelvin-Voigt table {KELVIN_VOIGT_FILE} beside "
