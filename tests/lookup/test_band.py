@@ -222,7 +222,8 @@ def test_standard_solid_reaches_kelvin_voigt_linearly_in_Q2():
     for q2 in (1e-4, 1e-5):
         ss = simulate_dimensionless("standard_solid", q1, nu, np.full(3, q2))
         d[q2] = ss["e_z"].to_numpy() - kv["e_z"].to_numpy()
-    assert np.all(np.abs(d[1e-4]) <= 0.17 * 1e-4)
+    # the largest slope measured over Q1 = 1e-3 ... 100 is 0.167 (at Q1 near 1)
+    assert np.all(np.abs(d[1e-4]) <= 0.2 * 1e-4)
     ratio = d[1e-4] / d[1e-5]
     assert np.all((ratio > 8.0) & (ratio < 12.0)), ratio
 
