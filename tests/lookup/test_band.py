@@ -118,6 +118,13 @@ def test_below_the_range_the_band_and_then_the_limit_answer(folder, kelvin_voigt
     assert above["error_bound"]["e_z"] == pytest.approx(2e-5)  # the main table's alone
 
 
+def test_extrapolation_and_linear_stay_refused_below_the_range(folder):
+    main = RestitutionTable.open(folder / "standard_solid_table.parquet")
+    for kw in ({"extrapolate": True}, {"method": "linear"}):
+        with pytest.raises(InputError, match="adaptive table"):
+            main.lookup(1.0, 0.3, Q2=1e-7, **kw)
+
+
 def test_the_seams_are_continuous(folder):
     main = RestitutionTable.open(folder / "standard_solid_table.parquet")
     q1 = np.geomspace(Q1_RANGE[0], Q1_RANGE[1] / 1.02, 200) * 1.01

@@ -170,7 +170,8 @@ def below_range(table: RestitutionTable, arrays: dict[str, np.ndarray], method: 
     InputError
         Below the range without a neighbour, naming the spec that builds the band.
     """
-    if table.model != "standard_solid" or not table.is_adaptive or "Q2" not in arrays:
+    if (table.model != "standard_solid" or not table.is_adaptive or "Q2" not in arrays
+            or method != "cubic" or extrapolate):  # the table's own lookup refuses these
         return None
     lo, _ = _q2_range(table)
     Q2 = np.asarray(arrays["Q2"], dtype=float)
