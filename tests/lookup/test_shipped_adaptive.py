@@ -32,6 +32,21 @@ def test_covers_the_whole_range_and_states_its_error(table):
     assert TABLE.stat().st_size < 20e6
 
 
+def test_below_its_range_the_band_answers_or_its_spec_is_named(table):
+    """Below Q2 = 1e-3 the band table beside it answers; without it the refusal names
+    the spec that builds it (vimpact.lookup.band)."""
+    from vimpact.lookup.band import BAND_FILE, BAND_SPEC
+    from vimpact.model.validation import InputError
+
+    if (TABLE.parent / BAND_FILE).is_file():
+        out = table.lookup(30.0, 0.3, Q2=1e-4)
+        assert 0.0 < out["e_z"] < 1.0 and out["error_bound"] is not None
+    else:
+        with pytest.raises(InputError, match="build it with") as exc:
+            table.lookup(30.0, 0.3, Q2=1e-4)
+        assert BAND_SPEC in str(exc.value) and (ROOT / BAND_SPEC).is_file()
+
+
 @pytest.mark.slow
 def test_figures_5_4_and_5_5_from_the_table_alone(table):
     """e_z(Q1) and e_x(Q1) for Q2 = 0.01 ... 1 at nu = 0.5 (thesis figs. 5.4/5.5) from the

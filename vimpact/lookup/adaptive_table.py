@@ -19,7 +19,7 @@ if TYPE_CHECKING:
     from vimpact.lookup.adaptive import AdaptiveGrid
     from vimpact.lookup.table import RestitutionTable
 
-__all__ = ["adaptive_outputs", "build_adaptive_grid"]
+__all__ = ["adaptive_lookup", "adaptive_outputs", "build_adaptive_grid"]
 
 
 def build_adaptive_grid(table: RestitutionTable) -> AdaptiveGrid:
@@ -83,3 +83,27 @@ def adaptive_outputs(table: RestitutionTable, arrays: dict[str, np.ndarray], met
                 + ([grid.tensor_axis] if grid.tensor_axis else [])})
     out["e_x"] = np.abs(out["beta_x"])
     return out
+
+
+def adaptive_lookup(table: RestitutionTable, arrays: dict[str, np.ndarray], method: str,
+                    extrapolate: bool) -> tuple[dict[str, np.ndarray], dict | None]:
+    """Interpolate an adaptive table at query points, with the error bound that holds.
+
+    Points of a standard-solid table below its ``Q2`` range are answered by the
+    table beside it that continues the range down to the Kelvin-Voigt limit
+    (:func:`vimpact.lookup.band.below_range`), or refused naming the spec that
+    builds it.
+
+    Returns
+    -------
+    (outputs, bound)
+        :func:`adaptive_outputs`'s result and the largest error bound of the tables
+        used (the table's own :meth:`~RestitutionTable.error_bound` if only it).
+    """
+    from vimpact.lookup.band import below_range
+
+    bound = table.error_bound(method)
+    split = below_range(table, arrays, method, extrapolate, adaptive_outputs, bound)
+    if split is not None:
+        return split
+    return adaptive_outputs(table, arrays, method, extrapolate), bound

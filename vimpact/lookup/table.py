@@ -403,11 +403,12 @@ class RestitutionTable:
         psis, thetas = self._tensor.psi_values(), self._tensor.theta_values()
         arrays, bcast = query.query_arrays(self.model, method, Q1, nu, Q2, psi, theta_ratio,
                                            psis, thetas, self._tensor.resolve_theta)
-        if self.is_adaptive:
-            out = adaptive_table.adaptive_outputs(self, arrays, method, extrapolate)
+        if self.is_adaptive:  # below a standard solid's Q2 range: vimpact.lookup.band
+            out, bound = adaptive_table.adaptive_lookup(self, arrays, method, extrapolate)
         else:
-            out = self._tensor(arrays, thetas, theta_ratio, method, extrapolate)
-        return query.lookup_result(arrays, out, bcast, self.error_bound(method))
+            out, bound = (self._tensor(arrays, thetas, theta_ratio, method, extrapolate),
+                          self.error_bound(method))
+        return query.lookup_result(arrays, out, bcast, bound)
 
     def to_xarray(self, theta_ratio=None):
         """Return the grid as an :class:`xarray.Dataset`.

@@ -11,7 +11,10 @@ the interpolation along ``nu`` and between check points), on ``e_z`` and
 used (random points, and random points inside randomly drawn cells:
 :func:`vimpact.tablebuild.verify.interpolation_error`), which is stored as
 ``vimpact.interpolation_error``; the refinement report is ``vimpact.grid_refinement``
-and the build's time and size ``vimpact.build``.
+and the build's time and size ``vimpact.build``. A standard-solid table that reaches
+down to the Kelvin-Voigt limit (:data:`vimpact.lookup.band.KELVIN_VOIGT_Q2`) also
+records its measured distance to it (``vimpact.kelvin_voigt_limit``,
+:func:`vimpact.tablebuild.band.kelvin_voigt_limit`).
 """
 
 from __future__ import annotations
@@ -151,6 +154,14 @@ def build_adaptive(spec_path, out=None, *, n_verify: int = 2000, seed: int = 0,
     build = {"seconds": round(seconds, 1), "refine_seconds": round(seconds_refine, 1),
              "simulated": int(simulated[0] + result["points"]), "tolerance": tol,
              "met": bool(report["met"]), "cells": int(len(leaves))}
+    if spec.model == "standard_solid":  # continued by the Kelvin-Voigt table below it?
+        from vimpact.lookup.band import reaches_kelvin_voigt
+        from vimpact.tablebuild.band import kelvin_voigt_limit
+
+        if reaches_kelvin_voigt(table):
+            limit = kelvin_voigt_limit(table, seed=seed, simulate=simulate)
+            table.metadata["vimpact.kelvin_voigt_limit"] = json.dumps(limit)
+            build["seconds"] = round(time.perf_counter() - start, 1)
     table.metadata["vimpact.build"] = json.dumps(build)
     path = Path(out) if out is not None else spec.output
     path.parent.mkdir(parents=True, exist_ok=True)
