@@ -31,6 +31,7 @@ from vimpact.lookup.adaptive import AdaptiveGrid, lattice_coordinates, refine_ce
 from vimpact.lookup.table import RestitutionTable
 from vimpact.model.validation import InputError
 from vimpact.sweep.spec import SweepSpec, load_spec
+from vimpact.tablebuild.output import save_build, written
 from vimpact.tablebuild.verify import interpolation_error, simulate_dimensionless
 
 __all__ = ["MAX_POINTS", "build_adaptive", "simulate_nodes"]
@@ -162,13 +163,7 @@ def build_adaptive(spec_path, out=None, *, n_verify: int = 2000, seed: int = 0,
             limit = kelvin_voigt_limit(table, seed=seed, simulate=simulate)
             table.metadata["vimpact.kelvin_voigt_limit"] = json.dumps(limit)
             build["seconds"] = round(time.perf_counter() - start, 1)
-    table.metadata["vimpact.build"] = json.dumps(build)
-    path = Path(out) if out is not None else spec.output
-    path.parent.mkdir(parents=True, exist_ok=True)
-    table.save(path)
+    path = save_build(table, build, spec, out)
     if log is not None:
-        errs = ", ".join(f"{k} {v['max']:.2g}" for k, v in result["outputs"].items()
-                         if v["max"] is not None)
-        log(f"wrote {path} ({path.stat().st_size / 1e6:.2f} MB) in {seconds:.0f} s; held-out "
-            f"max error {errs}")
+        log(written(path, seconds, result))
     return RestitutionTable.open(path), path

@@ -41,6 +41,7 @@ from vimpact.model.numerics import Numerics
 from vimpact.model.scene import Scene
 from vimpact.model.validation import InputError
 from vimpact.sweep.spec import ADHESION_AXIS, SweepSpec, load_spec
+from vimpact.tablebuild.output import save_build
 
 __all__ = ["build_adhesion_table", "simulate", "sticking_numbers", "verify_adhesion_table"]
 
@@ -255,13 +256,10 @@ def build_adhesion_table(spec_path, out=None, *, n_verify: int = 2000, seed: int
     result = verify_adhesion_table(table, n=n_verify, seed=seed, numerics=numerics)
     table.metadata["vimpact.interpolation_error"] = json.dumps(result)
     seconds = time.perf_counter() - start
-    table.metadata["vimpact.build"] = json.dumps({
+    path = save_build(table, {
         "seconds": round(seconds, 1), "refine_seconds": round(seconds_refine, 1),
         "tolerance": tol, "met": met, "nodes": {"Q1": len(Q1), "s": len(s)},
-        "rows": len(table.data)})
-    path = Path(out) if out is not None else spec.output
-    path.parent.mkdir(parents=True, exist_ok=True)
-    table.save(path)
+        "rows": len(table.data)}, spec, out)
     say(f"wrote {path} ({path.stat().st_size / 1e3:.0f} kB) in {seconds:.0f} s; held-out max "
         f"error e_z {result['outputs']['e_z']['max']:.3g}, stuck misread at "
         f"{result['stuck_misread']} of {result['points']} points")

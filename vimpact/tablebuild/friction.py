@@ -17,7 +17,6 @@ from __future__ import annotations
 import json
 import time
 from collections.abc import Callable
-from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -31,6 +30,7 @@ from vimpact.lookup.friction import (
     psi_of_coordinate,
 )
 from vimpact.model.validation import InputError
+from vimpact.tablebuild.output import save_build, written
 from vimpact.tablebuild.verify import interpolation_error, simulate_dimensionless
 
 __all__ = ["build_friction", "gross_slip_start"]
@@ -233,13 +233,7 @@ def build_friction(spec, out=None, *, n_verify: int = 2000, seed: int = 0,
     build = {"seconds": round(seconds, 1), "refine_seconds": round(seconds_refine, 1),
              "simulated": int(simulated[0]), "tolerance": tol,
              "met": bool(report["met"]), "cells": int(len(leaves))}
-    table.metadata["vimpact.build"] = json.dumps(build)
-    path = Path(out) if out is not None else spec.output
-    path.parent.mkdir(parents=True, exist_ok=True)
-    table.save(path)
+    path = save_build(table, build, spec, out)
     if log is not None:
-        errs = ", ".join(f"{k} {v['max']:.2g}" for k, v in result["outputs"].items()
-                         if v["max"] is not None)
-        log(f"wrote {path} ({path.stat().st_size / 1e6:.2f} MB) in {seconds:.0f} s; held-out "
-            f"max error {errs}")
+        log(written(path, seconds, result))
     return RestitutionTable.open(path), path
