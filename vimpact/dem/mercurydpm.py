@@ -77,6 +77,9 @@ def _fit_tangential(c: Contact, t: Targets, A: float, G0: float):
     ob = t.oblique
     if ob is not None:
         v, R, m, w0, target, mu = ob.v, ob.R, ob.m, ob.w0, ob.beta_x, ob.mu
+    elif t.beta_x is None:
+        raise ValueError(f"contact {c.key}: no beta_x targets to fit (neither full stick nor "
+                         "oblique); compute the targets with tangential=True")
     else:
         nominal = np.flatnonzero(t.nominal)
         pick = nominal[np.unique(np.linspace(0, nominal.size - 1, TANGENTIAL_FIT_POINTS)

@@ -98,7 +98,7 @@ def fit(problem: DemProblem, targets: dict[str, Targets]) -> list[ContactFit]:
     """
     fits = []
     # MFiX takes one friction for particle pairs and one for walls: the first contact's
-    written_mu = {}
+    written_mu: dict[bool, float] = {}
     for c in problem.contacts:
         written_mu.setdefault(c.is_wall, c.mu)
     for c in problem.contacts:

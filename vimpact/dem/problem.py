@@ -145,15 +145,16 @@ class Contact:
 
         Min, nominal and max radius of both types; one level without a size range.
         """
-        n = max(len(self.first.radii), 1 if self.is_wall else len(self.second.radii))
-        out = []
+        second = self.second
+        n = max(len(self.first.radii), 1 if isinstance(second, WallType) else len(second.radii))
+        out: list[tuple[Body, Body | Wall]] = []
         for k in range(n):
             b1 = self.first.body(self.first.radii[min(k, len(self.first.radii) - 1)])
-            if self.is_wall:
-                out.append((b1, Wall(self.second.material)))
+            if isinstance(second, WallType):
+                out.append((b1, Wall(second.material)))
             else:
-                r2 = self.second.radii[min(k, len(self.second.radii) - 1)]
-                out.append((b1, self.second.body(r2)))
+                r2 = second.radii[min(k, len(second.radii) - 1)]
+                out.append((b1, second.body(r2)))
         return out
 
     def effective(self, level: tuple[Body, Body | Wall]) -> tuple[float, float]:
@@ -269,7 +270,7 @@ def problem_from_toml(text: str, source: str = "<string>", *, base: Path | None 
     tables = data.get("types")
     if not isinstance(tables, dict) or not tables:
         raise _err(source, "[types]", tables, "at least one [types.NAME] table")
-    types = []
+    types: list[ParticleType] = []
     base_of: dict[str, str] = {}  # type name -> its TOML table (differ for size classes)
     for name, t in tables.items():
         where = f"types.{name}"

@@ -51,7 +51,7 @@ def figure(code: str, problem: DemProblem, targets: dict[str, Targets],
         if rows == 2:
             ax = axes[1, k]
             ob = t.oblique
-            if f.beta_oblique is not None and ob is not None:
+            if f.beta_oblique is not None and ob is not None and f.res_beta_x is not None:
                 for j, v in enumerate(sorted(set(ob.v.tolist()))):
                     sel = ob.v == v
                     ax.plot(ob.angle_deg[sel], ob.beta_x[sel], "-", color=f"C{j}", lw=1,
@@ -65,7 +65,7 @@ def figure(code: str, problem: DemProblem, targets: dict[str, Targets],
                 if k == 0:
                     ax.set_ylabel("beta_x")
                 continue
-            if f.beta_x is not None and t.beta_x is not None:
+            if f.beta_x is not None and t.beta_x is not None and f.res_beta_x is not None:
                 ax.plot(t.v, t.beta_x, ".", color="C0", ms=3)
                 ax.plot(t.v, f.beta_x, "o", ms=3, mfc="none", color="C3")
                 ax.set_title(f"beta_x RMS {f.res_beta_x.rms:.1e}", fontsize=8)
@@ -178,7 +178,8 @@ def oblique_round_trip(code: str, round_trip, problem: DemProblem,
     speeds, angles = sorted(set(first.v.tolist())), sorted(set(first.angle_deg.tolist()))
     rows = round_trip(problem, speeds, steps_per_contact, fits=ex.fits, angles_deg=angles,
                       contacts=walls)
-    stated = {f.contact.key: f.res_beta_x.max_abs for f in ex.fits if f.contact.key in walls}
+    stated = {f.contact.key: f.res_beta_x.max_abs for f in ex.fits
+              if f.contact.key in walls and f.res_beta_x is not None}
     for r in rows:
         ob = obl[r["contact"]]
         k = int(np.flatnonzero(np.isclose(ob.v, r["v"], rtol=1e-12)

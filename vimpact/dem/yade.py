@@ -29,12 +29,13 @@ head-on and oblique impacts (tests/dem/test_yade.py).
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 
 from vimpact.dem import laws, linear
 from vimpact.dem.fit import ContactFit, Residual, Targets, fit_constant, fit_scalar
-from vimpact.dem.problem import Contact, DemProblem
+from vimpact.dem.problem import Contact, DemProblem, WallType
 
 CODE = "yade"
 TANGENTIAL = True
@@ -151,10 +152,11 @@ def fit(problem: DemProblem, targets: dict[str, Targets]) -> list[ContactFit]:
         ob = t.oblique
         if ob is not None:
             # one et closest to vimpact's oblique impacts with the contact's friction
-            arm = {"R": ob.R, "v": ob.v} if c.is_wall else {}  # Yade's wall contact point
+            # Yade's wall contact point: on the wall plane, lever R - delta
+            R_arm, v_arm = (ob.R, ob.v) if c.is_wall else (None, None)
             et, b_ob = fit_scalar(lambda x: yade_oblique(tc, en, x, q, F, c.mu, ob.w0, 1000,
-                                                         **arm), ob.beta_x, 1e-6, 1.0)
-            b_ob = yade_oblique(tc, en, et, q, F, c.mu, ob.w0, **arm)
+                                                         R=R_arm, v=v_arm), ob.beta_x, 1e-6, 1.0)
+            b_ob = yade_oblique(tc, en, et, q, F, c.mu, ob.w0, R=R_arm, v=v_arm)
             res_b = Residual.of(b_ob, ob.beta_x)
             if t.beta_x is not None:
                 b = np.full_like(t.beta_x, yade_law(tc, en, et, q, F)[1])
@@ -189,8 +191,10 @@ def render(problem: DemProblem, fits: list[ContactFit],
     """``yade_materials.py``: run it with ``exec`` in your Yade script before creating bodies."""
     names = [t.name for t in problem.types] + [w.name for w in problem.walls]
     density = {t.name: t.density for t in problem.types}
-    first = {}  # each material's own values: those of its first contact (Yade checks that all
-    for f in fits:  # materials define the same variables; the MatchMakers decide the values)
+    # each material's own values: those of its first contact (Yade checks that all materials
+    # define the same variables; the MatchMakers decide the values)
+    first: dict[str, dict] = {}
+    for f in fits:
         for nm in (f.contact.first.name, f.contact.second.name):
             first.setdefault(nm, f.params)
     dt = time_step(fits, steps_per_contact)
@@ -315,12 +319,14 @@ def round_trip(problem: DemProblem, speeds, steps_per_contact: int = STEPS_PER_C
         c = f.contact
         if angles_deg is not None and not c.is_wall:
             continue
+        second = c.second
+        R2 = None if isinstance(second, WallType) else second.radius
         for v in speeds:
             for ang in (angles_deg if angles_deg is not None else [None]):
-                case = {"contact": c.key, "first": c.first.name, "second": c.second.name,
-                        "wall": c.second.name if c.is_wall else None, "v": float(v),
-                        "R1": c.first.radius, "R2": None if c.is_wall else c.second.radius,
-                        "predicted": float(f.params["e_yade"])}
+                case: dict[str, Any] = {
+                    "contact": c.key, "first": c.first.name, "second": second.name,
+                    "wall": second.name if c.is_wall else None, "v": float(v),
+                    "R1": c.first.radius, "R2": R2, "predicted": float(f.params["e_yade"])}
                 if ang is not None:
                     p = f.params
                     w0 = math.tan(math.radians(ang))
