@@ -105,6 +105,9 @@ def format_info(info: dict) -> str:
     ad = info.get("adaptive")
     if ad:
         tensor = f" x {ad['tensor_nodes']} {ad['tensor_axis']}" if ad["tensor_axis"] else ""
+        if "psi_nodes" in ad:  # a friction table: psi nodes on the kinks of beta_x(psi)
+            tensor += (f" x {ad['psi_nodes']} psi (nodes on the kinks of beta_x; gross slip "
+                       "throughout by its closed form)")
         lines.append(f"  adaptive        {ad['leaves']} cells in log "
                      + " x log ".join(ad["axes"]) + f" (levels {ad['levels'][0]} .. "
                      f"{ad['levels'][1]}), {ad['adaptive_nodes']} nodes{tensor}")
