@@ -31,7 +31,7 @@ from vimpact.lookup.adaptive import AdaptiveGrid, lattice_coordinates, refine_ce
 from vimpact.lookup.table import RestitutionTable
 from vimpact.model.validation import InputError
 from vimpact.sweep.spec import SweepSpec, load_spec
-from vimpact.tablebuild.output import save_build, written
+from vimpact.tablebuild.output import adaptive_table, save_build, written
 from vimpact.tablebuild.verify import interpolation_error, simulate_dimensionless
 
 __all__ = ["MAX_POINTS", "build_adaptive", "simulate_nodes"]
@@ -139,12 +139,7 @@ def build_adaptive(spec_path, out=None, *, n_verify: int = 2000, seed: int = 0,
         data[f"lattice_{a}"] = cols[f"lattice_{a}"]
     data["status"] = status.astype(str)
     seconds_refine = time.perf_counter() - start
-    meta = spec.metadata()
-    meta.update(mode="adaptive", rows=int(len(data)), adaptive=grid.to_metadata(),
-                grid_refinement=report)
-    meta.pop("layout", None)
-    table = RestitutionTable(data, {k: v if isinstance(v, str) else json.dumps(v)
-                                    for k, v in meta.items() if v is not None})
+    table = adaptive_table(data, spec, grid.to_metadata(), report)
     if log is not None:
         log(f"refined: {len(leaves)} cells, {len(keys)} nodes x {len(nu)} nu = {len(data)} "
             f"rows in {seconds_refine:.0f} s; verifying at {2 * n_verify} held-out points")

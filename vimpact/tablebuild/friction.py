@@ -30,7 +30,7 @@ from vimpact.lookup.friction import (
     psi_of_coordinate,
 )
 from vimpact.model.validation import InputError
-from vimpact.tablebuild.output import save_build, written
+from vimpact.tablebuild.output import adaptive_table, save_build, written
 from vimpact.tablebuild.verify import interpolation_error, simulate_dimensionless
 
 __all__ = ["build_friction", "gross_slip_start"]
@@ -216,12 +216,7 @@ def build_friction(spec, out=None, *, n_verify: int = 2000, seed: int = 0,
     data["lattice_psi"] = np.broadcast_to(np.arange(nn)[None, None, :], shape).ravel()
     data["status"] = rows["status"].ravel().astype(str)
     seconds_refine = time.perf_counter() - start
-    meta = spec.metadata()
-    meta.update(mode="adaptive", rows=int(len(data)), adaptive=fgrid.to_metadata(),
-                grid_refinement=report)
-    meta.pop("layout", None)
-    table = RestitutionTable(data, {k: v if isinstance(v, str) else json.dumps(v)
-                                    for k, v in meta.items() if v is not None})
+    table = adaptive_table(data, spec, fgrid.to_metadata(), report)
     if log is not None:
         log(f"refined: {len(leaves)} cells, {len(keys)} Q1 nodes x {nt} nu x {nn} psi = "
             f"{len(data)} rows in {seconds_refine:.0f} s; verifying at {2 * n_verify} "

@@ -1,4 +1,4 @@
-"""Write a built table with its build record, and the line that says so.
+"""Assemble and write a built table with its build record, and the line that says so.
 
 Every table build (:mod:`vimpact.tablebuild.adaptive`, :mod:`~vimpact.tablebuild.friction`,
 :mod:`~vimpact.tablebuild.adhesion`) ends the same way: the build's time and size go
@@ -12,6 +12,33 @@ from __future__ import annotations
 import json
 from pathlib import Path
 from typing import Any
+
+import pandas as pd
+
+from vimpact.lookup.table import RestitutionTable
+
+
+def adaptive_table(data: pd.DataFrame, spec: Any, grid_metadata: dict,
+                   report: dict) -> RestitutionTable:
+    """Return the adaptive restitution table of ``data`` with the spec's metadata.
+
+    Parameters
+    ----------
+    data : pandas.DataFrame
+        The node rows (axes, outputs, lattice coordinates, status).
+    spec : SweepSpec
+        The spec built; its metadata (units, numerics, spec text, ...) is stored.
+    grid_metadata : dict
+        The cell structure (``AdaptiveGrid.to_metadata()`` or the friction grid's).
+    report : dict
+        The refinement report, stored as ``vimpact.grid_refinement``.
+    """
+    meta = spec.metadata()
+    meta.update(mode="adaptive", rows=int(len(data)), adaptive=grid_metadata,
+                grid_refinement=report)
+    meta.pop("layout", None)
+    return RestitutionTable(data, {k: v if isinstance(v, str) else json.dumps(v)
+                                   for k, v in meta.items() if v is not None})
 
 
 def save_build(table: Any, build: dict, spec: Any, out) -> Path:
