@@ -35,7 +35,7 @@ def stiffness_ratio(cols) -> np.ndarray:
     return 1.0 + _arm_sum(g * tau / (tau + cols.t_H[:, None]))
 
 
-def refinement(cols, numerics: Numerics, tangential: np.ndarray, integrator: int
+def refinement(cols, numerics: Numerics, tangential: np.ndarray | bool, integrator: int
                ) -> tuple[np.ndarray, np.ndarray]:
     """Return the factors (>= 1) refining the time step and the element spacing, per row.
 
@@ -61,15 +61,27 @@ def refinement(cols, numerics: Numerics, tangential: np.ndarray, integrator: int
     - Stability of the explicit kicks: ``h omega <= 1/2`` for the stiffest
       spring on the scale of one step (all arms slower than the step).
     """
-    r = stiffness_ratio(cols)
-    time_factor, element_factor = r ** 0.4, r ** 0.2
-    stiff_t = np.where(tangential, cols.kappa * cols.contact_mass_factor, 0.0)
-    time_factor = time_factor * np.where(tangential, np.maximum(1.0, np.sqrt(stiff_t)), 1.0)
-    element_factor = element_factor * np.where(
-        tangential, np.maximum(1.0, (stiff_t / SOLID_SPHERE_STIFFNESS) ** 0.25), 1.0)
     arms = cols.G_arm.shape[1] > 0  # (without an arm column its terms are 0: not computed)
-    g = cols.G_arm / cols.G_inf[:, None]
-    tau_T = cols.tau_arm / cols.T[:, None]
+    if arms:
+        r = stiffness_ratio(cols)
+        time_factor, element_factor = r ** 0.4, r ** 0.2
+    else:  # r = 1 exactly, and 1 ** y = 1
+        time_factor = element_factor = np.ones(cols.G_inf.shape[0])
+    if isinstance(tangential, (bool, np.bool_)):  # one value for all rows (the element path)
+        # the same numbers as the masks below, without the masks (where, factors of 1)
+        stiff_t = cols.kappa * cols.contact_mass_factor if tangential else 0.0
+        if tangential:
+            time_factor = time_factor * np.maximum(1.0, np.sqrt(stiff_t))
+            element_factor = element_factor * np.maximum(
+                1.0, (stiff_t / SOLID_SPHERE_STIFFNESS) ** 0.25)
+    else:
+        stiff_t = np.where(tangential, cols.kappa * cols.contact_mass_factor, 0.0)
+        time_factor = time_factor * np.where(tangential, np.maximum(1.0, np.sqrt(stiff_t)), 1.0)
+        element_factor = element_factor * np.where(
+            tangential, np.maximum(1.0, (stiff_t / SOLID_SPHERE_STIFFNESS) ** 0.25), 1.0)
+    if arms:
+        g = cols.G_arm / cols.G_inf[:, None]
+        tau_T = cols.tau_arm / cols.T[:, None]
     h = HERTZ_TIME_FACTOR / numerics.steps / time_factor
     viscous = _arm_sum(np.where(tau_T < h[:, None], g * tau_T, 0.0)) if arms else 0.0
     if integrator == EULER:
@@ -88,12 +100,15 @@ def time_limit(cols, numerics: Numerics) -> np.ndarray:
 
     ``max_time`` Hertz times, stretched by the slow creep back of a viscous surface.
     """
-    viscous = cols.dashpot_time + _arm_sum(cols.G_arm * cols.tau_arm) / cols.G_inf  # s
+    viscous = cols.dashpot_time  # s (+ the arms'; without an arm column a sum of none)
+    if cols.G_arm.shape[1]:
+        viscous = viscous + _arm_sum(cols.G_arm * cols.tau_arm) / cols.G_inf
     stretch = np.minimum(10.0 * viscous / cols.T, MAX_TIME_STRETCH)
     return numerics.max_time * HERTZ_TIME_FACTOR * (1.0 + stretch)
 
 
-def element_row(cols, numerics: Numerics, tangential: np.ndarray, integrator: int) -> dict:
+def element_row(cols, numerics: Numerics, tangential: np.ndarray | bool, integrator: int
+                ) -> dict:
     """Return the element row and time step of each row, kernel units.
 
     Step ``h`` / T, element spacing ``dxi`` / a_H, elements in the half row

@@ -224,7 +224,7 @@ def unpack_row(cols: SceneColumns, out: np.ndarray, path_name: str, explicit_eul
                 or (tangential and abs(vc_end) > 1.0 + PASSIVITY_SLACK))
         contact_steps = t_contact * steps_per_T
         relative_gain = contact1 / contact0 - 1.0
-        Q1, Q2 = cols.Q1[0], cols.Q2[0]
+        Q1, Q2 = cols.Q_row()
     incremental = cols.memory[0] == TANGENTIAL_MEMORY.index("incremental")
     if ok and gain:
         status = (("energy_gain" if explicit_euler else "unstable") if incremental
