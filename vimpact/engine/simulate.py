@@ -116,8 +116,14 @@ def _run(cols: SceneColumns, numerics: Numerics, n_rec: int, rec_every: int,
         if path.spec is not None:
             arrays = element_arrays(_rows(cols, idx), numerics, path.spec)
             per_t_H = HERTZ_TIME_FACTOR / arrays["h"]
-            costly = (per_t_H > MAX_STEPS_PER_T_H) | (arrays["n_elem"] > MAX_ELEMENTS_IN_ROW)
-            n_costly = int(np.count_nonzero(costly))  # (cheaper than any() and flatnonzero)
+            if len(idx) == 1:  # (the same test on the row's scalars: cheaper on one row)
+                n_costly = int(per_t_H[0] > MAX_STEPS_PER_T_H
+                               or arrays["n_elem"][0] > MAX_ELEMENTS_IN_ROW)
+                costly = np.full(1, bool(n_costly))
+            else:
+                costly = ((per_t_H > MAX_STEPS_PER_T_H)
+                          | (arrays["n_elem"] > MAX_ELEMENTS_IN_ROW))
+                n_costly = int(np.count_nonzero(costly))  # (cheaper than any() and flatnonzero)
             for j in np.flatnonzero(costly) if n_costly else ():
                 refused[idx[j]] = ("too_costly",
                     f"this scene needs {per_t_H[j]:.3g} steps per Hertz time and "
