@@ -258,7 +258,7 @@ class SceneColumns:
         n = len(scenes)
         k = max((len(s.material.arms) for s in scenes if isinstance(s, Scene)), default=0)
         G_arm, tau_arm = np.zeros((n, k)), np.zeros((n, k))
-        reasons = np.full(n, None, dtype=object)
+        reasons = np.empty(n, dtype=object)  # (NumPy fills an object array with None)
         numbers, codes, flags = [], [], []  # a tuple per row, one array each at the end
         bad = False
         for i, s in enumerate(scenes):
@@ -322,7 +322,7 @@ class SceneColumns:
         if missing:
             raise InputError(f"scene columns {', '.join(missing)} are required "
                              f"(given: {', '.join(names) or 'none'})")
-        reasons = np.full(n, None, dtype=object)
+        reasons = np.empty(n, dtype=object)  # (NumPy fills an object array with None)
         num = {}
         for name, (rule, default) in NUMERIC.items():
             values = arrays.get(name, np.full(n, default))

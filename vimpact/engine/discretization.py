@@ -83,14 +83,18 @@ def refinement(cols, numerics: Numerics, tangential: np.ndarray | bool, integrat
         g = cols.G_arm / cols.G_inf[:, None]
         tau_T = cols.tau_arm / cols.T[:, None]
     h = HERTZ_TIME_FACTOR / numerics.steps / time_factor
-    viscous = _arm_sum(np.where(tau_T < h[:, None], g * tau_T, 0.0)) if arms else 0.0
-    if integrator == EULER:
-        viscous = viscous + cols.dashpot_time / cols.T
-    rate = 15.0 / 8.0 * viscous * numerics.row_width * np.maximum(1.0, stiff_t)
-    time_factor = time_factor * np.maximum(1.0, h * rate)
-    h = HERTZ_TIME_FACTOR / numerics.steps / time_factor
+    stiff_floor = np.maximum(1.0, stiff_t)
+    # without arms and with an implicit dashpot no viscous term is explicit: h C = 0, a
+    # factor of 1 (an infinite stiff_t gives NaN either way), not computed
+    if arms or integrator == EULER:
+        viscous = _arm_sum(np.where(tau_T < h[:, None], g * tau_T, 0.0)) if arms else 0.0
+        if integrator == EULER:
+            viscous = viscous + cols.dashpot_time / cols.T
+        rate = 15.0 / 8.0 * viscous * numerics.row_width * stiff_floor
+        time_factor = time_factor * np.maximum(1.0, h * rate)
+        h = HERTZ_TIME_FACTOR / numerics.steps / time_factor
     springs = 1.0 + (_arm_sum(np.where(tau_T >= h[:, None], g, 0.0)) if arms else 0.0)
-    omega = np.sqrt(15.0 / 8.0 * numerics.row_width * springs * np.maximum(1.0, stiff_t))
+    omega = np.sqrt(15.0 / 8.0 * numerics.row_width * springs * stiff_floor)
     time_factor = time_factor * np.maximum(1.0, 2.0 * h * omega)
     return time_factor, element_factor
 
