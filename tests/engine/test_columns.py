@@ -206,7 +206,8 @@ def test_one_row_q1_q2_are_the_column_values():
 
 def test_refinement_of_one_tangential_flag_is_that_of_its_mask():
     """The element path's refinement with one tangential flag for all rows gives the
-    factors of the row mask holding that flag, bit for bit (with and without arms)."""
+    factors of the row mask holding that flag, bit for bit (with and without arms; on
+    one row without arms simulate()'s scalar form against the array form)."""
     from vimpact.engine import discretization
     from vimpact.engine.columns import SceneColumns
     from vimpact.kernels.layout import EULER, VERLET
@@ -222,6 +223,9 @@ def test_refinement_of_one_tangential_flag_is_that_of_its_mask():
             for integrator in (VERLET, EULER):
                 for numerics in (v.Numerics(), v.Numerics.preset("fast")):
                     got = discretization.element_row(cols, numerics, flag, integrator)
+                    if cols.G_arm.shape == (1, 0):  # simulate()'s scalar form answered
+                        assert discretization._element_row_one(
+                            cols, numerics, flag, integrator) is not None
                     want = discretization.element_row(
                         cols, numerics, np.full(len(cols), flag), integrator)
                     for key in want:

@@ -6,6 +6,8 @@ one rule for the kernels, the NumPy reference and the benchmarks.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from vimpact.kernels.layout import EULER
@@ -118,6 +120,10 @@ def element_row(cols, numerics: Numerics, tangential: np.ndarray | bool, integra
     Step ``h`` / T, element spacing ``dxi`` / a_H, elements in the half row
     ``n_elem`` and the time limit in steps ``max_steps``, per row.
     """
+    if isinstance(tangential, bool) and cols.G_arm.shape == (1, 0):
+        row = _element_row_one(cols, numerics, tangential, integrator)
+        if row is not None:
+            return row
     time_factor, element_factor = refinement(cols, numerics, tangential, integrator)
     h = HERTZ_TIME_FACTOR / numerics.steps / time_factor
     per_a_H = np.ceil(numerics.elements * element_factor)
@@ -127,6 +133,58 @@ def element_row(cols, numerics: Numerics, tangential: np.ndarray | bool, integra
         "n_elem": _count(numerics.row_width * per_a_H),
         "max_steps": _count(time_limit(cols, numerics) / h),
     }
+
+
+def _element_row_one(cols, numerics: Numerics, tangential: bool, integrator: int
+                     ) -> dict | None:
+    """:func:`element_row` of one row without an arm column, on Python floats.
+
+    :func:`refinement` and :func:`time_limit` with their terms of no arm (factors
+    of 1, sums of none) left out and the rest in the same operations in the same
+    order on the row's values (IEEE arithmetic and square roots: the same numbers;
+    the one power stays a NumPy array operation, whose SIMD result can differ from
+    the C library's in the last bit), for :func:`vimpact.simulate`, where the array
+    operations cost more than the arithmetic. ``None`` if a value is not finite:
+    the array form then decides (``tests/engine/test_columns.py`` checks the two agree).
+    """
+    stiff_t = float(cols.kappa[0]) * float(cols.contact_mass_factor[0]) if tangential else 0.0
+    time_factor = element_factor = 1.0
+    if tangential:
+        time_factor = _at_least_1(math.sqrt(stiff_t))
+        element_factor = _at_least_1(
+            float((np.array([stiff_t / SOLID_SPHERE_STIFFNESS]) ** 0.25)[0]))
+    h = HERTZ_TIME_FACTOR / numerics.steps / time_factor
+    stiff_floor = _at_least_1(stiff_t)
+    T = float(cols.T[0])
+    dashpot_T = float(cols.dashpot_time[0]) / T
+    if integrator == EULER:
+        rate = 15.0 / 8.0 * (0.0 + dashpot_T) * numerics.row_width * stiff_floor
+        time_factor = time_factor * _at_least_1(h * rate)
+        h = HERTZ_TIME_FACTOR / numerics.steps / time_factor
+    omega = math.sqrt(15.0 / 8.0 * numerics.row_width * 1.0 * stiff_floor)
+    time_factor = time_factor * _at_least_1(2.0 * h * omega)
+    h = HERTZ_TIME_FACTOR / numerics.steps / time_factor
+    per_a_H = numerics.elements * element_factor
+    stretch = 10.0 * float(cols.dashpot_time[0]) / T
+    limit = numerics.max_time * HERTZ_TIME_FACTOR * (
+        1.0 + (MAX_TIME_STRETCH if stretch > MAX_TIME_STRETCH else stretch))  # (NaN stays)
+    if not all(map(math.isfinite, (h, per_a_H, limit, limit / h))):
+        return None
+    per_a_H = float(math.ceil(per_a_H))
+    n_elem, max_steps = numerics.row_width * per_a_H, limit / h
+    if n_elem > 2.0**62 or max_steps > 2.0**62:  # (saturated: _count)
+        return None
+    return {
+        "h": np.array([h]),
+        "dxi": np.array([1.0 / per_a_H]),
+        "n_elem": np.array([math.ceil(n_elem)], dtype=np.int64),
+        "max_steps": np.array([math.ceil(max_steps)], dtype=np.int64),
+    }
+
+
+def _at_least_1(x: float) -> float:
+    """``np.maximum(1.0, x)`` of a float (NaN stays NaN)."""
+    return 1.0 if x <= 1.0 else x
 
 
 def _arm_sum(x: np.ndarray) -> np.ndarray:
