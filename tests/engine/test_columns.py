@@ -181,3 +181,52 @@ def test_tolerance_is_refused_for_the_seed_memory():
     assert df.status.tolist() == ["tolerance_unreachable", "ok"]
     assert "tolerance = 0.001" in df.error[0] and math.isnan(df.beta_x[0])
     assert v.simulate(seed, FAST).status == "ok"
+
+
+def test_one_row_q1_q2_are_the_column_values():
+    """Q_row (simulate()'s scalar form) gives exactly Q1[0], Q2[0] for every model, with
+    and without an arm column (a standard solid or Prony series given without arms)."""
+    from vimpact.engine.columns import SceneColumns
+
+    mats = [v.Material.elastic(nu=0.3, E=1e9), v.Material.kelvin_voigt(nu=0.5, E=5e10, eta=1e5),
+            v.Material.standard_solid(nu=0.4, G1=1e9, G2=3e9, eta=4e6),
+            v.Material.prony(nu=0.5, G_inf=1e9, arms=[(2e9, 1e-4), (1e9, 1e-2)], eta0=3e3)]
+    batches = [SceneColumns.from_scenes([v.Scene(mat, R=0.01, m=0.03, v_z0=1.0)])
+               for mat in mats]
+    for model in ("standard_solid", "prony", "kelvin_voigt", "elastic"):  # no arm column
+        batches.append(SceneColumns.from_columns({
+            "nu": [0.4], "G_inf_Pa": [1e9], "eta0_Pa_s": [2e3], "R_m": [0.01],
+            "m_kg": [0.03], "v_z0_m_s": [1.0], "model": np.array([model], dtype=object)}))
+    for cols in batches:
+        q1, q2 = cols.Q_row()
+        for got, want in ((q1, cols.Q1[0]), (q2, cols.Q2[0])):
+            assert type(got) is type(want)
+            assert got == want or (math.isnan(got) and math.isnan(want)), (got, want)
+
+
+def test_refinement_of_one_tangential_flag_is_that_of_its_mask():
+    """The element path's refinement with one tangential flag for all rows gives the
+    factors of the row mask holding that flag, bit for bit (with and without arms; on
+    one row without arms simulate()'s scalar form against the array form)."""
+    from vimpact.engine import discretization
+    from vimpact.engine.columns import SceneColumns
+    from vimpact.kernels.layout import EULER, VERLET
+
+    kv = v.Material.kelvin_voigt(nu=0.5, E=5e10, eta=1e5)
+    sls = v.Material.standard_solid(nu=0.4, G1=1e9, G2=3e9, eta=4e6)
+    scenes = [v.Scene(kv, R=0.2, m=10.0, v_z0=10.0, v_x0=5.0, mu=0.3),
+              v.Scene(kv, R=0.2, m=10.0, v_z0=3.0, v_x0=-1.0, Theta=1e-3 * 10.0 * 0.2**2),
+              v.Scene(sls, R=0.01, m=0.03, v_z0=1.0, v_x0=0.5)]
+    for rows in [scenes[0]], [scenes[1]], scenes[:2], scenes[2:], scenes:
+        cols = SceneColumns.from_scenes(rows)
+        for flag in (False, True):
+            for integrator in (VERLET, EULER):
+                for numerics in (v.Numerics(), v.Numerics.preset("fast")):
+                    got = discretization.element_row(cols, numerics, flag, integrator)
+                    if cols.G_arm.shape == (1, 0):  # simulate()'s scalar form answered
+                        assert discretization._element_row_one(
+                            cols, numerics, flag, integrator) is not None
+                    want = discretization.element_row(
+                        cols, numerics, np.full(len(cols), flag), integrator)
+                    for key in want:
+                        assert np.array_equal(got[key], want[key]), (key, flag)

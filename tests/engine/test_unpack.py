@@ -95,3 +95,31 @@ def test_unpack_row_is_unpack_of_one_row():
     # the rows above reach the statuses unpack decides itself
     assert {"ok", "unstable", "energy_gain", "not_passive", "unresolved", "half_space",
             "normal_only", "vc0_zero", "non_finite", "too_costly"} <= statuses
+
+
+def test_unpack_row_where_python_floats_raise():
+    """Rows whose arithmetic divides by zero or overflows (Python floats raise where
+    NumPy gives inf or NaN): unpack_row still gives exactly what unpack gives."""
+    from vimpact.engine.columns import SceneColumns
+    from vimpact.engine.result import RESULT_FIELDS
+    from vimpact.engine.unpack import unpack, unpack_row
+    from vimpact.kernels import layout
+
+    rows = []
+    for vz_end, vc_end, t_contact in ((1.0, 0.5, 0.0), (-0.5, 1e200, 2.0), (0.0, 0.0, 0.0),
+                                      (1.0, 1.0, 1.0)):
+        row = np.zeros(layout.N_OUT)
+        row[layout.OUT_VZ_END], row[layout.OUT_VC_END] = vz_end, vc_end
+        row[layout.OUT_T_CONTACT], row[layout.OUT_T_GROSS_SLIP] = t_contact, 0.5
+        rows.append(row)
+    for scene in _scenes():
+        cols = SceneColumns.from_scenes([scene])
+        for row in rows:
+            want = unpack(cols, row[None, :], np.array(["p"], dtype=object), np.array([False]),
+                          np.array([50.0]), np.full(1, None, dtype=object))
+            got = unpack_row(cols, row, "p", False, 50.0, None)
+            for name in RESULT_FIELDS:
+                w = want[name][0]
+                w = w.item() if hasattr(w, "item") else w
+                assert type(got[name]) is type(w), (name, got[name], w)
+                assert got[name] == w or (got[name] != got[name] and w != w), (name, got, w)

@@ -229,6 +229,23 @@ class SceneColumns:
             q2 = np.where(G2 > 0.0, self.G_inf / np.where(G2 > 0.0, G2, 1.0), np.inf)
         return np.where(self.model == MODEL_STANDARD_SOLID, q2, np.nan)
 
+    def Q_row(self) -> tuple[float, float]:
+        """:attr:`Q1` and :attr:`Q2` of a one-row batch (row 0), as NumPy scalars.
+
+        The same rules on scalars (the same floating-point operations, so the same
+        numbers) for :func:`vimpact.simulate`, where the array forms cost more than the
+        arithmetic; with an arm column the array forms themselves.
+        """
+        if self.G_arm.shape[1]:
+            return self.Q1[0], self.Q2[0]
+        model = self.model[0]
+        if model == MODEL_PRONY:
+            q1 = np.float64(np.nan)
+        else:  # no arm column: a standard solid's arm viscosity is a sum of none
+            viscous = np.float64(0.0) if model == MODEL_STANDARD_SOLID else self.dashpot_time[0]
+            q1 = Q1_PER_TAU * viscous / self.T[0]
+        return q1, np.float64(np.inf if model == MODEL_STANDARD_SOLID else np.nan)
+
     def take(self, index) -> SceneColumns:
         """Return the rows ``index`` (an integer array or a mask) as a new batch."""
         fields = {k: getattr(self, k)[index] for k in _FIELDS}
@@ -241,7 +258,7 @@ class SceneColumns:
         n = len(scenes)
         k = max((len(s.material.arms) for s in scenes if isinstance(s, Scene)), default=0)
         G_arm, tau_arm = np.zeros((n, k)), np.zeros((n, k))
-        reasons = np.full(n, None, dtype=object)
+        reasons = np.empty(n, dtype=object)  # (NumPy fills an object array with None)
         numbers, codes, flags = [], [], []  # a tuple per row, one array each at the end
         bad = False
         for i, s in enumerate(scenes):
@@ -305,7 +322,7 @@ class SceneColumns:
         if missing:
             raise InputError(f"scene columns {', '.join(missing)} are required "
                              f"(given: {', '.join(names) or 'none'})")
-        reasons = np.full(n, None, dtype=object)
+        reasons = np.empty(n, dtype=object)  # (NumPy fills an object array with None)
         num = {}
         for name, (rule, default) in NUMERIC.items():
             values = arrays.get(name, np.full(n, default))

@@ -6,6 +6,8 @@ one rule for the kernels, the NumPy reference and the benchmarks.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from vimpact.kernels.layout import EULER
@@ -35,7 +37,7 @@ def stiffness_ratio(cols) -> np.ndarray:
     return 1.0 + _arm_sum(g * tau / (tau + cols.t_H[:, None]))
 
 
-def refinement(cols, numerics: Numerics, tangential: np.ndarray, integrator: int
+def refinement(cols, numerics: Numerics, tangential: np.ndarray | bool, integrator: int
                ) -> tuple[np.ndarray, np.ndarray]:
     """Return the factors (>= 1) refining the time step and the element spacing, per row.
 
@@ -61,24 +63,40 @@ def refinement(cols, numerics: Numerics, tangential: np.ndarray, integrator: int
     - Stability of the explicit kicks: ``h omega <= 1/2`` for the stiffest
       spring on the scale of one step (all arms slower than the step).
     """
-    r = stiffness_ratio(cols)
-    time_factor, element_factor = r ** 0.4, r ** 0.2
-    stiff_t = np.where(tangential, cols.kappa * cols.contact_mass_factor, 0.0)
-    time_factor = time_factor * np.where(tangential, np.maximum(1.0, np.sqrt(stiff_t)), 1.0)
-    element_factor = element_factor * np.where(
-        tangential, np.maximum(1.0, (stiff_t / SOLID_SPHERE_STIFFNESS) ** 0.25), 1.0)
     arms = cols.G_arm.shape[1] > 0  # (without an arm column its terms are 0: not computed)
-    g = cols.G_arm / cols.G_inf[:, None]
-    tau_T = cols.tau_arm / cols.T[:, None]
+    if arms:
+        r = stiffness_ratio(cols)
+        time_factor, element_factor = r ** 0.4, r ** 0.2
+    else:  # r = 1 exactly, and 1 ** y = 1
+        time_factor = element_factor = np.ones(cols.G_inf.shape[0])
+    if isinstance(tangential, (bool, np.bool_)):  # one value for all rows (the element path)
+        # the same numbers as the masks below, without the masks (where, factors of 1)
+        stiff_t = cols.kappa * cols.contact_mass_factor if tangential else 0.0
+        if tangential:
+            time_factor = time_factor * np.maximum(1.0, np.sqrt(stiff_t))
+            element_factor = element_factor * np.maximum(
+                1.0, (stiff_t / SOLID_SPHERE_STIFFNESS) ** 0.25)
+    else:
+        stiff_t = np.where(tangential, cols.kappa * cols.contact_mass_factor, 0.0)
+        time_factor = time_factor * np.where(tangential, np.maximum(1.0, np.sqrt(stiff_t)), 1.0)
+        element_factor = element_factor * np.where(
+            tangential, np.maximum(1.0, (stiff_t / SOLID_SPHERE_STIFFNESS) ** 0.25), 1.0)
+    if arms:
+        g = cols.G_arm / cols.G_inf[:, None]
+        tau_T = cols.tau_arm / cols.T[:, None]
     h = HERTZ_TIME_FACTOR / numerics.steps / time_factor
-    viscous = _arm_sum(np.where(tau_T < h[:, None], g * tau_T, 0.0)) if arms else 0.0
-    if integrator == EULER:
-        viscous = viscous + cols.dashpot_time / cols.T
-    rate = 15.0 / 8.0 * viscous * numerics.row_width * np.maximum(1.0, stiff_t)
-    time_factor = time_factor * np.maximum(1.0, h * rate)
-    h = HERTZ_TIME_FACTOR / numerics.steps / time_factor
+    stiff_floor = np.maximum(1.0, stiff_t)
+    # without arms and with an implicit dashpot no viscous term is explicit: h C = 0, a
+    # factor of 1 (an infinite stiff_t gives NaN either way), not computed
+    if arms or integrator == EULER:
+        viscous = _arm_sum(np.where(tau_T < h[:, None], g * tau_T, 0.0)) if arms else 0.0
+        if integrator == EULER:
+            viscous = viscous + cols.dashpot_time / cols.T
+        rate = 15.0 / 8.0 * viscous * numerics.row_width * stiff_floor
+        time_factor = time_factor * np.maximum(1.0, h * rate)
+        h = HERTZ_TIME_FACTOR / numerics.steps / time_factor
     springs = 1.0 + (_arm_sum(np.where(tau_T >= h[:, None], g, 0.0)) if arms else 0.0)
-    omega = np.sqrt(15.0 / 8.0 * numerics.row_width * springs * np.maximum(1.0, stiff_t))
+    omega = np.sqrt(15.0 / 8.0 * numerics.row_width * springs * stiff_floor)
     time_factor = time_factor * np.maximum(1.0, 2.0 * h * omega)
     return time_factor, element_factor
 
@@ -88,17 +106,24 @@ def time_limit(cols, numerics: Numerics) -> np.ndarray:
 
     ``max_time`` Hertz times, stretched by the slow creep back of a viscous surface.
     """
-    viscous = cols.dashpot_time + _arm_sum(cols.G_arm * cols.tau_arm) / cols.G_inf  # s
+    viscous = cols.dashpot_time  # s (+ the arms'; without an arm column a sum of none)
+    if cols.G_arm.shape[1]:
+        viscous = viscous + _arm_sum(cols.G_arm * cols.tau_arm) / cols.G_inf
     stretch = np.minimum(10.0 * viscous / cols.T, MAX_TIME_STRETCH)
     return numerics.max_time * HERTZ_TIME_FACTOR * (1.0 + stretch)
 
 
-def element_row(cols, numerics: Numerics, tangential: np.ndarray, integrator: int) -> dict:
+def element_row(cols, numerics: Numerics, tangential: np.ndarray | bool, integrator: int
+                ) -> dict:
     """Return the element row and time step of each row, kernel units.
 
     Step ``h`` / T, element spacing ``dxi`` / a_H, elements in the half row
     ``n_elem`` and the time limit in steps ``max_steps``, per row.
     """
+    if isinstance(tangential, bool) and cols.G_arm.shape == (1, 0):
+        row = _element_row_one(cols, numerics, tangential, integrator)
+        if row is not None:
+            return row
     time_factor, element_factor = refinement(cols, numerics, tangential, integrator)
     h = HERTZ_TIME_FACTOR / numerics.steps / time_factor
     per_a_H = np.ceil(numerics.elements * element_factor)
@@ -108,6 +133,58 @@ def element_row(cols, numerics: Numerics, tangential: np.ndarray, integrator: in
         "n_elem": _count(numerics.row_width * per_a_H),
         "max_steps": _count(time_limit(cols, numerics) / h),
     }
+
+
+def _element_row_one(cols, numerics: Numerics, tangential: bool, integrator: int
+                     ) -> dict | None:
+    """:func:`element_row` of one row without an arm column, on Python floats.
+
+    :func:`refinement` and :func:`time_limit` with their terms of no arm (factors
+    of 1, sums of none) left out and the rest in the same operations in the same
+    order on the row's values (IEEE arithmetic and square roots: the same numbers;
+    the one power stays a NumPy array operation, whose SIMD result can differ from
+    the C library's in the last bit), for :func:`vimpact.simulate`, where the array
+    operations cost more than the arithmetic. ``None`` if a value is not finite:
+    the array form then decides (``tests/engine/test_columns.py`` checks the two agree).
+    """
+    stiff_t = float(cols.kappa[0]) * float(cols.contact_mass_factor[0]) if tangential else 0.0
+    time_factor = element_factor = 1.0
+    if tangential:
+        time_factor = _at_least_1(math.sqrt(stiff_t))
+        element_factor = _at_least_1(
+            float((np.array([stiff_t / SOLID_SPHERE_STIFFNESS]) ** 0.25)[0]))
+    h = HERTZ_TIME_FACTOR / numerics.steps / time_factor
+    stiff_floor = _at_least_1(stiff_t)
+    T = float(cols.T[0])
+    dashpot_T = float(cols.dashpot_time[0]) / T
+    if integrator == EULER:
+        rate = 15.0 / 8.0 * (0.0 + dashpot_T) * numerics.row_width * stiff_floor
+        time_factor = time_factor * _at_least_1(h * rate)
+        h = HERTZ_TIME_FACTOR / numerics.steps / time_factor
+    omega = math.sqrt(15.0 / 8.0 * numerics.row_width * 1.0 * stiff_floor)
+    time_factor = time_factor * _at_least_1(2.0 * h * omega)
+    h = HERTZ_TIME_FACTOR / numerics.steps / time_factor
+    per_a_H = numerics.elements * element_factor
+    stretch = 10.0 * float(cols.dashpot_time[0]) / T
+    limit = numerics.max_time * HERTZ_TIME_FACTOR * (
+        1.0 + (MAX_TIME_STRETCH if stretch > MAX_TIME_STRETCH else stretch))  # (NaN stays)
+    if not all(map(math.isfinite, (h, per_a_H, limit, limit / h))):
+        return None
+    per_a_H = float(math.ceil(per_a_H))
+    n_elem, max_steps = numerics.row_width * per_a_H, limit / h
+    if n_elem > 2.0**62 or max_steps > 2.0**62:  # (saturated: _count)
+        return None
+    return {
+        "h": np.array([h]),
+        "dxi": np.array([1.0 / per_a_H]),
+        "n_elem": np.array([math.ceil(n_elem)], dtype=np.int64),
+        "max_steps": np.array([math.ceil(max_steps)], dtype=np.int64),
+    }
+
+
+def _at_least_1(x: float) -> float:
+    """``np.maximum(1.0, x)`` of a float (NaN stays NaN)."""
+    return 1.0 if x <= 1.0 else x
 
 
 def _arm_sum(x: np.ndarray) -> np.ndarray:

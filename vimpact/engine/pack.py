@@ -52,8 +52,6 @@ def element_arrays(cols: SceneColumns, numerics: Numerics, spec: KernelSpec) -> 
     mass factor, ``mu`` friction in tangential units (``mu v_z0 / |v_c0|``),
     ``h`` step, ``n_elem``/``dxi`` the half row, ``max_steps`` the time limit.
     """
-    n = len(cols)
-    tangential = np.full(n, bool(spec.tangential))
     g, tau, n_arms = arm_arrays(cols, spec.arms)
     with np.errstate(divide="ignore"):
         mu = np.where(np.isfinite(cols.mu), cols.mu * cols.v_z0 / np.abs(cols.v_c0), np.inf)
@@ -66,7 +64,7 @@ def element_arrays(cols: SceneColumns, numerics: Numerics, spec: KernelSpec) -> 
         "mu_t": cols.contact_mass_factor,
         "mu": mu,
     }
-    a.update(discretization.element_row(cols, numerics, tangential, spec.integrator))
+    a.update(discretization.element_row(cols, numerics, bool(spec.tangential), spec.integrator))
     return a
 
 

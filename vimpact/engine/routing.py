@@ -17,6 +17,7 @@ A scene names its effects (tangential problem or not, rotation, rheology);
 from __future__ import annotations
 
 import functools
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -155,19 +156,27 @@ _ONE_ROW: dict = {}
 def _route_row(cols: SceneColumns, numerics: Numerics) -> Routes:
     """:func:`route` of a one-row batch (:func:`vimpact.simulate`), on Python scalars.
 
-    The same masks (:func:`friction_rows`, :func:`continuum_stick`) and the same key
-    as :func:`route`, without the array arithmetic that costs more than the rest of
-    the call on one row; ``tests/engine/test_routing.py`` checks the two agree.
+    The same rules (:func:`friction_rows`, :func:`continuum_stick`, on the row's
+    scalars) and the same key as :func:`route`, without the array arithmetic that
+    costs more than the rest of the call on one row; ``tests/engine/test_routing.py``
+    checks the two agree.
     """
     if cols.reasons[0] is not None:
         path = None
     else:
         tangential = bool(cols.computes_tangential[0])
         arms = bool(cols.has_arms[0])
-        friction_mask = cols.computes_tangential & friction_rows(cols)
-        friction = bool(friction_mask[0])
+        friction = False  # friction_rows on the row's scalars (the same operations)
+        mu = cols.mu[0]
+        if tangential and math.isfinite(mu):
+            with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+                psi = cols.kappa[0] / mu * abs(cols.v_c0[0]) / cols.v_z0[0]
+            friction = bool(psi >= PSI_FULL_STICK)
+        incremental = cols.memory[0] == TANGENTIAL_MEMORY.index("incremental")
         continuum = not arms and not tangential and numerics.continuum
-        stick = not continuum and bool(continuum_stick(cols, numerics, friction_mask)[0])
+        # continuum_stick of a valid row
+        stick = (not continuum and numerics.continuum and not friction
+                 and (incremental or not tangential))
         kind = 1 if continuum else 2 if stick else 0
         key = (kind << 5 if kind else
                tangential << 4 | (int(cols.memory[0]) if tangential else 0) << 3 | arms << 2

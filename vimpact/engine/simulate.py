@@ -99,15 +99,15 @@ def _run(cols: SceneColumns, numerics: Numerics, n_rec: int, rec_every: int,
     routes = route(cols, numerics)
     out = np.zeros((n, layout.N_OUT))
     rec = np.zeros((n, n_rec, layout.N_REC))
-    path_names = np.full(n, None, dtype=object)
+    path_names = np.empty(n, dtype=object)  # (NumPy fills an object array with None)
     explicit_euler = np.zeros(n, dtype=bool)
     steps_per_T = np.zeros(n)
-    refused = np.full(n, None, dtype=object)
+    refused = np.empty(n, dtype=object)
     kernel_s = 0.0
     # one row runs on a serial kernel (run_path): no thread to count or to set
     threads = _threads() if n > 1 else 1
     if n == 1:  # (one scene: simulate(); np.flatnonzero costs more than the rest of this)
-        queue = [(routes.paths[0], np.zeros(1, dtype=np.int64))] if routes.paths else []
+        queue = [(routes.paths[0], _ROW_0)] if routes.paths else []
     else:
         queue = [(path, np.flatnonzero(routes.group == k)) for k, path in enumerate(routes.paths)]
     while queue:
@@ -116,8 +116,14 @@ def _run(cols: SceneColumns, numerics: Numerics, n_rec: int, rec_every: int,
         if path.spec is not None:
             arrays = element_arrays(_rows(cols, idx), numerics, path.spec)
             per_t_H = HERTZ_TIME_FACTOR / arrays["h"]
-            costly = (per_t_H > MAX_STEPS_PER_T_H) | (arrays["n_elem"] > MAX_ELEMENTS_IN_ROW)
-            n_costly = int(np.count_nonzero(costly))  # (cheaper than any() and flatnonzero)
+            if len(idx) == 1:  # (the same test on the row's scalars: cheaper on one row)
+                n_costly = int(per_t_H[0] > MAX_STEPS_PER_T_H
+                               or arrays["n_elem"][0] > MAX_ELEMENTS_IN_ROW)
+                costly = _ONE_COSTLY[n_costly]
+            else:
+                costly = ((per_t_H > MAX_STEPS_PER_T_H)
+                          | (arrays["n_elem"] > MAX_ELEMENTS_IN_ROW))
+                n_costly = int(np.count_nonzero(costly))  # (cheaper than any() and flatnonzero)
             for j in np.flatnonzero(costly) if n_costly else ():
                 refused[idx[j]] = ("too_costly",
                     f"this scene needs {per_t_H[j]:.3g} steps per Hertz time and "
@@ -129,10 +135,14 @@ def _run(cols: SceneColumns, numerics: Numerics, n_rec: int, rec_every: int,
             if why is not None:
                 for j in np.flatnonzero(~costly):
                     refused[idx[j]] = ("tolerance_unreachable", why)
-                costly[:] = True
+                costly = np.ones(len(costly), dtype=bool)  # (new: _ONE_COSTLY is read-only)
                 n_costly = len(costly)
-            explicit_euler[idx] = path.spec.integrator == layout.EULER
-            steps_per_T[idx] = 1.0 / arrays["h"]
+            if len(idx) == 1:  # (one row: scalar stores, the same numbers)
+                explicit_euler[idx[0]] = path.spec.integrator == layout.EULER
+                steps_per_T[idx[0]] = 1.0 / arrays["h"][0]
+            else:
+                explicit_euler[idx] = path.spec.integrator == layout.EULER
+                steps_per_T[idx] = 1.0 / arrays["h"]
             if n_costly:
                 idx = idx[~costly]
                 arrays = {key: value[~costly] for key, value in arrays.items()}
@@ -174,6 +184,16 @@ def _run(cols: SceneColumns, numerics: Numerics, n_rec: int, rec_every: int,
     if timings is not None:
         timings["kernel_s"] = timings.get("kernel_s", 0.0) + kernel_s
     return out, rec, path_names, explicit_euler, steps_per_T, refused
+
+
+def _read_only(a: np.ndarray) -> np.ndarray:
+    a.flags.writeable = False
+    return a
+
+
+#: the row index of a one-row batch, and its "too costly" masks (shared: never written)
+_ROW_0 = _read_only(np.zeros(1, dtype=np.int64))
+_ONE_COSTLY = (_read_only(np.zeros(1, dtype=bool)), _read_only(np.ones(1, dtype=bool)))
 
 
 def _threads() -> int:
