@@ -143,7 +143,8 @@ class Scene:
         mat = self.material
         with np.errstate(all="ignore"):
             hz = hertz_scales(mat.G_inf, mat.nu, self.R, self.m, self.v_z0)
-            ratio = self.Theta / (self.m * self.R**2) if math.isfinite(self.R**2 * self.m) else 0.0
+            theta = float(self.Theta or 0.0)  # set above: positive, never None here
+            ratio = theta / (self.m * self.R**2) if math.isfinite(self.R**2 * self.m) else 0.0
             m, v_z0, v_x0, omega0 = (np.float64(x) for x in (self.m, self.v_z0, self.v_x0,
                                                              self.omega0))  # inf, not OverflowError
             energy = m * (v_z0**2 + v_x0**2) + np.float64(self.Theta) * omega0**2

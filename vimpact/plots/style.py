@@ -7,8 +7,12 @@ from __future__ import annotations
 
 import contextlib
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 from vimpact.tableformat.files import atomic_file, refuse_symlink
+
+if TYPE_CHECKING:  # matplotlib's names of rc keys, for the checker only
+    from matplotlib.typing import RcKeyType
 
 __all__ = ["FORMATS", "STYLE", "check_out", "drawing"]
 
@@ -16,7 +20,7 @@ __all__ = ["FORMATS", "STYLE", "check_out", "drawing"]
 FORMATS = (".png", ".svg", ".pdf")
 
 #: Sizes readable in print at about 8 cm to 16 cm width.
-STYLE = {
+STYLE: dict[RcKeyType, Any] = {
     "font.size": 11,
     "axes.titlesize": 12,
     "axes.labelsize": 12,
