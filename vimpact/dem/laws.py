@@ -456,12 +456,28 @@ def mfix_coulomb(zeta: float, w_t: float, zeta_t, F: float, mu: float, w0,
         ux = ux - h * ft
         om = om + h * spin * ft
         x = x + h * v
-        ended = live & (x <= 0.0)
-        e[ended] = -v[ended]
-        wend[ended] = (ux - om)[ended]
-        live &= ~ended
-        if not live.any():
+        if _record_ended(live, x, v, ux, om, e, wend):
             break
+    return _stepped_result(live, e, wend, w0, shape)
+
+
+def _record_ended(live: np.ndarray, x: np.ndarray, v: np.ndarray, ux: np.ndarray,
+                  om: np.ndarray, e: np.ndarray, wend: np.ndarray) -> bool:
+    """Record the contacts whose overlap ``x`` is back to zero; return True when none is live.
+
+    Their normal restitution ``e = -v`` and contact-point velocity ``ux - om`` are
+    written into ``e`` and ``wend``, and they leave ``live`` (all updated in place).
+    """
+    ended = live & (x <= 0.0)
+    e[ended] = -v[ended]
+    wend[ended] = (ux - om)[ended]
+    live &= ~ended
+    return not live.any()
+
+
+def _stepped_result(live: np.ndarray, e: np.ndarray, wend: np.ndarray, w0: np.ndarray,
+                    shape: tuple) -> tuple[np.ndarray, np.ndarray]:
+    """Return ``(e, beta = -w_end / w0)`` in ``shape``; refuse a contact that never ended."""
     if live.any():
         raise RuntimeError("stepped contact law did not end its contact")
     return e.reshape(shape), (-wend / w0).reshape(shape)
@@ -510,15 +526,9 @@ def _stepped(alpha: np.ndarray, w0: np.ndarray, mu: float, steps: int, force, F:
         v = v_half - 0.5 * h * an
         ux = ux_half - 0.5 * h * at
         om = om_half + 0.5 * h * arm * spin * at
-        ended = live & (x <= 0.0)
-        e[ended] = -v[ended]
-        wend[ended] = (ux - om)[ended]
-        live &= ~ended
-        if not live.any():
+        if _record_ended(live, x, v, ux, om, e, wend):
             break
-    if live.any():
-        raise RuntimeError("stepped contact law did not end its contact")
-    return e.reshape(shape), (-wend / w0).reshape(shape)
+    return _stepped_result(live, e, wend, w0, shape)
 
 
 # ---- Tsuji-type Hertz (LIGGGHTS) ----------------------------------------
