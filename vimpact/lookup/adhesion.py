@@ -26,7 +26,6 @@ holds the ranges and the error measured against direct simulation
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import numpy as np
@@ -34,7 +33,7 @@ import pandas as pd
 
 from vimpact.lookup.interpolate import HermiteGrid
 from vimpact.model.validation import InputError
-from vimpact.tableformat.metadata import META_PREFIX, read_metadata
+from vimpact.tableformat.metadata import META_PREFIX, decode_value, read_metadata
 
 __all__ = ["KIND", "AdhesionTable", "is_adhesion_table"]
 
@@ -101,25 +100,14 @@ class AdhesionTable:
 
     def save(self, path) -> Path:
         """Write the rows and metadata as Parquet (atomically, with checksums and hashes)."""
-        import pyarrow as pa
+        from vimpact.tableformat.files import write_frame
 
-        from vimpact.tableformat.files import write_atomic
-
-        arrow = pa.Table.from_pandas(self.data, preserve_index=False)
-        meta = dict(arrow.schema.metadata or {})
-        meta.update({k.encode(): v.encode() for k, v in self.metadata.items()})
-        write_atomic(arrow.replace_schema_metadata(meta), Path(path))
-        return Path(path)
+        return write_frame(self.data, self.metadata, Path(path))
 
     def meta(self, key: str, default=None):
-        """Return the metadata entry ``vimpact.<key>``, JSON decoded where it is JSON."""
+        """Return the metadata entry ``vimpact.<key>``, decoded by the table format's codec."""
         text = self.metadata.get(META_PREFIX + key)
-        if text is None:
-            return default
-        try:
-            return json.loads(text)
-        except ValueError:
-            return text
+        return default if text is None else decode_value(key, text)
 
     # ---- ranges ------------------------------------------------------------------
     @property

@@ -196,18 +196,11 @@ class RestitutionTable:
 
     def save(self, path) -> Path:
         """Write the table as Parquet with its ``vimpact.*`` metadata (what :meth:`open` reads)."""
-        import pyarrow as pa
+        from vimpact.tableformat.files import write_frame
 
-        from vimpact.tableformat.files import write_atomic
-
-        arrow = pa.Table.from_pandas(self.data, preserve_index=False)
-        meta = dict(arrow.schema.metadata or {})
-        meta[(META_PREFIX + "model").encode()] = self.model.encode()  # what open() requires
-        meta.update({k.encode(): v.encode() for k, v in self.metadata.items()})
-        # atomically, with page checksums and fresh content/metadata hashes (the stored
-        # ones describe the file this table was read from, not these columns)
-        write_atomic(arrow.replace_schema_metadata(meta), Path(path))
-        return Path(path)
+        # the model first, as open() requires it; the table's own entries may repeat it
+        return write_frame(self.data, {META_PREFIX + "model": self.model, **self.metadata},
+                           Path(path))
 
     # ---- metadata --------------------------------------------------------
     def meta(self, key: str, default=None):

@@ -98,6 +98,22 @@ def atomic_file(path, name: str = "--out", mode: str = "wb"):
     fsync_dir(path.parent)
 
 
+def write_frame(data, metadata: dict[str, str], path: Path) -> Path:
+    """Write the DataFrame ``data`` with the Parquet key-value ``metadata`` (text) to ``path``.
+
+    Through :func:`write_atomic`: atomically, with page checksums and fresh content
+    and metadata hashes (stored hashes describe the file a table was read from, not
+    these columns). Returns ``path``.
+    """
+    import pyarrow as pa
+
+    arrow = pa.Table.from_pandas(data, preserve_index=False)
+    meta = dict(arrow.schema.metadata or {})
+    meta.update({k.encode(): v.encode() for k, v in metadata.items()})
+    write_atomic(arrow.replace_schema_metadata(meta), Path(path))
+    return Path(path)
+
+
 def write_atomic(table, path: Path, *, schema_only: bool = False, more=(),
                  content_sha256: str | None = None, recheck: bool = False) -> None:
     """Write the ``pyarrow`` ``table`` (or only its schema) to ``path`` atomically.

@@ -20,7 +20,7 @@ META_PREFIX = "vimpact."
 #: Metadata keys stored as JSON.
 JSON_KEYS = ("numerics", "units", "columns", "statuses", "paths", "rotation", "counts",
              "grid_tolerance", "grid_refinement", "interpolation_error", "grid_levels",
-             "adaptive", "build", "kelvin_voigt_limit")
+             "adaptive", "build", "kelvin_voigt_limit", "lam_range")
 #: Metadata keys stored as integers.
 INT_KEYS = ("schema_version", "seed", "rows", "chunk", "row_start", "row_stop", "n_chunks",
             "chunk_size")
