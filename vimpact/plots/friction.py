@@ -20,22 +20,13 @@ from pathlib import Path
 import numpy as np
 
 from vimpact.engine.simulate import simulate_batch
+from vimpact.lookup.friction import chi as mindlin_chi
 from vimpact.model.numerics import Numerics
 from vimpact.model.scene import REFERENCE_INDENTATION
 from vimpact.plots.style import drawing
 
 #: Numerics of these figures: about 1e-3 on beta_x, so that a figure takes seconds.
 FIGURE_NUMERICS = Numerics.preset("fast")
-
-
-def incidence(nu: float, mu: float, v_c, v_z0) -> np.ndarray:
-    """``psi = 2 (1 - nu) / (mu (2 - nu)) * v_c / v_z0`` (dimensionless)."""
-    return 2.0 * (1.0 - nu) / (mu * (2.0 - nu)) * np.asarray(v_c) / np.asarray(v_z0)
-
-
-def chi_of(nu: float, theta_ratio: float) -> float:
-    """``chi = (1 - nu)(1 + m R^2/Theta) / (2 - nu)`` (dimensionless)."""
-    return (1.0 - nu) * (1.0 + 1.0 / theta_ratio) / (2.0 - nu)
 
 
 def _columns(nu, G, eta, R, m, v_z0, v_x0, theta_ratio, mu) -> dict:
@@ -71,7 +62,7 @@ def fig_mbf(out) -> Path:
     psi1 = np.linspace(0.05, 8.0, 40)
     with drawing(out) as (fig, ax):
         for theta_ratio in (0.4, 1.0, 4.0):
-            chi = chi_of(nu, theta_ratio)
+            chi = mindlin_chi(nu, theta_ratio)
             psi2 = _exit_incidence(nu, theta_ratio, 0.0, psi1)
             line, = ax.plot(psi1, psi2, marker="o", ms=3,
                             label=rf"$\chi$ = {chi:.3g} ($\Theta/mR^2$ = {theta_ratio:g})")
@@ -92,7 +83,7 @@ def fig_beta_psi(out) -> Path:
         for Q1 in (0.0, 0.01, 0.1, 0.5):
             beta = -_exit_incidence(nu, theta_ratio, Q1, psi1) / psi1
             ax.semilogx(psi1, beta, marker="o", ms=3, label=f"Q1 = {Q1:g}")
-        ax.axvline(4.0 * chi_of(nu, theta_ratio), color="0.6", ls=":", lw=1.0)
+        ax.axvline(4.0 * mindlin_chi(nu, theta_ratio), color="0.6", ls=":", lw=1.0)
         ax.set_xlabel(r"incidence $\psi$")
         ax.set_ylabel(r"$\beta_x$")
         ax.set_title(r"tangential restitution with friction ($\nu$ = 0.5; dotted: $4\chi$)")
