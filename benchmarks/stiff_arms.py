@@ -15,7 +15,7 @@ For every ``rtol`` of a ladder, the continuum kernel
 (:func:`vimpact.kernels.continuum_maxwell.maxwell_stick_batch`, one numba
 thread, a batch of identical rows, median process CPU time per row) and its
 error on ``e_z`` and ``beta_x`` against the implicit scipy reference
-(``tests/oracles/maxwell_continuum_scipy.py``, LSODA at rtol 1e-12); the time to
+(``vimpact/reference/continuum_scipy.py``, LSODA at rtol 1e-12); the time to
 reach 1e-8 is the fastest rtol whose largest error is below it.
 
 Before, in the same run: the kernel as of :data:`BEFORE_COMMIT` integrated the
@@ -111,9 +111,9 @@ def _element_path(tau0, g, tau, want):
 def run(quick: bool) -> dict:
     import numba
 
-    from tests.oracles.maxwell_continuum_scipy import maxwell_continuum_reference
     from vimpact.kernels.continuum_maxwell import maxwell_stick_batch
     from vimpact.kernels.layout import N_OUT, OUT_STATUS, OUT_STEPS, OUT_VC_END, OUT_VZ_END
+    from vimpact.reference.continuum_scipy import maxwell_continuum_reference
 
     threads = numba.get_num_threads()
     numba.set_num_threads(1)

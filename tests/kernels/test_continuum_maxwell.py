@@ -2,7 +2,7 @@
 
 Oracles (nothing here was produced by the kernel): the Kelvin-Voigt closed
 form of docs/physics.md#kelvin-voigt-continuum (scipy), the Hertz contact time, an independent
-scipy implementation of section 11 (tests/oracles/maxwell_continuum_scipy.py:
+scipy implementation of section 11 (vimpact/reference/continuum_scipy.py:
 time as the unloading variable, the edge by brentq), the element rows refined
 and extrapolated, the mirror identity of the tangential problem, the standard
 solid's limits, Maw-Barber-Fawcett's reversal trend and passivity.
@@ -15,7 +15,6 @@ import math
 import numpy as np
 import pytest
 
-from tests.oracles.maxwell_continuum_scipy import maxwell_continuum_reference
 from vimpact.kernels.continuum_maxwell import maxwell_stick_batch, maxwell_stick_impact
 from vimpact.kernels.layout import (
     N_OUT,
@@ -38,6 +37,7 @@ from vimpact.kernels.layout import (
 )
 from vimpact.model.hertz import HERTZ_TIME_FACTOR, Q1_PER_TAU
 from vimpact.reference.closed_forms import kelvin_voigt_continuum
+from vimpact.reference.continuum_scipy import maxwell_continuum_reference
 
 MAX_STEPS = 1_000_000
 NO_REC = np.zeros((0, N_REC))

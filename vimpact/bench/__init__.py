@@ -40,7 +40,7 @@ BENCHMARKS: dict[str, str] = {
     "sweep_backends": "vimpact.bench.sweep_backends",
     "lookup": "vimpact.bench.lookup",
     "adaptive_lookup": "vimpact.bench.adaptive_lookup",
-    "continuum_maxwell": "benchmarks.continuum_maxwell",
+    "continuum_maxwell": "vimpact.bench.continuum_maxwell",
     "element_orders": "vimpact.bench.element_orders",
 }
 

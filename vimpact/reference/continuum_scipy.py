@@ -32,11 +32,26 @@ GN = 15.0 / 8.0
 
 @dataclass
 class ContinuumReference:
+    """Outputs of one reference impact: ``e_z``, ``beta_x`` (dimensionless), ``t_contact`` / T."""
+
     e_z: float
     beta_x: float
     t_contact: float
     u_max: float
     t_turn: float
+
+
+class _Falling:
+    """A terminal ``solve_ivp`` event: ``fn(t, y)`` crossing zero from above."""
+
+    terminal = True
+    direction = -1
+
+    def __init__(self, fn):
+        self.fn = fn
+
+    def __call__(self, t, y):
+        return self.fn(t, y)
 
 
 def maxwell_continuum_reference(tau0: float, g, tau, kappa: float, mu_t: float,
@@ -82,10 +97,7 @@ def maxwell_continuum_reference(tau0: float, g, tau, kappa: float, mu_t: float,
         dy[6 + 3 * n:6 + 4 * n] = -U / tau * dt + (B - wc) * v
         return dy
 
-    def turn(_sig, y):
-        return y[1]
-    turn.terminal = True
-    turn.direction = -1
+    turn = _Falling(lambda _sig, y: y[1])
 
     y0 = np.zeros(6 + 4 * n)
     y0[1] = 1.0
@@ -101,7 +113,7 @@ def maxwell_continuum_reference(tau0: float, g, tau, kappa: float, mu_t: float,
     b_max = yt[0]
 
     def density(sig_e, t, u, v, A):
-        """Normal force density of the element that entered at sigma_e."""
+        """Return the normal force density of the element that entered at sigma_e."""
         h = hist(sig_e)
         ue = h[0] ** 2
         te = h[2]
@@ -140,10 +152,7 @@ def maxwell_continuum_reference(tau0: float, g, tau, kappa: float, mu_t: float,
         dz[4 + n:4 + 2 * n] = (wc - B) / tau
         return dz
 
-    def end(t, z):
-        return density(0.0, t, z[0], z[1], z[2:2 + n])
-    end.terminal = True
-    end.direction = -1
+    end = _Falling(lambda t, z: density(0.0, t, z[0], z[1], z[2:2 + n]))
 
     z0 = np.concatenate([[b_max ** 2, 0.0], yt[3:3 + n], [yt[3 + 2 * n], yt[4 + 2 * n]],
                          yt[6 + 2 * n:6 + 3 * n]])
