@@ -265,3 +265,24 @@ def test_the_build_records_the_limit_of_a_table_that_reaches_it(tmp_path):
     assert limit["Q2"] == pytest.approx(1e-5)
     assert limit["max"]["e_z"] == pytest.approx(1e-6) and limit["max"]["beta_x"] == \
         pytest.approx(5e-7)
+
+
+def test_the_band_spec_tolerance_is_far_inside_the_table_tolerance():
+    """The band is built at rtol 1e-7 (its stiff-arm impacts are expensive); at random
+    points of the band (not those its spec quotes) that is within a tenth of the table's
+    1e-5 of the same impacts at rtol 1e-11 (a convergence check of the kernel)."""
+    from vimpact.model.numerics import Numerics
+    from vimpact.sweep import load_spec
+    from vimpact.tablebuild.verify import simulate_dimensionless
+
+    spec = load_spec(ROOT / BAND_SPEC)
+    rng = np.random.default_rng(2026)
+    n = 16
+    q1, nu, q2 = 10 ** rng.uniform(-3, 2, n), rng.uniform(0, 0.5, n), 10 ** rng.uniform(-5, -3, n)
+    band = simulate_dimensionless("standard_solid", q1, nu, q2, numerics=spec.numerics)
+    tight = simulate_dimensionless("standard_solid", q1, nu, q2,
+                                   numerics=Numerics(rtol=1e-11))
+    assert set(band["status"]) == {"ok"} == set(tight["status"])
+    for k in ("e_z", "beta_x"):
+        gap = np.max(np.abs(band[k].to_numpy() - tight[k].to_numpy()))
+        assert gap <= 0.1 * spec.grid_tolerance, (k, gap)
