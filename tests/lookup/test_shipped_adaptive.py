@@ -67,3 +67,28 @@ def test_figures_5_4_and_5_5_from_the_table_alone(table):
         assert gap <= bound[k], (k, gap, bound[k])
         if table.meta("grid_refinement")["met"]:
             assert gap <= 1e-5, (k, gap)
+
+
+def test_the_shipped_band_meets_its_neighbours_within_their_bounds(table):
+    """At the seams the two independently built tables agree within the sum of their
+    stated bounds: the main table and the band at Q2 = 1e-3, the band and the
+    Kelvin-Voigt table (plus the band's measured distance to that limit) at 1e-5."""
+    from vimpact.lookup.band import BAND_FILE, KELVIN_VOIGT_FILE
+    from vimpact.lookup.table import RestitutionTable
+
+    band_path = TABLE.parent / BAND_FILE
+    if not band_path.is_file():
+        pytest.skip("no band table beside the main one")
+    band = RestitutionTable.open(band_path)
+    kv = RestitutionTable.open(TABLE.parent / KELVIN_VOIGT_FILE)
+    rng = np.random.default_rng(7)
+    q1, nu = 10 ** rng.uniform(-3, 2, 300), rng.uniform(0, 0.5, 300)
+    main_b, band_b, kv_b = table.error_bound(), band.error_bound(), kv.error_bound()
+    at_top = band.lookup(q1, nu, Q2=np.full(300, 1e-3))
+    main = table.lookup(q1, nu, Q2=np.full(300, 1e-3))
+    at_bottom = band.lookup(q1, nu, Q2=np.full(300, 1e-5))
+    limit = kv.lookup(q1, nu)
+    gap = band.meta("kelvin_voigt_limit")["gap"]
+    for k in ("e_z", "beta_x"):
+        assert np.max(np.abs(at_top[k] - main[k])) <= main_b[k] + band_b[k]
+        assert np.max(np.abs(at_bottom[k] - limit[k])) <= band_b[k] + kv_b[k] + gap[k]
