@@ -9,7 +9,13 @@ import pytest
 
 from tests.sweep import write
 from vimpact.sweep import load_spec, parts_dir, read_metadata, run_sweep, runner
-from vimpact.sweep.spec import AUTO_CHUNK_ROWS, CHUNK_SIZE_FILE, DEFAULT_CHUNK_SIZE
+from vimpact.sweep.spec import (
+    AUTO_CHUNK_ROWS,
+    AUTO_CHUNK_SECONDS,
+    CHUNK_SIZE_FILE,
+    DEFAULT_CHUNK_SIZE,
+    ONE_CHUNK_SECONDS,
+)
 
 GRID = """
 model = "kelvin_voigt"
@@ -156,6 +162,24 @@ def test_the_rule_work_per_chunk_bounds_and_workers(tmp_path, monkeypatch):
     monkeypatch.setattr(runner, "seconds_per_row", lambda s: (1e-7, 8))
     assert runner.choose_chunk_size(small)["chunk_size"] == 40  # not more than the rows
     assert runner.choose_chunk_size(big, units=2)["chunk_size"] == 200_000 // 8
+
+
+def test_a_sweep_of_little_work_is_one_chunk(tmp_path, monkeypatch):
+    """Up to ONE_CHUNK_SECONDS of work (one process, at most AUTO_CHUNK_ROWS[1] rows) a
+    sweep is one chunk (no part written and then the table); beyond it, chunks of about
+    AUTO_CHUNK_SECONDS; with workers or shards, chunks to share."""
+    small = load_spec(write(tmp_path, GRID.format(chunk="")))  # 40 rows
+    for work, want in ((0.99 * ONE_CHUNK_SECONDS, 40),
+                       (1.01 * ONE_CHUNK_SECONDS, int(AUTO_CHUNK_SECONDS * 40 / (
+                           1.01 * ONE_CHUNK_SECONDS)))):  # 19 rows: about 1 s each
+        monkeypatch.setattr(runner, "seconds_per_row", lambda s, c=work / 40: (c, 8))
+        assert runner.choose_chunk_size(small)["chunk_size"] == want
+    # two workers: chunks to share (at least AUTO_CHUNK_ROWS[0] rows each)
+    assert runner.choose_chunk_size(small, units=2)["chunk_size"] == AUTO_CHUNK_ROWS[0]
+    big = load_spec(write(tmp_path, GRID.format(chunk="").replace("num = 20", "num = 60_000"),
+                          "big.toml"))  # 120,000 rows: more than a chunk holds
+    monkeypatch.setattr(runner, "seconds_per_row", lambda s: (1e-9, 8))
+    assert runner.choose_chunk_size(big)["chunk_size"] == AUTO_CHUNK_ROWS[1]
 
 
 def test_workers_on_a_small_sweep_says_so(tmp_path, monkeypatch, capsys):
