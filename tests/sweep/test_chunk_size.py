@@ -91,6 +91,31 @@ def test_the_chosen_size_is_recorded_and_gives_the_table_of_that_size(tmp_path, 
     assert _table(out).equals(_table(other))  # grid rows do not depend on the chunking
 
 
+def test_one_chosen_chunk_leaves_no_record_and_its_part_holds_the_size(tmp_path, monkeypatch):
+    """A chosen chunk of all the rows makes no parts directory in process (nothing to
+    resume: an interrupt leaves nothing behind); written as a part (a shard), the part's
+    metadata gives its size to --combine, which chooses nothing."""
+    made = _choose(monkeypatch, [40, 40])
+    spec = write(tmp_path, GRID.format(chunk=""))
+    out = tmp_path / "one.parquet"
+
+    def stop(done, total):
+        raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        run_sweep(spec, out=out, progress=stop)
+    assert not parts_dir(out).exists() and not out.exists()
+    table = run_sweep(spec, out=out, progress=False)
+    assert read_metadata(table)["chunk_size"] == 40 and made == [1, 1]
+    shard = tmp_path / "shard.parquet"
+    _choose(monkeypatch, [40])
+    parts = run_sweep(spec, out=shard, shard=(0, 1), progress=False)
+    assert sorted(p.name for p in parts.iterdir()) == ["part-00000.parquet"]
+    made = _choose(monkeypatch, [])  # --combine must not choose
+    run_sweep(spec, out=shard, combine=True, progress=False)
+    assert made == [] and _table(shard).equals(_table(table))
+
+
 def test_resume_uses_the_recorded_size(tmp_path, monkeypatch):
     made = _choose(monkeypatch, [7, 11])
     spec = write(tmp_path, GRID.format(chunk=""))

@@ -454,7 +454,6 @@ def _run(spec, spec_path, out, parts, resume, progress, workers, scheduler, shar
     if combine:
         _combine(spec, parts, out, log, stages)
         return out
-    parts.mkdir(parents=True, exist_ok=True)
     todo = [c for c in range(spec.n_chunks) if c not in done]
     if shard is not None:
         todo = [c for c in todo if c % shard[1] == shard[0]]
@@ -472,13 +471,17 @@ def _run(spec, spec_path, out, parts, resume, progress, workers, scheduler, shar
             if too_small:
                 print(f"vimpact sweep: {too_small}", file=sys.stderr, flush=True)
         if workers is not None or scheduler is not None:
+            parts.mkdir(parents=True, exist_ok=True)
             _run_dask(spec, todo, parts, bar, done, workers, scheduler)
         else:
             # a small file-layout table is written from its chunks in memory (parts
-            # not read back); one chunk goes straight to the table (no part)
+            # not read back); one chunk goes straight to the table (no part, no parts
+            # directory)
             if shard is None and layout == "file" and todo == list(range(spec.n_chunks)) \
                     and (spec.n_chunks == 1 or spec.rows <= store.HOLD_ROWS):
                 fresh = []
+            if spec.n_chunks > 1 or fresh is None:
+                parts.mkdir(parents=True, exist_ok=True)
             for chunk in todo:
                 table = compute_chunk(spec, chunk, timings)
                 summary = chunk_summary(table)
@@ -684,7 +687,10 @@ def chunked(spec: SweepSpec, parts: Path, choose: bool = True, units: int = 1,
     is; a grid without: the size an earlier run of the sweep recorded in ``parts``
     (:func:`recorded_chunk_size`), else, if ``choose``, one chosen now
     (:func:`choose_chunk_size`) and recorded before any chunk is made, so that
-    ``--resume``, shards and ``--combine`` cut the same chunks.
+    ``--resume``, shards and ``--combine`` cut the same chunks. One chunk of all the
+    rows is not recorded (nor is a parts directory made for it): its part, if a
+    backend writes one, holds its size in its metadata, and without a part there is
+    nothing to cut the same way.
     """
     if not spec.chooses_chunk_size:
         return spec
@@ -694,7 +700,9 @@ def chunked(spec: SweepSpec, parts: Path, choose: bool = True, units: int = 1,
             return spec
         record = {**choose_chunk_size(spec, units), "sweep_hash": spec.sweep_hash,
                   "rows": spec.rows}
-        size = _record_chunk_size(parts, record)
+        size = record["chunk_size"]
+        if size < spec.rows:
+            size = _record_chunk_size(parts, record)
         if log is not None:
             log(f"{size} rows per chunk, chosen from {record['seconds_per_row'] * 1e6:.3g} us "
                 f"per row measured (about {AUTO_CHUNK_SECONDS:g} s of work per chunk at most; "
