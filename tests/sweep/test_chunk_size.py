@@ -182,9 +182,9 @@ def test_the_rule_work_per_chunk_bounds_and_workers(tmp_path, monkeypatch):
                           "big.toml"))  # 200,000 rows
     lo, hi = AUTO_CHUNK_ROWS
     for cost, want in ((1e-7, hi), (1e-1, lo), (1e-3, 1000)):
-        monkeypatch.setattr(runner, "seconds_per_row", lambda s, cost=cost: (cost, 8))
+        monkeypatch.setattr(runner, "seconds_per_row", lambda s, cost=cost, **_: (cost, 8))
         assert runner.choose_chunk_size(big)["chunk_size"] == want
-    monkeypatch.setattr(runner, "seconds_per_row", lambda s: (1e-7, 8))
+    monkeypatch.setattr(runner, "seconds_per_row", lambda s, **_: (1e-7, 8))
     assert runner.choose_chunk_size(small)["chunk_size"] == 40  # not more than the rows
     assert runner.choose_chunk_size(big, units=2)["chunk_size"] == 200_000 // 8
 
@@ -197,14 +197,34 @@ def test_a_sweep_of_little_work_is_one_chunk(tmp_path, monkeypatch):
     for work, want in ((0.99 * ONE_CHUNK_SECONDS, 40),
                        (1.01 * ONE_CHUNK_SECONDS, int(AUTO_CHUNK_SECONDS * 40 / (
                            1.01 * ONE_CHUNK_SECONDS)))):  # 19 rows: about 1 s each
-        monkeypatch.setattr(runner, "seconds_per_row", lambda s, c=work / 40: (c, 8))
+        monkeypatch.setattr(runner, "seconds_per_row", lambda s, c=work / 40, **_: (c, 8))
         assert runner.choose_chunk_size(small)["chunk_size"] == want
     # two workers: chunks to share (at least AUTO_CHUNK_ROWS[0] rows each)
     assert runner.choose_chunk_size(small, units=2)["chunk_size"] == AUTO_CHUNK_ROWS[0]
     big = load_spec(write(tmp_path, GRID.format(chunk="").replace("num = 20", "num = 60_000"),
                           "big.toml"))  # 120,000 rows: more than a chunk holds
-    monkeypatch.setattr(runner, "seconds_per_row", lambda s: (1e-9, 8))
+    monkeypatch.setattr(runner, "seconds_per_row", lambda s, **_: (1e-9, 8))
     assert runner.choose_chunk_size(big)["chunk_size"] == AUTO_CHUNK_ROWS[1]
+
+
+def test_the_probe_of_a_sweep_that_is_surely_one_chunk_stops_at_its_first_batch(
+        tmp_path, monkeypatch):
+    """The first probe batch's time per row bounds the cost from above (its fixed cost
+    is in it): when even that makes the sweep at most ONE_CHUNK_SECONDS of work, it is
+    one chunk without a longer probe; with two workers the probe goes on to
+    PROBE_SECONDS. An engine of 1 ms per batch plus 0.1 ms per row stands in."""
+    def engine(spec, cols, timings=None):
+        if timings is not None:
+            timings["total_s"] = timings.get("total_s", 0.0) + 1e-3 + 1e-4 * len(cols["nu"])
+        return {}
+
+    monkeypatch.setattr(runner, "run_batch", engine)
+    spec = load_spec(write(tmp_path, GRID.format(chunk="").replace("num = 20", "num = 1000")))
+    one = runner.choose_chunk_size(spec)  # 2000 rows: at most 0.23 s of work
+    assert one["probe_rows"] == 64 and one["chunk_size"] == 2000
+    assert one["seconds_per_row"] == pytest.approx(1e-4 + 1e-3 / 64)
+    two = runner.choose_chunk_size(spec, units=2)
+    assert two["probe_rows"] > 64 and two["probe_rows"] * 1e-4 + 1e-3 >= runner.PROBE_SECONDS
 
 
 def test_workers_on_a_small_sweep_says_so(tmp_path, monkeypatch, capsys):

@@ -565,7 +565,8 @@ PROBE_ROWS = 4096
 CHUNKS_PER_WORKER = 4
 
 
-def seconds_per_row(spec: SweepSpec, probe_chunks: int = 8) -> tuple[float, int]:
+def seconds_per_row(spec: SweepSpec, probe_chunks: int = 8,
+                    enough: float = 0.0) -> tuple[float, int]:
     """Measure what a row of ``spec`` costs in the engine (:func:`run_batch`), s.
 
     Rows of ``probe_chunks`` places spread over the sweep, run as one batch as a chunk
@@ -574,6 +575,9 @@ def seconds_per_row(spec: SweepSpec, probe_chunks: int = 8) -> tuple[float, int]
     about that long at the cost measured (at least twice as many, at most
     :data:`PROBE_ROWS` rows or the whole sweep), so that a batch's fixed cost is a small
     part of the time taken. Returns the wall time per row of the last batch and its rows.
+    A first batch whose time per row is at most ``enough`` (s) is the answer: with the
+    batch's fixed cost in it, the true cost is lower still (what a caller that only
+    asks "at most this?" needs).
     """
     from vimpact.sweep.parameters import engine_columns
 
@@ -594,7 +598,8 @@ def seconds_per_row(spec: SweepSpec, probe_chunks: int = 8) -> tuple[float, int]
             except Exception:  # noqa: BLE001 - the chunk will record it
                 pass
         took = timings.get("total_s", 0.0)
-        if took >= PROBE_SECONDS or rows >= min(PROBE_ROWS, spec.rows) or per_place >= most:
+        if took >= PROBE_SECONDS or rows >= min(PROBE_ROWS, spec.rows) or per_place >= most \
+                or took <= enough * rows:
             return max(took, 1e-9) / max(rows, 1), rows
         # straight to the rows that take PROBE_SECONDS at this cost (a tenth more)
         per_place = min(most, max(2 * per_place,
@@ -617,12 +622,14 @@ def choose_chunk_size(spec: SweepSpec, units: int = 1) -> dict:
         ``chunk_size``, ``seconds_per_row`` (s), ``probe_rows`` (what was measured)
         and ``units``: the record :func:`chunked` stores.
     """
-    cost, probed = seconds_per_row(spec)
     lo, hi = AUTO_CHUNK_ROWS
+    # a sweep that is surely one chunk needs no precise cost (the first batch bounds it)
+    one = units == 1 and spec.rows <= hi
+    cost, probed = seconds_per_row(spec, enough=ONE_CHUNK_SECONDS / spec.rows if one else 0.0)
     size = int(min(hi, max(lo, AUTO_CHUNK_SECONDS / cost)))
     if units > 1:
         size = min(size, max(lo, -(-spec.rows // (CHUNKS_PER_WORKER * units))))
-    elif spec.rows <= hi and cost * spec.rows <= ONE_CHUNK_SECONDS:
+    elif one and cost * spec.rows <= ONE_CHUNK_SECONDS:
         size = spec.rows
     size = max(min(size, spec.rows), -(-spec.rows // MAX_CHUNKS), 1)
     return {"chunk_size": size, "seconds_per_row": cost, "probe_rows": probed, "units": units}
