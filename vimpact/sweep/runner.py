@@ -105,11 +105,11 @@ def compute_chunk(spec: SweepSpec, chunk: int, timings: dict | None = None):
     """Simulate the rows of ``chunk`` and return them as a ``pyarrow`` table.
 
     Columnar: the chunk's parameters (:mod:`vimpact.sweep.parameters`) become scene
-    columns of the engine (:func:`run_batch`: what :func:`vimpact.simulate_batch`
-    runs, without its DataFrame) and its result columns
-    the table's, with NumPy and Arrow (no Python object per row but a row's status,
-    path and error string). No row raises: an invalid scene gets status ``invalid``,
-    a batch that raises ``failed``, each with NaN outputs and a message in ``error``.
+    columns of the engine (:func:`run_batch`: what :func:`vimpact.simulate_batch` runs,
+    without its DataFrame) and its result columns the table's, with NumPy and Arrow (no
+    Python object per row but a row's status, path and error string). No row raises:
+    an invalid scene gets status ``invalid``, a batch that raises ``failed``, each with
+    NaN outputs and a message in ``error``.
     ``timings`` (a dict) receives ``kernel_s`` (s in the kernels) and ``total_s`` (s
     in the engine: validation, routing, kernels, results) summed over calls.
     """

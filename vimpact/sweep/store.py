@@ -446,9 +446,9 @@ def _write_fresh(spec, parts: Path, out: Path, explain_paths, fresh: list,
     """Write a file-layout table from its chunks in memory, all just computed.
 
     ``fresh``: ``(table, summary)`` of every chunk in chunk order. The content hash
-    is computed from the rows in memory (``digest``: given by the caller, who
-    computed it from them; computed here if ``None``), the parts (if any) are not read: the table
-    is the one :func:`combine` would make from them, byte for byte, and they are
+    is computed from the rows in memory (``digest``: given by the caller, who computed
+    it from them; computed here if ``None``), the parts (if any) are not read: the
+    table is the one :func:`combine` would make from them, byte for byte, and they are
     removed once it is written and its footer checked. One chunk has no part: a
     failed write (disk full) keeps nothing, the chunk is computed again by the next
     run.
