@@ -13,7 +13,7 @@ from vimpact.kernels import layout
 from vimpact.kernels import status as status_table
 from vimpact.model.numerics import MIN_CONTACT_STEPS
 from vimpact.model.scene import HALF_SPACE_LIMIT, TANGENTIAL_EFFECTS, TANGENTIAL_MEMORY
-from vimpact.model.validation import is_none
+from vimpact.model.validation import is_none, unexplained
 
 #: kernel status code -> status name (the status table's codes)
 KERNEL_STATUSES = {
@@ -348,7 +348,7 @@ def _explain(status: np.ndarray, error: np.ndarray, contact_steps: np.ndarray,
     No row ends without numbers and without saying why.
     """
     explain = ~member(status, FINISHED) | (status == "not_passive")
-    for i in np.flatnonzero(explain & is_none(error)):
+    for i in unexplained(explain, error):
         error[i] = _reason(status[i], contact_steps[i], relative_gain[i])
 
 
