@@ -40,7 +40,8 @@ def main(argv=None) -> dict:
         data["default"] = default_sweep(10_000 if args.quick else 100_000,
                                         1 if args.quick else 2)
         data["default"]["command"] = "python -m benchmarks.sweep_backends --part default"
-        print(json.dumps({k: x for k, x in data["default"].items() if k != "runs"}, indent=1))
+        print(json.dumps({k: x for k, x in data["default"].items()
+                          if k not in ("runs", "thread_pairs")}, indent=1))
     args.out.mkdir(parents=True, exist_ok=True)
     path.write_text(json.dumps(data, indent=1))
     return data

@@ -18,6 +18,22 @@ def test_member_is_numpy_isin(n):
     assert np.array_equal(got, np.isin(values, list(FINISHED)))
 
 
+def test_guard_marks_the_rows_it_turns_non_finite_as_not_finished():
+    """guard's answer (the rows not finished) takes non_finite rows as not finished
+    without a second look at the statuses: the status table must say so."""
+    from vimpact.engine.unpack import guard
+
+    assert "non_finite" not in FINISHED
+    status = np.array(["ok", "ok", "time_limit", "normal_only"], dtype=object)
+    values = {"e_z": np.array([0.5, np.nan, np.nan, 0.7]),
+              "e_x": np.array([0.1, 0.2, np.nan, np.nan])}  # NaN e_x: normal only
+    dead = guard(values, status, np.array([True, True, True, False]))
+    assert list(status) == ["ok", "non_finite", "time_limit", "normal_only"]
+    assert list(dead) == [False, True, True, False]
+    assert np.array_equal(dead, ~member(status, FINISHED))
+    assert np.isnan(values["e_x"][1]) and values["e_z"][3] == 0.7
+
+
 def _scenes():
     """Scenes that take every branch of unpack: tangential or not, rotation held,
     seed memory, v_c0 = 0, arms."""

@@ -9,7 +9,13 @@ import pytest
 
 from tests.sweep import write
 from vimpact.sweep import load_spec, parts_dir, read_metadata, run_sweep, runner
-from vimpact.sweep.spec import AUTO_CHUNK_ROWS, CHUNK_SIZE_FILE, DEFAULT_CHUNK_SIZE
+from vimpact.sweep.spec import (
+    AUTO_CHUNK_ROWS,
+    AUTO_CHUNK_SECONDS,
+    CHUNK_SIZE_FILE,
+    DEFAULT_CHUNK_SIZE,
+    ONE_CHUNK_SECONDS,
+)
 
 GRID = """
 model = "kelvin_voigt"
@@ -85,6 +91,31 @@ def test_the_chosen_size_is_recorded_and_gives_the_table_of_that_size(tmp_path, 
     assert _table(out).equals(_table(other))  # grid rows do not depend on the chunking
 
 
+def test_one_chosen_chunk_leaves_no_record_and_its_part_holds_the_size(tmp_path, monkeypatch):
+    """A chosen chunk of all the rows makes no parts directory in process (nothing to
+    resume: an interrupt leaves nothing behind); written as a part (a shard), the part's
+    metadata gives its size to --combine, which chooses nothing."""
+    made = _choose(monkeypatch, [40, 40])
+    spec = write(tmp_path, GRID.format(chunk=""))
+    out = tmp_path / "one.parquet"
+
+    def stop(done, total):
+        raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        run_sweep(spec, out=out, progress=stop)
+    assert not parts_dir(out).exists() and not out.exists()
+    table = run_sweep(spec, out=out, progress=False)
+    assert read_metadata(table)["chunk_size"] == 40 and made == [1, 1]
+    shard = tmp_path / "shard.parquet"
+    _choose(monkeypatch, [40])
+    parts = run_sweep(spec, out=shard, shard=(0, 1), progress=False)
+    assert sorted(p.name for p in parts.iterdir()) == ["part-00000.parquet"]
+    made = _choose(monkeypatch, [])  # --combine must not choose
+    run_sweep(spec, out=shard, combine=True, progress=False)
+    assert made == [] and _table(shard).equals(_table(table))
+
+
 def test_resume_uses_the_recorded_size(tmp_path, monkeypatch):
     made = _choose(monkeypatch, [7, 11])
     spec = write(tmp_path, GRID.format(chunk=""))
@@ -151,11 +182,49 @@ def test_the_rule_work_per_chunk_bounds_and_workers(tmp_path, monkeypatch):
                           "big.toml"))  # 200,000 rows
     lo, hi = AUTO_CHUNK_ROWS
     for cost, want in ((1e-7, hi), (1e-1, lo), (1e-3, 1000)):
-        monkeypatch.setattr(runner, "seconds_per_row", lambda s, cost=cost: (cost, 8))
+        monkeypatch.setattr(runner, "seconds_per_row", lambda s, cost=cost, **_: (cost, 8))
         assert runner.choose_chunk_size(big)["chunk_size"] == want
-    monkeypatch.setattr(runner, "seconds_per_row", lambda s: (1e-7, 8))
+    monkeypatch.setattr(runner, "seconds_per_row", lambda s, **_: (1e-7, 8))
     assert runner.choose_chunk_size(small)["chunk_size"] == 40  # not more than the rows
     assert runner.choose_chunk_size(big, units=2)["chunk_size"] == 200_000 // 8
+
+
+def test_a_sweep_of_little_work_is_one_chunk(tmp_path, monkeypatch):
+    """Up to ONE_CHUNK_SECONDS of work (one process, at most AUTO_CHUNK_ROWS[1] rows) a
+    sweep is one chunk (no part written and then the table); beyond it, chunks of about
+    AUTO_CHUNK_SECONDS; with workers or shards, chunks to share."""
+    small = load_spec(write(tmp_path, GRID.format(chunk="")))  # 40 rows
+    for work, want in ((0.99 * ONE_CHUNK_SECONDS, 40),
+                       (1.01 * ONE_CHUNK_SECONDS, int(AUTO_CHUNK_SECONDS * 40 / (
+                           1.01 * ONE_CHUNK_SECONDS)))):  # 19 rows: about 1 s each
+        monkeypatch.setattr(runner, "seconds_per_row", lambda s, c=work / 40, **_: (c, 8))
+        assert runner.choose_chunk_size(small)["chunk_size"] == want
+    # two workers: chunks to share (at least AUTO_CHUNK_ROWS[0] rows each)
+    assert runner.choose_chunk_size(small, units=2)["chunk_size"] == AUTO_CHUNK_ROWS[0]
+    big = load_spec(write(tmp_path, GRID.format(chunk="").replace("num = 20", "num = 60_000"),
+                          "big.toml"))  # 120,000 rows: more than a chunk holds
+    monkeypatch.setattr(runner, "seconds_per_row", lambda s, **_: (1e-9, 8))
+    assert runner.choose_chunk_size(big)["chunk_size"] == AUTO_CHUNK_ROWS[1]
+
+
+def test_the_probe_of_a_sweep_that_is_surely_one_chunk_stops_at_its_first_batch(
+        tmp_path, monkeypatch):
+    """The first probe batch's time per row bounds the cost from above (its fixed cost
+    is in it): when even that makes the sweep at most ONE_CHUNK_SECONDS of work, it is
+    one chunk without a longer probe; with two workers the probe goes on to
+    PROBE_SECONDS. An engine of 1 ms per batch plus 0.1 ms per row stands in."""
+    def engine(spec, cols, timings=None):
+        if timings is not None:
+            timings["total_s"] = timings.get("total_s", 0.0) + 1e-3 + 1e-4 * len(cols["nu"])
+        return {}
+
+    monkeypatch.setattr(runner, "run_batch", engine)
+    spec = load_spec(write(tmp_path, GRID.format(chunk="").replace("num = 20", "num = 1000")))
+    one = runner.choose_chunk_size(spec)  # 2000 rows: at most 0.23 s of work
+    assert one["probe_rows"] == 64 and one["chunk_size"] == 2000
+    assert one["seconds_per_row"] == pytest.approx(1e-4 + 1e-3 / 64)
+    two = runner.choose_chunk_size(spec, units=2)
+    assert two["probe_rows"] > 64 and two["probe_rows"] * 1e-4 + 1e-3 >= runner.PROBE_SECONDS
 
 
 def test_workers_on_a_small_sweep_says_so(tmp_path, monkeypatch, capsys):

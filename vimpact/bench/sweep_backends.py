@@ -11,7 +11,7 @@ source checkout ``python -m benchmarks.sweep_backends [--part backends|large|bot
   the machine is shared and noisy. The two tables must be identical.
 - ``large``: one 1e6-row random oblique sweep (``fast`` numerics, in-process):
   wall time, kernel time alone (seconds inside the numba kernels, from
-  ``simulate_batch(timings=...)``), their ratio (target <= 1.2), rows/s, Python
+  ``run_sweep(timings=...)``), their ratio (target <= 1.2), rows/s, Python
   overhead per row, and the peak resident memory of this process and its
   children (``resource.getrusage``).
 
@@ -21,7 +21,9 @@ source checkout ``python -m benchmarks.sweep_backends [--part backends|large|bot
   ``chunk_size = 64`` (the fixed default before), in turns, and the chosen chunking on
   1 and on 2 numba threads; each against the kernel time of its own run and against
   ``simulate_batch`` on the same rows in one call (target: sweep wall <= 1.2x the kernel
-  time; 2 threads never slower than 1). The tables must be equal.
+  time; 2 threads never slower than 1), and the best chosen run's wall time split by
+  stage (engine outside the kernels, choosing the chunk size, writing, the rest). The
+  tables must be equal.
 
 The cluster's start (``backends``: ``cluster_start_s``, and ``cluster_ready_s`` with its
 workers' first sweep, which loads the kernels, less the same sweep in process) is what
@@ -142,7 +144,7 @@ def large(rows: int, chunk: int) -> dict:
     children_kb = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss
     kernel = timings.get("kernel_s", float("nan"))
     return {"rows": rows, "chunk_size": chunk, "numerics": "fast", "wall_s": wall,
-            "kernel_s": kernel, "simulate_batch_s": timings.get("total_s"),
+            "kernel_s": kernel, "engine_s": timings.get("total_s"),
             "wall_over_kernel": wall / kernel, "rows_per_s": rows / wall,
             "overhead_us_per_row": 1e6 * (wall - kernel) / rows,
             "peak_rss_mb": {"self": self_kb / 1024, "children": children_kb / 1024},
@@ -160,14 +162,19 @@ nu = {{ start = 0.0, stop = 0.5, num = 100 }}
 """
 
 
-def default_sweep(rows: int = 100_000, repeats: int = 2) -> dict:
+def default_sweep(rows: int = 100_000, repeats: int = 2, thread_pairs: int = 4) -> dict:
     """Time the default (chosen) chunking against ``chunk_size = 64``, and 1 vs 2 threads.
 
     Each configuration ``repeats`` times in turns after a warm-up; per run the wall time,
-    the kernel time and ``simulate_batch`` time of its chunks
-    (``run_sweep(timings=...)``) and the chunk size it used; each round starts with one
-    ``simulate_batch`` call on all the sweep's rows (the kernel at its best: one launch).
-    Ratios are taken within a round (the load changes between rounds).
+    the kernel and engine time of its chunks, the time to choose the chunk size and to
+    write (``run_sweep(timings=...)``) and the chunk size it used; each round starts with
+    one ``simulate_batch`` call on all the sweep's rows (the kernel at its best: one
+    launch). Ratios are taken within a round (the load changes between rounds);
+    ``chosen_over_kernel_by_stage`` splits the best chosen run's wall time by stage.
+    1 against 2 threads: besides the rounds, ``thread_pairs`` more chosen sweeps per
+    round on each, back to back in alternating order (``one_thread_over_two``: the median
+    over all pairs of the 1-thread wall time over the 2-thread one; on a shared machine
+    the load moves between two runs, so one pair per round says little).
     """
     import numba
 
@@ -178,6 +185,7 @@ def default_sweep(rows: int = 100_000, repeats: int = 2) -> dict:
     threads = min(2, max_threads())
     q1 = max(1, rows // 100)
     runs: dict[str, list[dict]] = {"chosen": [], "chunk_64": [], "chosen_1_thread": []}
+    pairs: list[dict] = []
     with tempfile.TemporaryDirectory() as folder:
         tmp = Path(folder)
         chosen = tmp / "chosen.toml"
@@ -207,10 +215,21 @@ def default_sweep(rows: int = 100_000, repeats: int = 2) -> dict:
                     run_sweep(path, out=out, progress=False, timings=timings)
                     wall = time.perf_counter() - t0
                     runs[name].append({"wall_s": wall, "kernel_s": timings["kernel_s"],
-                                       "simulate_batch_s": timings["total_s"], "threads": nt,
+                                       "engine_s": timings["total_s"],
+                                       "choose_s": timings.get("choose_s", 0.0),
+                                       "write_s": timings.get("write_s", 0.0), "threads": nt,
                                        "chunk_size": read_metadata(out)["chunk_size"],
                                        "one_batch_kernel_s": batch["kernel_s"]})
                     tables[name] = out
+                for k in range(thread_pairs):
+                    walls = {}
+                    for nt in ((threads, 1) if k % 2 == 0 else (1, threads)):
+                        numba.set_num_threads(nt)
+                        t0 = time.perf_counter()
+                        run_sweep(chosen, out=tmp / f"pair_{r}_{k}_{nt}.parquet",
+                                  progress=False)
+                        walls[nt] = time.perf_counter() - t0
+                    pairs.append({"one_thread_s": walls[1], "two_threads_s": walls[threads]})
         finally:
             numba.set_num_threads(max_threads())
         import pyarrow.parquet as pq
@@ -226,13 +245,30 @@ def default_sweep(rows: int = 100_000, repeats: int = 2) -> dict:
         """Return the median over the rounds of the wall time of ``a`` / that of ``b``."""
         return float(np.median([x["wall_s"] / y["wall_s"] for x, y in zip(runs[a], runs[b])]))
 
+    def shares(name: str) -> dict:
+        """Return where the wall time of the best round of ``name`` went, over its kernel time.
+
+        ``engine_python``: the engine outside the kernels (validation, routing, results);
+        ``choose``: the chunk size; ``write``: content hashes, parts, the table and its
+        checks; ``rest``: the spec, the lock, the chunk's table columns, the progress.
+        """
+        x = min(runs[name], key=lambda r: r["wall_s"] / r["kernel_s"])
+        k = x["kernel_s"]
+        rest = x["wall_s"] - x["engine_s"] - x["choose_s"] - x["write_s"]
+        return {"kernel": 1.0, "engine_python": (x["engine_s"] - k) / k,
+                "choose": x["choose_s"] / k, "write": x["write_s"] / k, "rest": rest / k}
+
     result = {"rows": spec.rows, "threads": threads, "repeats": repeats, "runs": runs,
               "one_batch": batches, "tables_equal": equal}
     for name in runs:
         result[f"{name}_wall_over_kernel"] = ratio(name, "kernel_s")
         result[f"{name}_wall_over_one_batch_kernel"] = ratio(name, "one_batch_kernel_s")
+    result["chosen_over_kernel_by_stage"] = shares("chosen")
     result["chunk_64_over_chosen"] = turns("chunk_64", "chosen")
-    result["one_thread_over_two"] = turns("chosen_1_thread", "chosen")
+    result["thread_pairs"] = pairs
+    result["one_thread_over_two"] = float(np.median(
+        [x["wall_s"] / y["wall_s"] for x, y in zip(runs["chosen_1_thread"], runs["chosen"])]
+        + [p["one_thread_s"] / p["two_threads_s"] for p in pairs]))
     result["target_wall_over_kernel"] = 1.2
     return result
 

@@ -58,7 +58,7 @@ from vimpact.model.scene import (
     TANGENTIAL_MEMORY,
     Scene,
 )
-from vimpact.model.validation import InputError, check_column, is_none, message
+from vimpact.model.validation import InputError, check_column, is_none, message, unexplained
 
 #: numeric input columns: name -> (validation rule, default or None if required)
 NUMERIC = {
@@ -351,7 +351,7 @@ class SceneColumns:
         model = _model(arrays.get("model"), G_arm, num["eta0_Pa_s"], n, reasons)
         seeded = ((codes["tangential_memory"] == TANGENTIAL_MEMORY.index("seed"))
                   & np.isfinite(num["mu"]))
-        for row in np.flatnonzero(seeded & is_none(reasons)):
+        for row in unexplained(seeded, reasons):
             reasons[row] = message("mu", float(num["mu"][row]), SEED_FRICTION_ALLOWED)
         cols = dict(nu=num["nu"], G_inf=num["G_inf_Pa"], eta0=num["eta0_Pa_s"], G_arm=G_arm,
                     tau_arm=tau_arm, R=R, m=m, v_z0=num["v_z0_m_s"], v_x0=num["v_x0_m_s"],
@@ -362,7 +362,7 @@ class SceneColumns:
         # the adhesive impact is normal only (the rule of vimpact.Scene)
         oblique = ((num["adhesion_J_m2"] > 0.0) & (codes["tangential"] != TANGENTIAL_EFFECTS.index(
             "none")) & (num["v_x0_m_s"] + R * num["omega0_rad_s"] != 0.0))
-        for row in np.flatnonzero(oblique & is_none(reasons)):
+        for row in unexplained(oblique, reasons):
             reasons[row] = message("adhesion_J_m2", float(num["adhesion_J_m2"][row]),
                                    ADHESION_OBLIQUE)
         _neutralize(cols)
@@ -461,15 +461,19 @@ def _neutralize(cols: dict) -> None:
 def _codes(name: str, values, choices, default: str, n: int, reasons) -> np.ndarray:
     if values is None:
         return np.full(n, choices.index(default), dtype=np.int8)
-    values = np.asarray(values, dtype=object)
+    values = np.asarray(values)
+    text = values.dtype.kind == "U"  # compared as it is (as objects: a str per row, 5 ms/1e5)
+    if not text:
+        values = values.astype(object)
     out = np.zeros(n, dtype=np.int8)
     known = np.zeros(n, dtype=bool)
     for code, choice in enumerate(choices):
         hit = values == choice
         out[hit] = code
         known |= hit
-    for i in np.flatnonzero(~known & is_none(reasons)):
-        reasons[i] = message(name, values[i], "one of " + ", ".join(map(repr, choices)))
+    for i in unexplained(~known, reasons):
+        reasons[i] = message(name, values[i].item() if text else values[i],
+                             "one of " + ", ".join(map(repr, choices)))
     return out
 
 
@@ -481,7 +485,7 @@ def _flags(name: str, values, default: bool, n: int, reasons) -> np.ndarray:
         return values.copy()
     obj = values.astype(object)
     ok = np.array([isinstance(v, (bool, np.bool_)) for v in obj], dtype=bool)
-    for i in np.flatnonzero(~ok & is_none(reasons)):
+    for i in unexplained(~ok, reasons):
         reasons[i] = message(name, obj[i], "True or False")
     return np.where(ok, obj == True, default)  # noqa: E712 - elementwise
 
@@ -500,7 +504,7 @@ def _model(values, G_arm: np.ndarray, eta0: np.ndarray, n: int, reasons) -> np.n
                                    "at most one Maxwell arm and eta0 = 0"),
             MODEL_PRONY: (np.ones(n, dtype=bool), "")}
     for code, (ok, what) in fits.items():
-        for i in np.flatnonzero((codes == code) & ~ok & is_none(reasons)):
+        for i in unexplained((codes == code) & ~ok, reasons):
             reasons[i] = (f"model = {MODELS[code]!r} is not allowed for this row: it needs "
                           f"{what} (the row has {n_arms[i]} arms, eta0 = {eta0[i]:g} Pa s)")
     return codes

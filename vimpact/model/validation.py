@@ -42,6 +42,17 @@ def is_none(values) -> np.ndarray:
     return np.equal(values, None)  # type: ignore[call-overload]  # (stubs: no None operand)
 
 
+def unexplained(mask: np.ndarray, reasons: np.ndarray) -> np.ndarray:
+    """Return the indices of the rows of ``mask`` whose reason is still ``None``.
+
+    In ascending order, as ``np.flatnonzero(mask & is_none(reasons))``, but looking at
+    the rows of ``mask`` only (bad rows are few; ``is_none`` of a whole batch costs
+    about 1.3 ms per 1e5 rows, paid once per input column before).
+    """
+    rows = np.flatnonzero(mask)
+    return rows[is_none(reasons[rows])] if rows.size else rows
+
+
 def message(name: str, value, allowed: str) -> str:
     """Return the one wording of every input error."""
     return f"{name} = {value!r} is not allowed: must be {allowed}"
@@ -133,7 +144,7 @@ def check_column(name: str, values, rule: str, reasons: np.ndarray) -> np.ndarra
         bad = ~test(x)
     if raw.dtype.kind == "b":
         bad[:] = True
-    for i in np.flatnonzero(bad & is_none(reasons)):
+    for i in unexplained(bad, reasons):
         reasons[i] = message(name, raw.ravel()[i].item() if hasattr(raw.ravel()[i], "item")
                              else raw.ravel()[i], allowed if raw.dtype.kind != "b" else "a number")
     x[bad] = np.nan

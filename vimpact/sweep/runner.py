@@ -38,6 +38,7 @@ import dataclasses
 import os
 import socket
 import sys
+import time
 from collections.abc import Callable
 from pathlib import Path
 
@@ -51,10 +52,12 @@ from vimpact.sweep.spec import (
     AUTO_CHUNK_SECONDS,
     CHUNK_SIZE_FILE,
     MAX_CHUNKS,
+    ONE_CHUNK_SECONDS,
     SweepSpec,
     load_spec,
 )
 from vimpact.tableformat import files
+from vimpact.tableformat.integrity import ContentHash
 from vimpact.tableformat.metadata import COMMON_METADATA, decode_metadata
 from vimpact.tableformat.schema import (
     ADHESION_RESULTS,
@@ -79,20 +82,41 @@ class SweepInterrupted(KeyboardInterrupt):
 
 # ---- one chunk ---------------------------------------------------------------------
 
+def run_batch(spec: SweepSpec, scene_cols: dict, timings: dict | None = None) -> dict:
+    """Run scene columns of ``spec`` on the engine and return its result columns.
+
+    What :func:`vimpact.simulate_batch` runs (validation, routing, kernels, SI results:
+    :func:`vimpact.engine.simulate.run_columns`) without building its DataFrame: the
+    sweep takes the NumPy columns as they are. ``timings`` receives ``kernel_s`` (s in
+    the kernels) and ``total_s`` (s of the whole call), summed over calls.
+    """
+    from vimpact.engine.columns import scene_columns
+    from vimpact.engine.simulate import run_columns
+
+    t0 = time.perf_counter()
+    try:
+        return run_columns(scene_columns(scene_cols), spec.numerics, timings=timings)[0]
+    finally:
+        if timings is not None:
+            timings["total_s"] = timings.get("total_s", 0.0) + time.perf_counter() - t0
+
+
 def compute_chunk(spec: SweepSpec, chunk: int, timings: dict | None = None):
     """Simulate the rows of ``chunk`` and return them as a ``pyarrow`` table.
 
     Columnar: the chunk's parameters (:mod:`vimpact.sweep.parameters`) become scene
-    columns of :func:`vimpact.simulate_batch` and its result frame the table's
-    columns, with NumPy (no Python object per row). No row raises: an invalid
-    scene gets status ``invalid``, a batch that raises ``failed``, each with NaN
-    outputs and a message in ``error``. ``timings`` (a dict) receives
-    ``kernel_s`` and ``total_s`` summed over calls.
+    columns of the engine (:func:`run_batch`: what :func:`vimpact.simulate_batch` runs,
+    without its DataFrame) and its result columns the table's, with NumPy and Arrow (no
+    Python object per row but a row's status, path and error string). No row raises:
+    an invalid scene gets status ``invalid``, a batch that raises ``failed``, each with
+    NaN outputs and a message in ``error``.
+    ``timings`` (a dict) receives ``kernel_s`` (s in the kernels) and ``total_s`` (s
+    in the engine: validation, routing, kernels, results) summed over calls.
     """
     import pyarrow as pa
+    import pyarrow.compute as pc
 
     from vimpact.engine.result import FINISHED
-    from vimpact.engine.simulate import simulate_batch
     from vimpact.sweep.parameters import engine_columns
 
     start, stop = spec.chunk_rows(chunk)
@@ -106,33 +130,35 @@ def compute_chunk(spec: SweepSpec, chunk: int, timings: dict | None = None):
     for key, values in {**params, **inputs}.items():
         if key in cols:
             cols[key][:] = values
-    status = np.full(n, "invalid", dtype=object)
+    # a row no batch reaches stays invalid; one batch of all the chunk's rows in order
+    # (the usual case) hands over its label columns as they are
+    status = np.empty(n, dtype=object)
+    status[:] = "invalid"  # one str (np.full makes one per row: 30x slower)
     error = np.full(n, None, dtype=object)
     path = np.full(n, None, dtype=object)
     for rows, scene_cols in batches:
         if len(rows) == 0:
             continue
+        whole = len(rows) == n and bool(np.all(rows == np.arange(n)))
         try:
-            frame = simulate_batch(scene_cols, spec.numerics, timings=timings)
+            result = run_batch(spec, scene_cols, timings)
         except Exception as exc:  # noqa: BLE001 - recorded as the rows' status
             status[rows], error[rows] = "failed", f"{type(exc).__name__}: {exc}"
             continue
-        st = frame["status"].to_numpy(dtype=object)
-        status[rows] = st
-        if "error" in frame:
-            err = frame["error"].to_numpy(dtype=object)
-            error[rows] = np.where(_isnull(err), None, err)
-        pth = frame["path"].to_numpy(dtype=object)
-        path[rows] = np.where(_isnull(pth), None, pth)
+        st = result["status"]
+        if whole:
+            status, error, path = st.copy(), result["error"].copy(), result["path"].copy()
+        else:
+            status[rows], error[rows], path[rows] = st, result["error"], result["path"]
         for name, source in (RESULTS | (ADHESION_RESULTS if spec.has_adhesion else {})).items():
-            cols[name][rows] = frame[source].to_numpy(dtype=float)
+            cols[name][rows] = result[source]
         valid = st != "invalid"
         if spec.mode == "random" and spec.model != "prony":
-            cols["Q1"][rows] = frame["Q1"].to_numpy(dtype=float)
+            cols["Q1"][rows] = result["Q1"]
             if spec.model == "standard_solid" and "G_arm1_Pa" not in scene_cols:
                 cols["Q2"][rows] = np.where(valid, np.inf, np.nan)  # no arm (eta = 0): G2 idle
             elif spec.model == "standard_solid":
-                cols["Q2"][rows] = frame["Q2"].to_numpy(dtype=float)
+                cols["Q2"][rows] = result["Q2"]
             else:
                 cols["Q2"][rows] = np.nan  # the Kelvin-Voigt limit G2 -> inf (never 0: log 0)
         if spec.mode == "grid" and spec.model == "elastic":
@@ -144,27 +170,38 @@ def compute_chunk(spec: SweepSpec, chunk: int, timings: dict | None = None):
         vc0 = params["v_x0_m_s"] + params["R_m"] * params["omega0_rad_s"]
     else:  # the reference scene's v_x0 (1, or psi's; 0 on a lam axis), omega0 = 0
         vc0 = inputs["v_x0_m_s"]
-    guard_nan(cols, status, error, (vc0 == 0.0) | (spec.tangential == "none"),
-              np.isin(status, list(FINISHED)))
-    labels = {"model": inputs["model"], "path": path, "status": status, "error": error}
+    status_arrow = pa.array(status, type=pa.string())
+    finished = pc.is_in(status_arrow, value_set=pa.array(FINISHED, type=pa.string()))
+    if guard_nan(cols, status, error, (vc0 == 0.0) | (spec.tangential == "none"),
+                 finished.to_numpy(zero_copy_only=False)).any():
+        status_arrow = pa.array(status, type=pa.string())
+    labels = {"model": _repeated(inputs["model"], n), "path": pa.array(path, type=pa.string()),
+              "status": status_arrow, "error": pa.array(error, type=pa.string())}
     schema = spec.schema()
-    arrays = [pa.array(labels[c] if c in labels else cols[c], type=f.type)
+    arrays = [labels[c] if c in labels else pa.array(cols[c], type=f.type)
               for c, f in zip(spec.columns(), schema)]
     return pa.Table.from_arrays(arrays, schema=schema)
 
 
-def _isnull(values: np.ndarray) -> np.ndarray:
-    import pandas as pd
-    return pd.isna(values)
+def _repeated(values: np.ndarray, n: int):
+    """Return a string column as a ``pyarrow`` array; one repeated value without a loop."""
+    import pyarrow as pa
+
+    if n and isinstance(values[0], str) and bool(np.all(values == values[0])):
+        return pa.DictionaryArray.from_arrays(np.zeros(n, dtype=np.int32),
+                                              pa.array([values[0]], type=pa.string())
+                                              ).cast(pa.string())
+    return pa.array(values, type=pa.string())
 
 
 def guard_nan(cols: dict, status: np.ndarray, error: np.ndarray, vc0_zero: np.ndarray,
-              finished: np.ndarray) -> None:
+              finished: np.ndarray) -> np.ndarray:
     """Allow NaN only with a status that explains it.
 
     A finished row with a NaN output that no
     status explains (``e_x``, ``beta_x`` are NaN when ``v_c0 = 0``) becomes
     ``non_finite`` with all outputs NaN and the columns named in ``error``.
+    Returns the rows changed (bool).
     """
     explained = np.broadcast_to(np.asarray(vc0_zero, dtype=bool), finished.shape)
     nothing = np.zeros(finished.shape, dtype=bool)
@@ -177,6 +214,7 @@ def guard_nan(cols: dict, status: np.ndarray, error: np.ndarray, vc0_zero: np.nd
     status[bad] = "non_finite"
     for c in OUTPUTS:
         cols[c][bad] = np.nan
+    return bad
 
 
 def chunk_summary(table) -> dict:
@@ -317,8 +355,10 @@ def run_sweep(spec_path, out=None, resume: bool = False,
     combine : only combine the parts into the table (every chunk must be there)
     chunk_order : in-process only: the order to compute the chunks in (default
         ascending); the table does not depend on it
-    timings : in-process only: a dict that receives ``kernel_s`` and ``total_s`` of
-        :func:`vimpact.simulate_batch` summed over the chunks
+    timings : in-process only: a dict that receives, in s, ``kernel_s`` (in the
+        kernels) and ``total_s`` (in the engine, :func:`run_batch`) summed over the
+        chunks, ``choose_s`` (the chunk size: read, or measured and recorded) and
+        ``write_s`` (content hashes, parts, the table and its checks)
     stages : what a workflow above the sweep adds (:class:`SweepStages`; default
         none: a grid with ``tolerance`` is refused, see
         :func:`vimpact.tablebuild.sweep.run_sweep`)
@@ -399,7 +439,9 @@ def _run(spec, spec_path, out, parts, resume, progress, workers, scheduler, shar
         units = max(1, sum(scheduler.nthreads().values()))
     else:
         units = shard[1] if shard is not None else 1
+    t0 = time.perf_counter()
     spec = chunked(spec, parts, not combine, units, log)
+    _timed(timings, "choose_s", t0)
     if parts.exists():
         # --combine: store.combine verifies the parts (a part read once)
         done = {} if combine else store.existing_parts(spec, parts)
@@ -412,7 +454,6 @@ def _run(spec, spec_path, out, parts, resume, progress, workers, scheduler, shar
     if combine:
         _combine(spec, parts, out, log, stages)
         return out
-    parts.mkdir(parents=True, exist_ok=True)
     todo = [c for c in range(spec.n_chunks) if c not in done]
     if shard is not None:
         todo = [c for c in todo if c % shard[1] == shard[0]]
@@ -423,34 +464,49 @@ def _run(spec, spec_path, out, parts, resume, progress, workers, scheduler, shar
     bar = Progress(spec.rows, rows_done, spec.path.stem, progress)
     finished = False
     fresh: list | None = None
+    whole = ContentHash()  # of the rows in ``fresh``
     try:
         if workers is not None and todo:
             too_small = small_for_cluster(spec, todo, workers)
             if too_small:
                 print(f"vimpact sweep: {too_small}", file=sys.stderr, flush=True)
         if workers is not None or scheduler is not None:
+            parts.mkdir(parents=True, exist_ok=True)
             _run_dask(spec, todo, parts, bar, done, workers, scheduler)
         else:
             # a small file-layout table is written from its chunks in memory (parts
-            # not read back); one chunk goes straight to the table (no part)
+            # not read back); one chunk goes straight to the table (no part, no parts
+            # directory)
             if shard is None and layout == "file" and todo == list(range(spec.n_chunks)) \
                     and (spec.n_chunks == 1 or spec.rows <= store.HOLD_ROWS):
                 fresh = []
+            if spec.n_chunks > 1 or fresh is None:
+                parts.mkdir(parents=True, exist_ok=True)
             for chunk in todo:
                 table = compute_chunk(spec, chunk, timings)
                 summary = chunk_summary(table)
+                t0 = time.perf_counter()
+                own = None  # a part's hash and the table's from one canonical form
                 if fresh is not None:
                     fresh.append((table, summary))
+                    if spec.n_chunks > 1:
+                        own = ContentHash().update(table, also=whole).hexdigest()
+                    else:
+                        whole.update(table)
                 if spec.n_chunks > 1 or fresh is None:
-                    store.write_part(spec, table, parts, chunk, summary)
+                    store.write_part(spec, table, parts, chunk, summary, own)
                     done[chunk] = store.part_path(parts, chunk, spec.n_chunks)
+                _timed(timings, "write_s", t0)
                 start, stop = spec.chunk_rows(chunk)
                 bar.update(stop - start)
         finished = True
         bar.close()
         if shard is not None:
             return parts
-        _combine(spec, parts, out, log, stages, fresh)
+        t0 = time.perf_counter()
+        _combine(spec, parts, out, log, stages, fresh,
+                 whole.hexdigest() if fresh is not None else None)
+        _timed(timings, "write_s", t0)
     except KeyboardInterrupt:
         bar.close(finished)
         hint = f"vimpact sweep {spec_path}" + (f" --out {out}" if out != spec.output else "")
@@ -460,12 +516,19 @@ def _run(spec, spec_path, out, parts, resume, progress, workers, scheduler, shar
     return out
 
 
+def _timed(timings: dict | None, key: str, t0: float) -> None:
+    """Add the seconds since ``t0`` to ``timings[key]`` (if ``timings`` is a dict)."""
+    if timings is not None:
+        timings[key] = timings.get(key, 0.0) + time.perf_counter() - t0
+
+
 def _combine(spec: SweepSpec, parts: Path, out: Path, log, stages: SweepStages,
-             fresh=None) -> None:
+             fresh=None, fresh_digest: str | None = None) -> None:
     """Run :func:`vimpact.sweep.store.combine`, then ``stages.finish``.
 
     ``fresh``: the ``(table, summary)`` of every chunk, computed in this process:
-    the table is written from them (:func:`vimpact.sweep.store.combine`).
+    the table is written from them (:func:`vimpact.sweep.store.combine`), with the
+    content hash ``fresh_digest`` of their rows.
 
     The stages' own files
     (``stages.kept``) leave the parts directory first (the directory must hold only
@@ -479,7 +542,8 @@ def _combine(spec: SweepSpec, parts: Path, out: Path, log, stages: SweepStages,
             saved[name] = kept.read_text()
             kept.unlink()
     try:
-        store.combine(spec, parts, out, lambda first: explain_paths(spec, first), fresh)
+        store.combine(spec, parts, out, lambda first: explain_paths(spec, first), fresh,
+                      fresh_digest)
     except BaseException:
         if Path(parts).is_dir():
             for name, text in saved.items():
@@ -501,20 +565,25 @@ PROBE_ROWS = 4096
 CHUNKS_PER_WORKER = 4
 
 
-def seconds_per_row(spec: SweepSpec, probe_chunks: int = 8) -> tuple[float, int]:
-    """Measure what a row of ``spec`` costs in :func:`vimpact.simulate_batch`, s.
+def seconds_per_row(spec: SweepSpec, probe_chunks: int = 8,
+                    enough: float = 0.0) -> tuple[float, int]:
+    """Measure what a row of ``spec`` costs in the engine (:func:`run_batch`), s.
 
     Rows of ``probe_chunks`` places spread over the sweep, run as one batch as a chunk
-    runs them (their kernels compiled or loaded first, :func:`warm_kernels`), their
-    number doubled until the batch takes :data:`PROBE_SECONDS` (or :data:`PROBE_ROWS`
-    rows, or the whole sweep), so that its fixed cost is a small part. Returns the
-    wall time per row and the rows timed.
+    runs them (their kernels compiled or loaded first, :func:`warm_kernels`): first 8
+    per place, then, if that took less than :data:`PROBE_SECONDS`, as many as take
+    about that long at the cost measured (at least twice as many, at most
+    :data:`PROBE_ROWS` rows or the whole sweep), so that a batch's fixed cost is a small
+    part of the time taken. Returns the wall time per row of the last batch and its rows.
+    A first batch whose time per row is at most ``enough`` (s) is the answer: with the
+    batch's fixed cost in it, the true cost is lower still (what a caller that only
+    asks "at most this?" needs).
     """
-    from vimpact.engine.simulate import simulate_batch
     from vimpact.sweep.parameters import engine_columns
 
     warm_kernels(spec)
     per_place = 8
+    most = max(8, -(-PROBE_ROWS // probe_chunks))
     while True:
         probe = dataclasses.replace(spec, chunk_size=per_place)
         places = np.unique(np.linspace(0, probe.n_chunks - 1,
@@ -525,13 +594,16 @@ def seconds_per_row(spec: SweepSpec, probe_chunks: int = 8) -> tuple[float, int]
         timings: dict = {}
         for _, cols in engine_columns(probe, params)[0]:
             try:
-                simulate_batch(cols, spec.numerics, timings=timings)
+                run_batch(spec, cols, timings)
             except Exception:  # noqa: BLE001 - the chunk will record it
                 pass
         took = timings.get("total_s", 0.0)
-        if took >= PROBE_SECONDS or rows >= min(PROBE_ROWS, spec.rows):
+        if took >= PROBE_SECONDS or rows >= min(PROBE_ROWS, spec.rows) or per_place >= most \
+                or took <= enough * rows:
             return max(took, 1e-9) / max(rows, 1), rows
-        per_place *= 2
+        # straight to the rows that take PROBE_SECONDS at this cost (a tenth more)
+        per_place = min(most, max(2 * per_place,
+                                  int(1.1 * per_place * PROBE_SECONDS / max(took, 1e-9))))
 
 
 def choose_chunk_size(spec: SweepSpec, units: int = 1) -> dict:
@@ -540,7 +612,9 @@ def choose_chunk_size(spec: SweepSpec, units: int = 1) -> dict:
     About :data:`~vimpact.sweep.spec.AUTO_CHUNK_SECONDS` of work per chunk
     (:func:`seconds_per_row`), within :data:`~vimpact.sweep.spec.AUTO_CHUNK_ROWS` and the
     sweep's rows, at most ``MAX_CHUNKS`` chunks, and with ``units`` workers or shards at least
-    :data:`CHUNKS_PER_WORKER` chunks each where the rows allow it.
+    :data:`CHUNKS_PER_WORKER` chunks each where the rows allow it. One process (``units =
+    1``) makes a sweep of at most :data:`~vimpact.sweep.spec.ONE_CHUNK_SECONDS` of work
+    (and at most ``AUTO_CHUNK_ROWS[1]`` rows) one chunk.
 
     Returns
     -------
@@ -548,11 +622,15 @@ def choose_chunk_size(spec: SweepSpec, units: int = 1) -> dict:
         ``chunk_size``, ``seconds_per_row`` (s), ``probe_rows`` (what was measured)
         and ``units``: the record :func:`chunked` stores.
     """
-    cost, probed = seconds_per_row(spec)
     lo, hi = AUTO_CHUNK_ROWS
+    # a sweep that is surely one chunk needs no precise cost (the first batch bounds it)
+    one = units == 1 and spec.rows <= hi
+    cost, probed = seconds_per_row(spec, enough=ONE_CHUNK_SECONDS / spec.rows if one else 0.0)
     size = int(min(hi, max(lo, AUTO_CHUNK_SECONDS / cost)))
     if units > 1:
         size = min(size, max(lo, -(-spec.rows // (CHUNKS_PER_WORKER * units))))
+    elif one and cost * spec.rows <= ONE_CHUNK_SECONDS:
+        size = spec.rows
     size = max(min(size, spec.rows), -(-spec.rows // MAX_CHUNKS), 1)
     return {"chunk_size": size, "seconds_per_row": cost, "probe_rows": probed, "units": units}
 
@@ -616,7 +694,10 @@ def chunked(spec: SweepSpec, parts: Path, choose: bool = True, units: int = 1,
     is; a grid without: the size an earlier run of the sweep recorded in ``parts``
     (:func:`recorded_chunk_size`), else, if ``choose``, one chosen now
     (:func:`choose_chunk_size`) and recorded before any chunk is made, so that
-    ``--resume``, shards and ``--combine`` cut the same chunks.
+    ``--resume``, shards and ``--combine`` cut the same chunks. One chunk of all the
+    rows is not recorded (nor is a parts directory made for it): its part, if a
+    backend writes one, holds its size in its metadata, and without a part there is
+    nothing to cut the same way.
     """
     if not spec.chooses_chunk_size:
         return spec
@@ -626,7 +707,9 @@ def chunked(spec: SweepSpec, parts: Path, choose: bool = True, units: int = 1,
             return spec
         record = {**choose_chunk_size(spec, units), "sweep_hash": spec.sweep_hash,
                   "rows": spec.rows}
-        size = _record_chunk_size(parts, record)
+        size = record["chunk_size"]
+        if size < spec.rows:
+            size = _record_chunk_size(parts, record)
         if log is not None:
             log(f"{size} rows per chunk, chosen from {record['seconds_per_row'] * 1e6:.3g} us "
                 f"per row measured (about {AUTO_CHUNK_SECONDS:g} s of work per chunk at most; "
@@ -660,20 +743,19 @@ def small_for_cluster(spec: SweepSpec, todo: list[int], workers: int) -> str | N
 def warm_kernels(spec: SweepSpec, rows_per_chunk: int = 2, chunks: int = 4) -> None:
     """Compile (or load from numba's cache) the kernels the spec needs, in this process.
 
-    A few rows of a few chunks spread over the sweep, so that workers find them cached.
+    A few rows of a few chunks spread over the sweep, run as one batch, so that workers
+    find them cached.
     """
-    from vimpact.engine.simulate import simulate_batch
     from vimpact.sweep.parameters import engine_columns
 
     picks = np.unique(np.linspace(0, spec.n_chunks - 1, min(chunks, spec.n_chunks)).astype(int))
-    for chunk in picks:
-        params = spec.chunk_parameters(int(chunk))
-        params = {k: v[:rows_per_chunk] for k, v in params.items()}
-        for _, cols in engine_columns(spec, params)[0]:
-            try:
-                simulate_batch(cols, spec.numerics)
-            except Exception:  # noqa: BLE001 - the task will record it
-                pass
+    pieces = [spec.chunk_parameters(int(chunk)) for chunk in picks]
+    params = {k: np.concatenate([p[k][:rows_per_chunk] for p in pieces]) for k in pieces[0]}
+    for _, cols in engine_columns(spec, params)[0]:
+        try:
+            run_batch(spec, cols)
+        except Exception:  # noqa: BLE001 - the task will record it
+            pass
 
 
 #: Local Dask workers per usable core at most (``--workers``): a worker is one process
@@ -870,4 +952,4 @@ def _run_dask(spec, todo, parts, bar, done, workers, scheduler) -> None:
 __all__ = ["PLAIN", "SweepInterrupted", "SweepStages", "check_workers", "choose_chunk_size",
            "chunk_summary", "chunked", "compute_chunk", "connect_scheduler", "explain_paths",
            "guard_nan", "local_cluster", "max_local_workers", "recorded_chunk_size",
-           "run_chunk", "run_sweep", "seconds_per_row", "small_for_cluster", "warm_kernels"]
+           "run_batch", "run_chunk", "run_sweep", "seconds_per_row", "small_for_cluster", "warm_kernels"]

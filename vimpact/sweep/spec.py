@@ -101,7 +101,8 @@ valid scene becomes a row with status ``invalid`` and the reason in the
 Chunk size when the spec sets none: a grid's rows do not depend on the chunking, so
 the runner chooses it from the measured cost of the rows
 (:func:`vimpact.sweep.runner.choose_chunk_size`: about :data:`AUTO_CHUNK_SECONDS` of
-work per chunk, :data:`AUTO_CHUNK_ROWS` rows at least and at most), once per sweep,
+work per chunk, :data:`AUTO_CHUNK_ROWS` rows at least and at most, one chunk for a
+sweep of at most :data:`ONE_CHUNK_SECONDS` of work), once per sweep,
 before the first chunk, and records it in the parts directory
 (:data:`CHUNK_SIZE_FILE`) so that ``--resume``, shards and ``--combine`` use the same
 chunks; the table's metadata ``chunk_size`` holds it. Random draws are made per chunk
@@ -194,6 +195,11 @@ DEFAULT_CHUNK_SIZE = 64
 AUTO_CHUNK_SECONDS = 1.0
 #: Rows per chunk the runner chooses at least and at most (memory: about a kilobyte a row).
 AUTO_CHUNK_ROWS = (16, 100_000)
+#: Work of a whole sweep, s, up to which the runner makes it one chunk when it chooses
+#: (one process, at most ``AUTO_CHUNK_ROWS[1]`` rows): in chunks a file-layout table's rows
+#: are written twice, a part and then the table (about 1 us a row, 10-20 % of a
+#: Kelvin-Voigt row's kernel time), which would only save this much work on an interrupt.
+ONE_CHUNK_SECONDS = 2 * AUTO_CHUNK_SECONDS
 #: File in the parts directory that records the chunk size the runner chose (JSON).
 CHUNK_SIZE_FILE = "_chunk_size.json"
 #: Rows of one sweep at most (a grid axis has at most as many points).

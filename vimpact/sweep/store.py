@@ -263,11 +263,13 @@ def move_aside(path: Path) -> Path:
     return target
 
 
-def write_part(spec, table, parts: Path, chunk: int, summary_: dict) -> Path:
+def write_part(spec, table, parts: Path, chunk: int, summary_: dict,
+               content_sha256: str | None = None) -> Path:
     """Write the table of ``chunk`` atomically.
 
     With the sweep metadata, its row range, its summary (``counts``, ``paths``),
-    page checksums and its content hash.
+    page checksums and its content hash (``content_sha256``: computed by the caller
+    from ``table``, e.g. together with the whole table's; computed here if ``None``).
 
     A failed write (e.g. disk full) raises ``OSError`` saying that the finished
     parts are kept and how to continue.
@@ -277,7 +279,8 @@ def write_part(spec, table, parts: Path, chunk: int, summary_: dict) -> Path:
             "n_chunks": spec.n_chunks, **summary_}
     path = part_path(parts, chunk, spec.n_chunks)
     try:
-        write_atomic(table.replace_schema_metadata(encode_metadata(meta)), path)
+        write_atomic(table.replace_schema_metadata(encode_metadata(meta)), path,
+                     content_sha256=content_sha256)
     except OSError as exc:
         raise _kept(exc, parts) from exc
     return path
@@ -333,7 +336,8 @@ def is_complete(spec, out: Path) -> bool:
 HOLD_ROWS = AUTO_CHUNK_ROWS[1]
 
 
-def combine(spec, parts: Path, out: Path, explain_paths, fresh=None) -> None:
+def combine(spec, parts: Path, out: Path, explain_paths, fresh=None,
+            fresh_digest: str | None = None) -> None:
     """Finish the table from the parts.
 
     Verify every part (:func:`existing_parts`:
@@ -355,13 +359,14 @@ def combine(spec, parts: Path, out: Path, explain_paths, fresh=None) -> None:
     stays bounded by a chunk, or by that many rows). ``fresh``: ``(table, summary)``
     of every chunk of a file-layout table, just computed in this process (at most
     :data:`HOLD_ROWS` rows, or one chunk), in chunk order: the table is written from
-    them with its content hash computed from the rows in memory and the parts are
+    them with its content hash computed from the rows in memory (``fresh_digest``, if
+    the caller computed it from them as they were made, else here) and the parts are
     not read (:func:`_write_fresh`); a one-chunk sweep has no part.
     """
     import pyarrow.parquet as pq
 
     if fresh is not None:
-        _write_fresh(spec, parts, out, explain_paths, fresh)
+        _write_fresh(spec, parts, out, explain_paths, fresh, fresh_digest)
         return
     whole = ContentHash()
     held: list | None = [] if spec.table_layout == "file" and (
@@ -436,12 +441,14 @@ def _remove_parts_dir(parts: Path) -> None:
     fsync_dir(parts.parent)
 
 
-def _write_fresh(spec, parts: Path, out: Path, explain_paths, fresh: list) -> None:
+def _write_fresh(spec, parts: Path, out: Path, explain_paths, fresh: list,
+                 digest: str | None = None) -> None:
     """Write a file-layout table from its chunks in memory, all just computed.
 
     ``fresh``: ``(table, summary)`` of every chunk in chunk order. The content hash
-    is computed from the rows in memory, the parts (if any) are not read: the table
-    is the one :func:`combine` would make from them, byte for byte, and they are
+    is computed from the rows in memory (``digest``: given by the caller, who computed
+    it from them; computed here if ``None``), the parts (if any) are not read: the
+    table is the one :func:`combine` would make from them, byte for byte, and they are
     removed once it is written and its footer checked. One chunk has no part: a
     failed write (disk full) keeps nothing, the chunk is computed again by the next
     run.
@@ -460,10 +467,11 @@ def _write_fresh(spec, parts: Path, out: Path, explain_paths, fresh: list) -> No
                 paths[name] = {"rows": 0, "first_row": entry["first_row"]}
             paths[name]["rows"] += entry["rows"]
     paths = _explained(paths, explain_paths)
-    whole = ContentHash()
-    for table in tables:
-        whole.update(table)
-    digest = whole.hexdigest()
+    if digest is None:
+        whole = ContentHash()
+        for table in tables:
+            whole.update(table)
+        digest = whole.hexdigest()
     meta = encode_metadata({**spec.metadata(), "paths": paths})
     out.parent.mkdir(parents=True, exist_ok=True)
     written = [part_path(parts, c, spec.n_chunks) for c in range(spec.n_chunks)

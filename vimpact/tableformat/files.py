@@ -34,6 +34,22 @@ from vimpact.tableformat.metadata import META_PREFIX
 COMPRESSION = "zstd"
 
 
+def parquet_options(schema) -> dict:
+    """Return the Parquet writer options of every table and part vimpact writes.
+
+    Page checksums, :data:`COMPRESSION`, and dictionary encoding for the text columns
+    only (status, path, model, error: a few distinct values each). A float column is
+    written plain: its results are mostly distinct values, so a dictionary is tried
+    and dropped page by page, which took 40 % of a sweep table's write time (and
+    the file came out larger: 1.71 MB against 1.45 MB for 1e5 Kelvin-Voigt rows).
+    """
+    import pyarrow as pa
+
+    text = [f.name for f in schema if pa.types.is_string(f.type)
+            or pa.types.is_large_string(f.type) or pa.types.is_dictionary(f.type)]
+    return {"write_page_checksum": True, "compression": COMPRESSION, "use_dictionary": text}
+
+
 def fsync_dir(path: Path) -> None:
     """Fsync a directory (its entries survive a crash); a no-op where not possible."""
     try:
@@ -157,8 +173,8 @@ def write_atomic(table, path: Path, *, schema_only: bool = False, more=(),
             if schema_only:
                 pq.write_metadata(table.schema, f)
             elif more:
-                with pq.ParquetWriter(f, table.schema, write_page_checksum=True,
-                                      compression=COMPRESSION) as writer:
+                with pq.ParquetWriter(f, table.schema, **parquet_options(table.schema)) \
+                        as writer:
                     for k, piece in enumerate(itertools.chain([table], more)):
                         if again is not None:
                             again.update(piece)
@@ -167,7 +183,7 @@ def write_atomic(table, path: Path, *, schema_only: bool = False, more=(),
             else:
                 if again is not None:
                     again.update(table)
-                pq.write_table(table, f, write_page_checksum=True, compression=COMPRESSION)
+                pq.write_table(table, f, **parquet_options(table.schema))
             if again is not None and again.hexdigest() != content_sha256:
                 raise Damaged(f"the rows written to {path} do not give the content hash "
                               f"{str(content_sha256)[:12]}... (data "
@@ -271,5 +287,5 @@ class OutputLock:
 
 
 
-__all__ = ["COMPRESSION", "OutputLock", "atomic_file", "fsync_dir", "refuse_symlink",
-           "remove_temporaries", "write_atomic"]
+__all__ = ["COMPRESSION", "OutputLock", "atomic_file", "fsync_dir", "parquet_options",
+           "refuse_symlink", "remove_temporaries", "write_atomic"]
