@@ -164,8 +164,13 @@ def test_shipped_specs_are_valid():
     assert np.allclose(np.diff(np.log10(kv.axes["Q1"])), 0.1)
     assert np.allclose(kv.axes["nu"], [0, 0.05, 0.1, 0.15, 0.2, 0.25, 0.3, 0.35, 0.4, 0.45, 0.475, 0.5])
     assert list(specs["fig5_4_5_standard_solid_q2"].axes["Q2"]) == [0.01, 0.1, 1, 10, 100]
-    for spec in specs.values():
-        assert spec.numerics == v.Numerics.preset("default")
+    default = v.Numerics.preset("default")
+    for name, spec in specs.items():
+        if name == "standard_solid_band":  # its stiff-arm impacts: a looser rtol, stated
+            assert spec.numerics == dataclasses.replace(default, rtol=1e-6)
+            assert spec.grid_tolerance >= 100 * spec.numerics.rtol
+        else:
+            assert spec.numerics == default
         assert spec.output.parent.name == "tables"
 
 
