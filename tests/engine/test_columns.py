@@ -230,3 +230,30 @@ def test_refinement_of_one_tangential_flag_is_that_of_its_mask():
                         cols, numerics, np.full(len(cols), flag), integrator)
                     for key in want:
                         assert np.array_equal(got[key], want[key]), (key, flag)
+
+
+def test_small_full_stick_batches_run_the_impact_kernel_with_the_batch_kernels_numbers(
+        monkeypatch):
+    """Up to ``CONTINUUM_STICK_SERIAL_ROWS`` full-stick continuum rows run the serial
+    impact kernel row by row (a small run compiles no parallel batch kernel); more
+    rows run the batch kernel. Both give the same numbers, bit for bit."""
+    from vimpact.kernels import continuum_maxwell
+
+    n = pack.CONTINUUM_STICK_SERIAL_ROWS
+    scenes = [v.Scene.from_dimensionless(q1, nu, q2)
+              for q1, nu, q2 in zip(np.geomspace(0.01, 3.0, n + 1), np.linspace(0.0, 0.5, n + 1),
+                                    [None, 0.3, 3.0] * n)]
+    launches = []
+    batch = continuum_maxwell.maxwell_stick_batch
+
+    def counted(*args):
+        launches.append(len(args[0]))
+        return batch(*args)
+
+    monkeypatch.setattr(continuum_maxwell, "maxwell_stick_batch", counted)
+    big = v.simulate_batch(scenes)
+    small = v.simulate_batch(scenes[:n])
+    assert launches == [n + 1]  # the small batch did not launch the batch kernel
+    assert (big.path == "continuum[stick]").all() and (big.status == "ok").all()
+    for key in ("e_z", "beta_x", "e_x", "t_contact", "u_max", "a_max", "n_steps"):
+        assert np.array_equal(small[key].to_numpy(), big[key].to_numpy()[:n]), key

@@ -21,6 +21,13 @@ CONTINUUM_MAX_STEPS = 1_000_000
 #: Accepted steps of the full-stick continuum kernel at most (tens to thousands;
 #: beyond, the element path takes the row).
 CONTINUUM_STICK_MAX_STEPS = 200_000
+#: Rows of the full-stick continuum path up to which a batch runs the serial impact
+#: kernel row by row instead of the parallel batch kernel: continuum rows take tens to
+#: hundreds of microseconds, so a parallel launch gains at most a few ms there, and a
+#: small run (a first command, a small sweep) does not compile the batch kernel, about
+#: 10 s of CPU on an empty cache (its parallel loop optimizes the whole impact kernel
+#: once more). The same kernel computes every row either way: the same numbers.
+CONTINUUM_STICK_SERIAL_ROWS = 16
 
 
 def arm_arrays(cols: SceneColumns, keep: bool = True) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -80,9 +87,9 @@ def run_path(path: Path, cols: SceneColumns, numerics: Numerics, rec: np.ndarray
         g, tau, n_arms = arm_arrays(cols)
         args = (cols.dashpot_time / cols.T, g, tau, n_arms, cols.kappa, cols.contact_mass_factor,
                 cols.computes_tangential)
-        # one row (a single simulate()): the impact kernel itself, whose cold compile
+        # few rows (a single simulate()): the impact kernel itself, whose cold compile
         # is about half that of the parallel batch kernel
-        if rec.shape[1] == 0 and len(cols) > 1:
+        if rec.shape[1] == 0 and len(cols) > CONTINUUM_STICK_SERIAL_ROWS:
             continuum_maxwell.maxwell_stick_batch(*args, numerics.rtol, CONTINUUM_STICK_MAX_STEPS,
                                                   out)
             return

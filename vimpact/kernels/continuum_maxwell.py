@@ -493,7 +493,7 @@ def _rhs(phase, y0, x, K, r, advance, tau0, g, itau, n, kappa, mu_t, tang, rc, h
     return Fz, Fx
 
 
-@jit()
+@jit(inline="always")
 def _rhs_once(phase, y0, x, K, r, tau0, g, itau, n, kappa, mu_t, tang, rc, hs, nh, ah, e_val,
               kh):
     """Evaluate :func:`_rhs` at a state that holds its arm quantities (no advance).
@@ -501,7 +501,10 @@ def _rhs_once(phase, y0, x, K, r, tau0, g, itau, n, kappa, mu_t, tang, rc, hs, n
     For the few evaluations outside the steps. The right-hand side is a called
     function, compiled once (inlined into :func:`_step` and here it was lowered
     twice) for an ``advance`` typed bool, not a literal (which would compile it once
-    per value).
+    per value). This wrapper itself is inlined where it is called: compiled as a
+    function of its own it optimized and emitted all of :func:`_rhs` once more in its
+    own module, about 1 s of the 14 s of CPU of a cold ``vimpact simulate`` (measured
+    side by side, fresh cache each).
     """
     return _rhs(phase, y0, x, K, r, np.bool_(False), tau0, g, itau, n, kappa, mu_t, tang, rc, hs,
                 nh, ah, e_val, kh)
