@@ -380,7 +380,7 @@ def kv_normal_impact(tau0, rtol, max_steps, rec, rec_every, out):
     atol_s = atol * s_scale
     atol_v = atol * v_scale
 
-    unloading = np.bool_(False)
+    unloading: np.bool_ = np.bool_(False)
     s = 0.0
     v = 1.0
     t = 0.0

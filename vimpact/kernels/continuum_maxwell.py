@@ -971,7 +971,7 @@ def maxwell_stick_impact(tau0, g, tau, kappa, mu_t, tangential, rtol, max_steps,
             i_rec = _rec_state(rec, i_rec, phase, y, K, tau0, ga, itau, n, kappa, mu_t, tang, rc,
                                hs, nh, ah, e_val, kh)
     if status == STATUS_OK and (n > 0 or tau0 > 0.0):
-        a_end = np.empty(max(n, 1))
+        a_end = np.empty(n if n > 0 else np.int64(1))
         for i in range(n):
             a_end[i] = y[3] - y[4 + i]  # A_i = u - D_i
         tol_c = 10.0 * rtol * max(u_max, 1e-300)

@@ -59,6 +59,7 @@ from __future__ import annotations
 import functools
 import math
 import types
+from collections.abc import Callable
 from typing import NamedTuple
 
 import numpy as np
@@ -727,6 +728,11 @@ def _named_for(function, spec: KernelSpec):
     function.__qualname__ = f"{function.__qualname__}_{tag}"
     function.__name__ = f"{function.__name__}_{tag}"
     return function
+
+
+#: the impact a batch loop calls: not bound here (a declaration for the type checker);
+#: :func:`element_kernel` binds it per specialization in the loop's globals
+_spec_impact: Callable[..., None]
 
 
 def _batch_template(key: tuple):
