@@ -92,3 +92,24 @@ def test_the_shipped_band_meets_its_neighbours_within_their_bounds(table):
     for k in ("e_z", "beta_x"):
         assert np.max(np.abs(at_top[k] - main[k])) <= main_b[k] + band_b[k]
         assert np.max(np.abs(at_bottom[k] - limit[k])) <= band_b[k] + kv_b[k] + gap[k]
+
+
+def test_info_names_the_table_that_answers_below(table):
+    """`table info` says which neighbour answers below the Q2 range: the band below the
+    main table, the Kelvin-Voigt table (with the measured distance) below the band."""
+    from vimpact.lookup.band import BAND_FILE, KELVIN_VOIGT_FILE
+    from vimpact.lookup.info import format_info
+    from vimpact.lookup.table import RestitutionTable
+
+    band_path = TABLE.parent / BAND_FILE
+    if not band_path.is_file():
+        assert table.info()["below"] is None
+        return
+    below = table.info()["below"]
+    assert below["file"] == BAND_FILE and below["Q2"] == pytest.approx(1e-3)
+    assert f"Q2 < 0.001: {BAND_FILE} beside it answers" in format_info(table.info())
+    band = RestitutionTable.open(band_path).info()
+    assert band["below"]["file"] == KELVIN_VOIGT_FILE and band["below"]["Q2"] == pytest.approx(1e-5)
+    assert 0.0 < band["below"]["limit_distance"]["beta_x"] < 1e-5
+    kv = RestitutionTable.open(TABLE.parent / KELVIN_VOIGT_FILE)
+    assert kv.info()["below"] is None

@@ -53,6 +53,7 @@ def table_info(table: RestitutionTable) -> dict:
             grid_info, failed, note = None, None, str(exc)
     spec = table.meta("spec")
     return {
+        "below": _below(table),
         "path": None if table.path is None else str(table.path),
         "model": table.model,
         "rows": int(len(table.data)),
@@ -74,6 +75,28 @@ def table_info(table: RestitutionTable) -> dict:
     }
 
 
+def _below(table: RestitutionTable) -> dict | None:
+    """Return which table beside ``table`` answers below its ``Q2`` range, or None.
+
+    For an adaptive standard-solid table read from a file (:mod:`vimpact.lookup.band`):
+    the neighbour's file name, the ``Q2`` where it takes over and its error bound; for
+    the Kelvin-Voigt limit also the measured distance to it.
+    """
+    from vimpact.lookup.band import neighbour_below
+
+    try:
+        found = neighbour_below(table)
+    except (OSError, ValueError):
+        return None
+    if found is None or found.path is None:
+        return None
+    grid = table.adaptive_grid()
+    lo = float(grid.bounds[grid.axes.index("Q2")][0])
+    limit = table.meta("kelvin_voigt_limit") if found.model == "kelvin_voigt" else None
+    return {"file": found.path.name, "Q2": lo, "error_bound": found.error_bound(),
+            "limit_distance": limit.get("max") if isinstance(limit, dict) else None}
+
+
 def format_info(info: dict) -> str:
     """Return the readable form of :meth:`vimpact.lookup.table.RestitutionTable.info`.
 
@@ -86,7 +109,8 @@ def format_info(info: dict) -> str:
     -------
     str
         One line per item (model, rows, statuses, ranges, grid or adaptive cells,
-        numerics, interpolation error, version, spec).
+        numerics, interpolation error, the table that answers below its ``Q2`` range,
+        version, spec).
     """
     lines = [f"restitution table {info['path'] or '(in memory)'}"]
     if info.get("description"):
@@ -136,6 +160,17 @@ def format_info(info: dict) -> str:
                      "against direct simulation")
     else:
         lines.append("  interpolation   error not measured (`vimpact table verify TABLE --write`)")
+    below = info.get("below")
+    if below:
+        bound = below["error_bound"] or {}
+        text = ", ".join(f"{k} {bound[k]:.2g}" for k in ("e_z", "beta_x")
+                         if bound.get(k) is not None)
+        line = (f"  below           Q2 < {below['Q2']:.6g}: {below['file']} beside it answers"
+                + (f" (error bound {text}" if text else ""))
+        if below.get("limit_distance"):
+            d = below["limit_distance"]
+            line += f"; distance to that limit {d['e_z']:.2g} e_z, {d['beta_x']:.2g} beta_x"
+        lines.append(line + (")" if text else ""))
     lines.append(f"  vimpact         {info['version'] or 'unknown'}"
                  f" (schema {info['schema_version'] or 'unknown'})")
     spec = info["spec"]
