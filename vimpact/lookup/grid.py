@@ -18,7 +18,7 @@ import numpy as np
 import pandas as pd
 
 from vimpact.lookup.columns import DATA_STATUSES, LOOKUP_MODELS, SPEC_HINTS, fmt
-from vimpact.lookup.interpolate import LOG_AXES, cluster_nodes, same_node
+from vimpact.lookup.interpolate import LOG_AXES, cluster_nodes, outside_range, same_node
 from vimpact.model.scene import DEFAULT_THETA_RATIO
 from vimpact.model.validation import InputError
 
@@ -57,13 +57,7 @@ class TableGrid:
         lo, hi = nodes[0], nodes[-1]
         inside = ((x >= lo) | same_node(x, lo)) & ((x <= hi) | same_node(x, hi))
         if not extrapolate and not np.all(inside):
-            bad = float(x[~inside].flat[0])
-            covered = (f"{name} = {fmt(lo)} only (a single grid value)" if len(nodes) == 1
-                       else f"{name} in [{fmt(lo)}, {fmt(hi)}]")
-            raise InputError(
-                f"{name} = {bad:.6g} is outside the table's range: it covers {covered}; "
-                "extrapolate=True (--extrapolate) extrapolates linearly"
-                + (f" in log {name}" if name in LOG_AXES else ""))
+            raise outside_range(name, nodes, float(x[~inside].flat[0]), name in LOG_AXES)
         if not extrapolate:
             x = np.clip(x, lo, hi)  # values within round-off of an end node
         if len(nodes) == 1:  # a single value: constant along this axis

@@ -107,6 +107,20 @@ def _fmt(x: float) -> str:
     return f"{x:.6g}"
 
 
+def outside_range(name: str, nodes: np.ndarray, bad: float, log_axis: bool) -> InputError:
+    """Return the refusal of a lookup at ``name = bad``, outside the axis' ``nodes``.
+
+    The one wording of the tensor lookups (multilinear and cubic): the range covered
+    and how to extrapolate (linearly, in log ``name`` on a ``log_axis``).
+    """
+    lo, hi = nodes[0], nodes[-1]
+    covered = (f"{name} = {_fmt(lo)} only (a single grid value)" if len(nodes) == 1
+               else f"{name} in [{_fmt(lo)}, {_fmt(hi)}]")
+    return InputError(f"{name} = {bad:.6g} is outside the table's range: it covers {covered}; "
+                      "extrapolate=True (--extrapolate) extrapolates linearly"
+                      + (f" in log {name}" if log_axis else ""))
+
+
 def derivative_matrix(x: np.ndarray, stencil: int = _STENCIL) -> np.ndarray:
     """Return the derivative matrix ``D`` of the nodes ``x``.
 
@@ -295,13 +309,7 @@ class HermiteGrid:
         tol_hi = NODE_RTOL * abs(hi) + NODE_ATOL
         if not extrapolate and (x.min() < lo - tol_lo or x.max() > hi + tol_hi):
             inside = (x >= lo - tol_lo) & (x <= hi + tol_hi)
-            bad = float(x[~inside].flat[0])
-            covered = (f"{name} = {_fmt(lo)} only (a single grid value)" if len(nodes) == 1
-                       else f"{name} in [{_fmt(lo)}, {_fmt(hi)}]")
-            raise InputError(
-                f"{name} = {bad:.6g} is outside the table's range: it covers {covered}; "
-                "extrapolate=True (--extrapolate) extrapolates linearly"
-                + (f" in log {name}" if name in self.log_axes else ""))
+            raise outside_range(name, nodes, float(x[~inside].flat[0]), name in self.log_axes)
         if extrapolate and name in self.log_axes and len(nodes) > 1 and x.min() <= 0.0:
             bad = float(x[x <= 0.0].flat[0])
             raise InputError(
