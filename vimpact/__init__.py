@@ -15,9 +15,9 @@ Physics, conventions and units: ``docs/physics.md``.
 
 from __future__ import annotations
 
-import importlib
 from importlib.metadata import PackageNotFoundError, version
 
+from vimpact import _lazy
 from vimpact.kernels.threads import configure as _configure_threads
 
 _configure_threads()  # before numba starts its threads (vimpact.kernels.threads)
@@ -62,12 +62,7 @@ __all__ = sorted(_EXPORTS) + ["__version__"]
 
 
 def __getattr__(name: str):
-    module = _EXPORTS.get(name)
-    if module is None:
-        raise AttributeError(f"module 'vimpact' has no attribute {name!r}")
-    value = getattr(importlib.import_module(module), name)
-    globals()[name] = value  # later look-ups skip this function
-    return value
+    return _lazy.load(__name__, _EXPORTS, globals(), name)
 
 
 def __dir__() -> list[str]:

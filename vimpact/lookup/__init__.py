@@ -11,7 +11,7 @@ pandas until one is used)::
 
 from __future__ import annotations
 
-import importlib
+from vimpact import _lazy
 
 #: public name -> module that defines it
 _EXPORTS = {
@@ -33,12 +33,7 @@ __all__ = sorted(_EXPORTS)
 
 
 def __getattr__(name: str):
-    module = _EXPORTS.get(name)
-    if module is None:
-        raise AttributeError(f"module 'vimpact.lookup' has no attribute {name!r}")
-    value = getattr(importlib.import_module(module), name)
-    globals()[name] = value  # later look-ups skip this function
-    return value
+    return _lazy.load(__name__, _EXPORTS, globals(), name)
 
 
 def __dir__() -> list[str]:
