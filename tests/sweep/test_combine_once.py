@@ -15,23 +15,11 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 import pytest
 
-from tests.sweep import faults, write
+from tests.sweep import GRID_KV, faults, write
 from vimpact import cli
 from vimpact.sweep import parts_dir, run_sweep, store
 from vimpact.sweep.spec import load_spec
 from vimpact.tableformat import files, integrity, metadata
-
-# Kelvin-Voigt on its continuum path, 6 rows: seconds
-GRID_KV = """
-model = "kelvin_voigt"
-chunk_size = {chunk}
-[numerics]
-steps = 100
-elements = 20
-[grid]
-Q1 = [0.01, 0.1, 1.0]
-nu = [0.3, 0.5]
-"""
 
 
 class Reads:

@@ -22,7 +22,7 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 import pytest
 
-from tests.sweep import faults, write
+from tests.sweep import GRID_KV, faults, write
 from vimpact import cli
 from vimpact.model.validation import InputError
 from vimpact.sweep import parts_dir, run_sweep, store
@@ -31,17 +31,6 @@ from vimpact.tableformat import files, integrity, metadata
 
 ROOT = Path(__file__).resolve().parents[2]
 
-# Kelvin-Voigt on its continuum path, 6 rows in 3 chunks: seconds
-GRID_KV = """
-model = "kelvin_voigt"
-chunk_size = 2
-[numerics]
-steps = 100
-elements = 20
-[grid]
-Q1 = [0.01, 0.1, 1.0]
-nu = [0.3, 0.5]
-"""
 
 
 @pytest.fixture(scope="module")
@@ -49,7 +38,7 @@ def clean(tmp_path_factory):
     """The spec and the table of an undisturbed run: what every faulty run must end with
     (and, kept aside, the parts of all its chunks)."""
     tmp = tmp_path_factory.mktemp("clean")
-    spec = write(tmp, GRID_KV)
+    spec = write(tmp, GRID_KV.format(chunk=2))
     parts = run_sweep(spec, out=tmp / "template.parquet", shard=(0, 1), progress=False)
     names = sorted(p.name for p in parts.glob("part-*.parquet"))
     assert names == ["part-00000.parquet", "part-00001.parquet", "part-00002.parquet"]
@@ -272,7 +261,7 @@ def test_a_part_of_another_sweep_is_refused(tmp_path, clean):
     spec, _ = clean
     out = tmp_path / "t.parquet"
     parts = parts_of(spec, out)
-    other = write(tmp_path, GRID_KV.replace("steps = 100", "steps = 101"), "other.toml")
+    other = write(tmp_path, GRID_KV.format(chunk=2).replace("steps = 100", "steps = 101"), "other.toml")
     other_parts = run_sweep(other, out=tmp_path / "other.parquet", shard=(0, 1), progress=False)
     foreign = (other_parts / "part-00001.parquet").read_bytes()
     (parts / "part-00001.parquet").write_bytes(foreign)
@@ -382,7 +371,7 @@ def test_the_shipped_tables_pass(tmp_path):
 
 def test_dataset_layout_damaged_part_is_refused_then_recomputed(tmp_path, clean, capsys):
     spec, clean_bytes = clean
-    ds_spec = write(tmp_path, 'layout = "dataset"\n' + GRID_KV, "dataset.toml")
+    ds_spec = write(tmp_path, 'layout = "dataset"\n' + GRID_KV.format(chunk=2), "dataset.toml")
     out = run_sweep(ds_spec, out=tmp_path / "ds.parquet", progress=False)
     assert integrity.verify_table(out).endswith("content hash verified")
     (tmp_path / "clean.parquet").write_bytes(clean_bytes)
