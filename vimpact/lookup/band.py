@@ -31,7 +31,7 @@ if TYPE_CHECKING:
     from vimpact.lookup.table import RestitutionTable
 
 __all__ = ["BAND_FILE", "BAND_SPEC", "KELVIN_VOIGT_FILE", "KELVIN_VOIGT_Q2", "below_range",
-           "neighbour_below", "reaches_kelvin_voigt"]
+           "neighbour_below", "q2_range", "reaches_kelvin_voigt"]
 
 #: The band table's file name, looked for beside a standard-solid table.
 BAND_FILE = "standard_solid_band.parquet"
@@ -58,7 +58,8 @@ def _open(path: Path) -> RestitutionTable:
     return _OPENED[key]
 
 
-def _q2_range(table: RestitutionTable) -> tuple[float, float]:
+def q2_range(table: RestitutionTable) -> tuple[float, float]:
+    """Return the ``Q2`` range ``(lo, hi)`` of an adaptive standard-solid table's cells."""
     grid = table.adaptive_grid()
     lo, hi = grid.bounds[grid.axes.index("Q2")]
     return float(lo), float(hi)
@@ -66,7 +67,7 @@ def _q2_range(table: RestitutionTable) -> tuple[float, float]:
 
 def reaches_kelvin_voigt(table: RestitutionTable) -> bool:
     """Whether an adaptive standard-solid table reaches down to :data:`KELVIN_VOIGT_Q2`."""
-    return _q2_range(table)[0] <= KELVIN_VOIGT_Q2 * (1.0 + 1e-9)
+    return q2_range(table)[0] <= KELVIN_VOIGT_Q2 * (1.0 + 1e-9)
 
 
 def neighbour_below(table: RestitutionTable) -> RestitutionTable | None:
@@ -103,13 +104,13 @@ def neighbour_below(table: RestitutionTable) -> RestitutionTable | None:
     found = _open(band)
     if found.model != "standard_solid" or not found.is_adaptive:
         return None
-    if not np.isclose(_q2_range(found)[1], _q2_range(table)[0], rtol=1e-9):
+    if not np.isclose(q2_range(found)[1], q2_range(table)[0], rtol=1e-9):
         return None
     return found
 
 
 def _refusal(table: RestitutionTable, q2: float) -> InputError:
-    lo, hi = _q2_range(table)
+    lo, hi = q2_range(table)
     if reaches_kelvin_voigt(table) and table.meta("kelvin_voigt_limit") is None:
         return InputError(
             f"Q2 = {q2:.6g} is outside the table's range: it covers Q2 in [{lo:.6g}, "
@@ -173,7 +174,7 @@ def below_range(table: RestitutionTable, arrays: dict[str, np.ndarray], method: 
     if (table.model != "standard_solid" or not table.is_adaptive or "Q2" not in arrays
             or method != "cubic" or extrapolate):  # the table's own lookup refuses these
         return None
-    lo, _ = _q2_range(table)
+    lo, _ = q2_range(table)
     Q2 = np.asarray(arrays["Q2"], dtype=float)
     below = Q2 < lo * (1.0 - 1e-9)
     if not below.any():

@@ -82,7 +82,7 @@ def _below(table: RestitutionTable) -> dict | None:
     the neighbour's file name, the ``Q2`` where it takes over and its error bound; for
     the Kelvin-Voigt limit also the measured distance to it.
     """
-    from vimpact.lookup.band import neighbour_below
+    from vimpact.lookup.band import neighbour_below, q2_range
 
     try:
         found = neighbour_below(table)
@@ -90,8 +90,7 @@ def _below(table: RestitutionTable) -> dict | None:
         return None
     if found is None or found.path is None:
         return None
-    grid = table.adaptive_grid()
-    lo = float(grid.bounds[grid.axes.index("Q2")][0])
+    lo = q2_range(table)[0]
     limit = table.meta("kelvin_voigt_limit") if found.model == "kelvin_voigt" else None
     return {"file": found.path.name, "Q2": lo, "error_bound": found.error_bound(),
             "limit_distance": limit.get("max") if isinstance(limit, dict) else None}
