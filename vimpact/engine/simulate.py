@@ -11,9 +11,9 @@ SI result columns (:mod:`~vimpact.engine.unpack`) -> ``DataFrame`` (batch) or
 from __future__ import annotations
 
 import time
+from typing import TYPE_CHECKING
 
 import numpy as np
-import pandas as pd
 
 from vimpact.engine.columns import SceneColumns, scene_columns
 from vimpact.engine.pack import element_arrays, interleave, run_path
@@ -25,6 +25,9 @@ from vimpact.model.hertz import HERTZ_TIME_FACTOR
 from vimpact.model.numerics import MAX_ELEMENTS_IN_ROW, MAX_STEPS_PER_T_H, Numerics
 from vimpact.model.scene import HALF_SPACE_LIMIT, TANGENTIAL_MEMORY, Scene
 from vimpact.model.validation import InputError, message, require
+
+if TYPE_CHECKING:  # pandas (0.3 s to import) is loaded only where a DataFrame is made
+    import pandas as pd
 
 #: Rows of a recorded trajectory at most (the last row always holds the end state).
 MAX_TRAJECTORY_ROWS = 1_000_000
@@ -247,6 +250,8 @@ def simulate_batch(scenes, numerics: Numerics | str | None = None, *,
         Nothing is raised for a bad row. ``error`` has pandas' string dtype; a row
         without an error has a missing value there (``isna`` is True).
     """
+    import pandas as pd
+
     t0 = time.perf_counter()
     numerics = _numerics(numerics)
     cols = scene_columns(scenes)
@@ -351,6 +356,8 @@ def explain(scene: Scene, numerics: Numerics | str | None = None) -> str:
 
 def _trajectory(s: Scene, rec: np.ndarray) -> pd.DataFrame:
     """Physical time series from kernel records."""
+    import pandas as pd
+
     hz = s.hertz
     vc = rec[:, layout.REC_VC] if s.computes_tangential else np.ones(len(rec))
     v_x, omega = s.tangential_end_state(vc)
