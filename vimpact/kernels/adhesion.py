@@ -202,8 +202,10 @@ def adhesive_impact(tau0, g, tau, lam, h, n_elem, dxi, max_steps, out):
 
     :func:`adhesive_record` without the record.
     """
+    # np.int64: a bare constant would be typed Literal[int] and compile _impact a second
+    # time, besides the int64 signature adhesive_record compiles it for
     _impact(tau0, g, tau, lam, h, n_elem, dxi, max_steps, out, np.zeros((0, N_REC)),
-            CERTIFY_EVERY)
+            np.int64(CERTIFY_EVERY))
 
 
 @jit()
