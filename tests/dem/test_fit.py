@@ -107,3 +107,27 @@ def test_kelvin_voigt_fit_is_close_to_tau_and_residual_is_second_order():
     tau = 600.0 / 3e7
     assert A == pytest.approx(tau, rel=0.1)
     assert np.max(np.abs(e - t.e_z)) < 0.1 * np.max(1 - t.e_z)
+
+
+@pytest.mark.parametrize("ln_k, ln_x", [(-0.18, 7.27), (-0.2, -0.58), (0.5, 2.0), (-1.0, 4.0)])
+def test_tangential_grid_search_recovers_known_lammps_constants(ln_k, ln_x):
+    """The shrinking-grid search of the LAMMPS tangential fit, on beta targets made by the
+    stepped Hertz-Mindlin-Coulomb law itself at known ``(ln k_t / k_0, ln x_gamma_t)``,
+    finds those constants from the fit's own start (the cost has curved valleys: a search
+    that shrinks after every move stopped in the wrong one in three of these four)."""
+    import math
+
+    from vimpact.dem.fit import grid_search
+    from vimpact.dem.lammps import FIT_STEPS, SEARCH_HALF_WIDTH, SEARCH_START
+
+    alpha = np.array([1e-4, 3e-4, 1e-3, 3e-3])  # A v0 / d_H at four speeds
+    kappa0, F, mu, w0 = 0.6, 3.5, 0.5, np.ones(4)  # 45 degrees, a solid sphere
+
+    def beta(ln_kappa, ln_gamma):
+        return laws.hertz_mindlin_coulomb(alpha, kappa0 * np.exp(ln_kappa), np.exp(ln_gamma),
+                                          F, mu, w0, FIT_STEPS)[1]
+
+    target = beta(ln_k, ln_x)
+    z = grid_search(lambda z: np.mean((beta(z[:, :1], z[:, 1:]) - target) ** 2, axis=1),
+                    SEARCH_START, SEARCH_HALF_WIDTH, (-5.0, math.log(1e-6)), (5.0, math.log(1e12)))
+    assert z == pytest.approx([ln_k, ln_x], abs=0.01)

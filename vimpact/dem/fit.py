@@ -329,14 +329,17 @@ def fit_scalar(predict, target: np.ndarray, lo: float, hi: float) -> tuple[float
 
 def grid_search(cost, start, half_width, lower, upper, xatol: float = 5e-4, n: int = 7,
                 max_rounds: int = 40) -> np.ndarray:
-    """Minimize ``cost`` over two parameters by shrinking grids, each evaluated in one call.
+    """Minimize ``cost`` over two parameters by a pattern search of grids, each evaluated in one call.
 
     Each round evaluates an ``n x n`` grid of half-widths ``half_width`` around the
     centre (clipped to ``[lower, upper]``) in one call of ``cost`` (so that a stepped
-    law runs every candidate at once), moves the centre to the best point and, when that
-    point is inside the grid, shrinks the half-widths to one grid spacing (else doubles
-    them, up to 4 times the first: the minimum lies further out). Stops when the spacing
-    is below ``xatol`` in both parameters.
+    law runs every candidate at once) and moves the centre to the best point. The grid
+    shrinks to one grid spacing only when the centre stays the best (the minimum is
+    bracketed); a move keeps it, and a move to an edge doubles the half-width of that
+    parameter (up to 4 times the first: the minimum lies further out). Shrinking after
+    every move instead crawls along a curved valley of the cost by ever smaller steps
+    and stops far from its bottom. Stops when the spacing is below ``xatol`` in both
+    parameters, or after ``max_rounds`` rounds.
 
     Parameters
     ----------
@@ -358,24 +361,15 @@ def grid_search(cost, start, half_width, lower, upper, xatol: float = 5e-4, n: i
         axes = [np.unique(np.clip(c[i] + h[i] * u, lo[i], hi[i])) for i in range(2)]
         z = np.stack([g.ravel() for g in np.meshgrid(*axes, indexing="ij")], axis=1)
         f = cost(z)
-
-        def at(p: np.ndarray) -> int:  # the grid point nearest to p
-            return int(np.argmin(np.abs(z - p).sum(axis=1)))
-
+        centre = int(np.argmin(np.abs(z - c).sum(axis=1)))  # the grid point at the centre
         j = int(np.argmin(f))
-        if f[j] >= f[at(c)] * (1.0 - 1e-12):
-            j = at(c)  # ties keep the centre
-        # an edge in one parameter counts only if it is better than that parameter at the
-        # centre (a flat direction would otherwise move the grid for ever)
-        edge = [(z[j, i] in (axes[i][0], axes[i][-1])) and axes[i].size > 1
-                and lo[i] < z[j, i] < hi[i]
-                and f[j] < f[at(np.where(np.arange(2) == i, c, z[j]))] * (1.0 - 1e-9)
-                for i in range(2)]
-        c = z[j]
-        if any(edge):  # the minimum lies further out: look wider
-            h = np.minimum(h * 2.0, h_max)
-        else:
-            h = h * 2.0 / (n - 1)  # the last spacing: the best point is this close
+        if f[j] >= f[centre] * (1.0 - 1e-12):  # ties keep the centre: shrink around it
+            h = h * 2.0 / (n - 1)
             if np.all(h < xatol):
                 break
+            continue
+        for i in range(2):  # an edge inside the bounds: the minimum lies further out
+            if axes[i].size > 1 and z[j, i] in (axes[i][0], axes[i][-1]) and lo[i] < z[j, i] < hi[i]:
+                h[i] = min(2.0 * h[i], h_max[i])
+        c = z[j]
     return c
