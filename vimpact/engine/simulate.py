@@ -11,13 +11,13 @@ SI result columns (:mod:`~vimpact.engine.unpack`) -> ``DataFrame`` (batch) or
 from __future__ import annotations
 
 import time
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from vimpact.engine.columns import SceneColumns, scene_columns
 from vimpact.engine.pack import element_arrays, interleave, run_path
-from vimpact.engine.result import RESULT_FIELDS, ImpactResult
+from vimpact.engine.result import RESULT_FIELDS, STATUS_NAMES, Coded, ImpactResult
 from vimpact.engine.routing import CONTINUUM_STICK, choose_path, route
 from vimpact.engine.unpack import unpack, unpack_row
 from vimpact.kernels import layout
@@ -54,12 +54,14 @@ def _numerics(numerics) -> Numerics:
 
 
 def run_columns(cols: SceneColumns, numerics: Numerics, n_rec: int = 0, rec_every: int = 1,
-                timings: dict | None = None
-                ) -> tuple[dict[str, np.ndarray], np.ndarray, np.ndarray]:
+                timings: dict | None = None, codes: bool = False
+                ) -> tuple[dict[str, Any], np.ndarray, np.ndarray]:
     """Route, pack, run and unpack a batch.
 
     The result columns, the trajectory buffer ``(n, n_rec, N_REC)`` (kernel units) and the
-    rows written in it.
+    rows written in it. ``codes``: ``status`` and ``path`` as
+    :class:`~vimpact.engine.result.Coded` (integer codes and their names) instead of
+    object arrays of ``str`` (:func:`~vimpact.engine.unpack.unpack`).
 
     Rows the full-stick continuum kernel hands back (its assumptions broke, or
     its step limit) run again on the element kernel their effects call for.
@@ -72,37 +74,57 @@ def run_columns(cols: SceneColumns, numerics: Numerics, n_rec: int = 0, rec_ever
 
         rest, adh = np.flatnonzero(~adhesive), np.flatnonzero(adhesive)
         t0 = time.perf_counter()
-        parts = [result_columns(cols.take(adh), numerics)]
+        parts: list[dict[str, Any]] = [result_columns(cols.take(adh), numerics)]
         if timings is not None:  # (the conversion to SI is included: it is small)
             timings["kernel_s"] = timings.get("kernel_s", 0.0) + time.perf_counter() - t0
+        if codes:
+            parts[0]["status"] = Coded.encode(parts[0]["status"], STATUS_NAMES)
+            parts[0]["path"] = Coded.encode(parts[0]["path"])
         rec = np.zeros((len(cols), n_rec, layout.N_REC))
         written = np.zeros(len(cols), dtype=np.int64)
         if len(rest):
             result, rec[rest], written[rest] = run_columns(cols.take(rest), numerics, n_rec,
-                                                           rec_every, timings)
+                                                           rec_every, timings, codes)
             parts.append(result)
         order = np.argsort(np.concatenate([adh, rest]), kind="stable")
-        return ({name: np.concatenate([p[name] for p in parts])[order] for name in parts[0]},
+        return ({name: _concatenate([p[name] for p in parts], order) for name in parts[0]},
                 rec, written)
-    out, rec, path_names, explicit_euler, steps_per_T, refused = _run(
+    out, rec, paths, explicit_euler, steps_per_T, refused = _run(
         cols, numerics, n_rec, rec_every, timings)
     written = out[:, layout.OUT_N_REC].astype(np.int64)
-    return unpack(cols, out, path_names, explicit_euler, steps_per_T, refused), rec, written
+    return (unpack(cols, out, paths, explicit_euler, steps_per_T, refused, codes), rec,
+            written)
+
+
+def _concatenate(pieces: list, order: np.ndarray):
+    """Return result columns (arrays, or :class:`Coded` with their own names) joined, in ``order``."""
+    if not isinstance(pieces[0], Coded):
+        return np.concatenate(pieces)[order]
+    names = tuple(dict.fromkeys(name for p in pieces for name in p.names))
+    index = {name: i for i, name in enumerate(names)}
+    codes = []
+    for p in pieces:  # each piece's codes in the joined names (-1 stays -1: the last entry)
+        lookup = np.array([index[name] for name in p.names] + [-1], dtype=np.int16)
+        codes.append(lookup[p.codes])
+    return Coded(np.concatenate(codes)[order], names)
 
 
 def _run(cols: SceneColumns, numerics: Numerics, n_rec: int, rec_every: int,
-         timings: dict | None) -> tuple[np.ndarray, ...]:
+         timings: dict | None
+         ) -> tuple[np.ndarray, np.ndarray, Coded, np.ndarray, np.ndarray, np.ndarray]:
     """Route, pack and run a batch; return the kernel rows and what unpack takes.
 
     Route, pack and run: the kernel rows ``out``, the trajectory buffer, and per
-    row the path name, explicit Euler, steps per ``T`` and refusal that
+    row the path (:class:`~vimpact.engine.result.Coded`, ``-1`` where none ran),
+    explicit Euler, steps per ``T`` and refusal that
     :func:`~vimpact.engine.unpack.unpack` takes (:func:`run_columns`).
     """
     n = len(cols)
     routes = route(cols, numerics)
     out = np.zeros((n, layout.N_OUT))
     rec = np.zeros((n, n_rec, layout.N_REC))
-    path_names = np.empty(n, dtype=object)  # (NumPy fills an object array with None)
+    path_codes = np.full(n, -1, dtype=np.int16)  # (-1: no path, an invalid row)
+    path_list: list[str] = []
     explicit_euler = np.zeros(n, dtype=bool)
     steps_per_T = np.zeros(n)
     refused = np.empty(n, dtype=object)
@@ -176,7 +198,9 @@ def _run(cols: SceneColumns, numerics: Numerics, n_rec: int, rec_every: int,
             out[idx] = sub_out
             if n_rec:
                 rec[idx] = sub_rec
-        path_names[idx] = path.name
+        if path.name not in path_list:
+            path_list.append(path.name)
+        path_codes[idx] = path_list.index(path.name)
         if path.kind == CONTINUUM_STICK:
             status = sub_out[:, layout.OUT_STATUS]
             back = (status == layout.STATUS_ASSUMPTION) | (status == layout.STATUS_TIME_LIMIT)
@@ -186,7 +210,7 @@ def _run(cols: SceneColumns, numerics: Numerics, n_rec: int, rec_every: int,
                 queue.extend((p, rows[again.group == k]) for k, p in enumerate(again.paths))
     if timings is not None:
         timings["kernel_s"] = timings.get("kernel_s", 0.0) + kernel_s
-    return out, rec, path_names, explicit_euler, steps_per_T, refused
+    return out, rec, Coded(path_codes, tuple(path_list)), explicit_euler, steps_per_T, refused
 
 
 def _read_only(a: np.ndarray) -> np.ndarray:
@@ -330,9 +354,11 @@ def _simulate(scene: Scene, numerics: Numerics, trajectory: bool) -> ImpactResul
             rec_every = max(1, int(per_t_H) // TRAJECTORY_ROWS_PER_T_H)
             n_rec = int(a["max_steps"][0] // rec_every) + 2
         n_rec = min(n_rec, MAX_TRAJECTORY_ROWS)
-    out, rec, path_names, explicit_euler, steps_per_T, refused = _run(
+    out, rec, paths, explicit_euler, steps_per_T, refused = _run(
         cols, numerics, n_rec, rec_every, None)
-    row = unpack_row(cols, out[0], path_names[0], bool(explicit_euler[0]),
+    code = int(paths.codes[0])  # (-1: refused, no path ran)
+    row = unpack_row(cols, out[0], paths.names[code] if code >= 0 else None,
+                     bool(explicit_euler[0]),
                      float(steps_per_T[0]), refused[0])
     traj = None
     if trajectory:
