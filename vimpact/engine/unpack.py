@@ -109,29 +109,36 @@ def unpack(cols: SceneColumns, out: np.ndarray, path_names: np.ndarray | Coded,
         # (rotation off) is outside it, so its work on the sphere cannot count as a gain
         contact0 = v_z0**2 + v_c0**2 / mu_t
         contact1 = v_z_end**2 + (vc_end * v_c0) ** 2 / mu_t
+        # a tangential output of a batch without a tangential row is its fill value
+        # throughout (np.where picks none of it): not computed
+        some = bool(tangential.any())
         values = {
             "e_z": np.abs(vz_end),
-            "e_x": np.where(tangential, np.abs(vc_end), np.nan),
-            "beta_x": np.where(tangential, -vc_end, np.nan),
+            "e_x": _tangential(some, tangential, lambda: np.abs(vc_end), np.nan),
+            "beta_x": _tangential(some, tangential, lambda: -vc_end, np.nan),
             "t_contact": out[:, layout.OUT_T_CONTACT] * cols.T,
             "u_max": out[:, layout.OUT_U_MAX] * cols.d,
             "a_max": out[:, layout.OUT_B_MAX] * cols.a_H,
             "energy_ratio": energy1 / energy0,
             "v_z_end": v_z_end, "v_x_end": v_x_end, "omega_end": omega_end,
-            "mu_eff": np.where(tangential, np.abs(impulse) / (v_z0 - v_z_end), np.nan),
+            "mu_eff": _tangential(some, tangential,
+                                  lambda: np.abs(impulse) / (v_z0 - v_z_end), np.nan),
             "rebound_angle": np.degrees(np.arctan2(v_x_end, -v_z_end)),
-            "gross_slip_fraction": np.where(
-                tangential, out[:, layout.OUT_T_GROSS_SLIP] / out[:, layout.OUT_T_CONTACT], np.nan),
-            "friction_energy": np.where(
-                tangential, out[:, layout.OUT_W_FRICTION] * cols.m * v_c0**2, 0.0),
+            "gross_slip_fraction": _tangential(
+                some, tangential,
+                lambda: out[:, layout.OUT_T_GROSS_SLIP] / out[:, layout.OUT_T_CONTACT], np.nan),
+            "friction_energy": _tangential(
+                some, tangential, lambda: out[:, layout.OUT_W_FRICTION] * cols.m * v_c0**2,
+                0.0),
             # without adhesion an element leaves before it would pull: no tensile force
             "F_tensile_max": np.zeros(n),
         }
         # the contact point's tangential speed cannot grow either (|beta_x| <= 1): the
         # normal energy is far larger when v_c0 << v_z0, so the sum above misses it
         gain = ((contact1 > contact0 * (1.0 + PASSIVITY_SLACK))
-                | (np.abs(vz_end) > 1.0 + PASSIVITY_SLACK)
-                | (tangential & (np.abs(vc_end) > 1.0 + PASSIVITY_SLACK)))
+                | (np.abs(vz_end) > 1.0 + PASSIVITY_SLACK))
+        if some:
+            gain |= tangential & (np.abs(vc_end) > 1.0 + PASSIVITY_SLACK)
         contact_steps = out[:, layout.OUT_T_CONTACT] * steps_per_T
         unresolved = contact_steps < MIN_CONTACT_STEPS
         relative_gain = contact1 / contact0 - 1.0
@@ -177,6 +184,13 @@ def unpack(cols: SceneColumns, out: np.ndarray, path_names: np.ndarray | Coded,
         result[name] = np.where(valid, result[name], np.nan)
     result["n_steps"] = np.where(valid, result["n_steps"], 0)
     return {name: result[name] for name in RESULT_FIELDS}
+
+
+def _tangential(some: bool, tangential: np.ndarray, value, fill: float) -> np.ndarray:
+    """``np.where(tangential, value(), fill)``; ``fill`` throughout, uncomputed, if not ``some``."""
+    if not some:
+        return np.full(tangential.shape[0], fill)
+    return np.where(tangential, value(), fill)
 
 
 def unpack_row(cols: SceneColumns, out: np.ndarray, path_name: str | None, explicit_euler: bool,
