@@ -218,9 +218,7 @@ def _repeated(values: np.ndarray, n: int):
     import pyarrow as pa
 
     if n and isinstance(values[0], str) and bool(np.all(values == values[0])):
-        return pa.DictionaryArray.from_arrays(np.zeros(n, dtype=np.int32),
-                                              pa.array([values[0]], type=pa.string())
-                                              ).cast(pa.string())
+        return pa.repeat(pa.scalar(values[0], type=pa.string()), n)
     return pa.array(values, type=pa.string())
 
 
