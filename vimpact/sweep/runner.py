@@ -202,11 +202,16 @@ def compute_chunk(spec: SweepSpec, chunk: int, timings: dict | None = None):
 def _decoded(codes: np.ndarray, names):
     """Return codes into ``names`` (``-1``: null) as a ``pyarrow`` string array.
 
-    Through a dictionary array: the same string column as from the names per row, without
-    a Python string per row.
+    Through a dictionary array (or one repeated value): the same string column as from
+    the names per row, without a Python string per row.
     """
     import pyarrow as pa
 
+    n = len(codes)
+    first = int(codes[0]) if n else -1
+    if n and bool(np.all(codes == first)):  # one value (the usual case): no strings made
+        return (pa.repeat(pa.scalar(names[first], type=pa.string()), n) if first >= 0
+                else pa.nulls(n, type=pa.string()))
     missing = codes < 0
     return pa.DictionaryArray.from_arrays(
         codes, pa.array(list(names), type=pa.string()),
