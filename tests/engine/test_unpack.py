@@ -1,21 +1,29 @@
-"""unpack.member takes two routes (a Python pass on short arrays, np.isin on long
-ones); both must give NumPy's answer."""
+"""The batch unpack (status codes) and the scalar unpack of one row agree; the code
+tables follow the status table."""
 
 import numpy as np
-import pytest
 
-from vimpact.engine.result import FINISHED, STATUSES
-from vimpact.engine.unpack import _SHORT, member
+from vimpact.engine.result import FINISHED, STATUS_CODE, STATUS_NAMES, STATUSES, Coded
+from vimpact.engine.unpack import finished_codes
 
 
-@pytest.mark.parametrize("n", [0, 1, _SHORT, _SHORT + 1, 5000])
-def test_member_is_numpy_isin(n):
-    rng = np.random.default_rng(n)
-    names = np.array(list(STATUSES) + ["not a status"], dtype=object)
-    values = names[rng.integers(0, len(names), n)]
-    got = member(values, FINISHED)
-    assert got.dtype == bool and got.shape == (n,)
-    assert np.array_equal(got, np.isin(values, list(FINISHED)))
+def test_finished_codes_are_the_finished_names():
+    """The finished mask of status codes is ``name in FINISHED`` of their names, for
+    every status of the table (the sweep's ``failed`` too)."""
+    codes = np.arange(len(STATUS_NAMES))
+    names = np.array(STATUS_NAMES, dtype=object)[codes]
+    assert np.array_equal(finished_codes(codes), np.isin(names, list(FINISHED)))
+    assert set(STATUSES) < set(STATUS_NAMES) and "failed" in STATUS_NAMES
+    assert all(STATUS_NAMES[STATUS_CODE[name]] == name for name in STATUS_NAMES)
+
+
+def test_coded_round_trip():
+    """Codes and names give back the object column, ``None`` (code -1) included."""
+    values = np.array(["b", None, "a", "b", None], dtype=object)
+    coded = Coded.encode(values)
+    assert coded.names == ("b", "a") and list(coded.codes) == [0, -1, 1, 0, -1]
+    assert list(coded.decode()) == list(values)
+    assert list(Coded.encode(values, ("a", "b")).codes) == [1, -1, 0, 1, -1]
 
 
 def test_guard_marks_the_rows_it_turns_non_finite_as_not_finished():
@@ -24,13 +32,15 @@ def test_guard_marks_the_rows_it_turns_non_finite_as_not_finished():
     from vimpact.engine.unpack import guard
 
     assert "non_finite" not in FINISHED
-    status = np.array(["ok", "ok", "time_limit", "normal_only"], dtype=object)
+    names = ["ok", "ok", "time_limit", "normal_only"]
+    status = np.array([STATUS_CODE[s] for s in names], dtype=np.int8)
     values = {"e_z": np.array([0.5, np.nan, np.nan, 0.7]),
               "e_x": np.array([0.1, 0.2, np.nan, np.nan])}  # NaN e_x: normal only
     dead = guard(values, status, np.array([True, True, True, False]))
-    assert list(status) == ["ok", "non_finite", "time_limit", "normal_only"]
+    assert [STATUS_NAMES[c] for c in status] == ["ok", "non_finite", "time_limit",
+                                                 "normal_only"]
     assert list(dead) == [False, True, True, False]
-    assert np.array_equal(dead, ~member(status, FINISHED))
+    assert np.array_equal(dead, ~finished_codes(status))
     assert np.isnan(values["e_x"][1]) and values["e_z"][3] == 0.7
 
 

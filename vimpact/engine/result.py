@@ -4,7 +4,9 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, fields
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, NamedTuple
+
+import numpy as np
 
 from vimpact.kernels.status import TABLE as STATUS_TABLE
 
@@ -46,6 +48,43 @@ STATUSES = {s.name: s.message for s in STATUS_TABLE if not s.sweep_only}
 
 #: Statuses whose numbers are results (the others carry NaN).
 FINISHED = tuple(s.name for s in STATUS_TABLE if s.finished and not s.sweep_only)
+
+#: Every status name (the sweep's ``failed`` too), in the status table's order: inside
+#: the engine and the sweep a row's status is its index here (an ``int8`` code), made
+#: text only where text is shown or stored (:class:`Coded`).
+STATUS_NAMES: tuple[str, ...] = tuple(s.name for s in STATUS_TABLE)
+#: status name -> its code (index in :data:`STATUS_NAMES`)
+STATUS_CODE: dict[str, int] = {name: i for i, name in enumerate(STATUS_NAMES)}
+
+
+class Coded(NamedTuple):
+    """A text column as integer codes into a tuple of names (``-1``: no value, ``None``).
+
+    The engine's statuses and kernel paths take one of a few names; a code per row is
+    compared, masked and stored without a Python string per row.
+    """
+
+    codes: np.ndarray
+    names: tuple[str, ...]
+
+    def decode(self) -> np.ndarray:
+        """Return the column as an object array of ``str`` (``None`` for code ``-1``)."""
+        lookup = np.empty(len(self.names) + 1, dtype=object)  # the last entry: None
+        lookup[:-1] = self.names
+        return lookup[self.codes]
+
+    @classmethod
+    def encode(cls, values: np.ndarray, names: tuple[str, ...] | None = None) -> Coded:
+        """Return the object array ``values`` (``str`` or ``None``) as codes into ``names``.
+
+        ``names`` default: the distinct values in order of first appearance.
+        """
+        if names is None:
+            names = tuple(dict.fromkeys(v for v in values.tolist() if v is not None))
+        index = {name: i for i, name in enumerate(names)}
+        codes = np.fromiter((index[v] if v is not None else -1 for v in values.tolist()),
+                            dtype=np.int16, count=len(values))
+        return cls(codes, names)
 
 
 @dataclass(frozen=True)

@@ -11,13 +11,13 @@ SI result columns (:mod:`~vimpact.engine.unpack`) -> ``DataFrame`` (batch) or
 from __future__ import annotations
 
 import time
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 
 from vimpact.engine.columns import SceneColumns, scene_columns
 from vimpact.engine.pack import element_arrays, interleave, run_path
-from vimpact.engine.result import RESULT_FIELDS, ImpactResult
+from vimpact.engine.result import RESULT_FIELDS, STATUS_NAMES, Coded, ImpactResult
 from vimpact.engine.routing import CONTINUUM_STICK, choose_path, route
 from vimpact.engine.unpack import unpack, unpack_row
 from vimpact.kernels import layout
@@ -54,12 +54,14 @@ def _numerics(numerics) -> Numerics:
 
 
 def run_columns(cols: SceneColumns, numerics: Numerics, n_rec: int = 0, rec_every: int = 1,
-                timings: dict | None = None
-                ) -> tuple[dict[str, np.ndarray], np.ndarray, np.ndarray]:
+                timings: dict | None = None, codes: bool = False
+                ) -> tuple[dict[str, Any], np.ndarray, np.ndarray]:
     """Route, pack, run and unpack a batch.
 
     The result columns, the trajectory buffer ``(n, n_rec, N_REC)`` (kernel units) and the
-    rows written in it.
+    rows written in it. ``codes``: ``status`` and ``path`` as
+    :class:`~vimpact.engine.result.Coded` (integer codes and their names) instead of
+    object arrays of ``str`` (:func:`~vimpact.engine.unpack.unpack`).
 
     Rows the full-stick continuum kernel hands back (its assumptions broke, or
     its step limit) run again on the element kernel their effects call for.
@@ -72,37 +74,57 @@ def run_columns(cols: SceneColumns, numerics: Numerics, n_rec: int = 0, rec_ever
 
         rest, adh = np.flatnonzero(~adhesive), np.flatnonzero(adhesive)
         t0 = time.perf_counter()
-        parts = [result_columns(cols.take(adh), numerics)]
+        parts: list[dict[str, Any]] = [result_columns(cols.take(adh), numerics)]
         if timings is not None:  # (the conversion to SI is included: it is small)
             timings["kernel_s"] = timings.get("kernel_s", 0.0) + time.perf_counter() - t0
+        if codes:
+            parts[0]["status"] = Coded.encode(parts[0]["status"], STATUS_NAMES)
+            parts[0]["path"] = Coded.encode(parts[0]["path"])
         rec = np.zeros((len(cols), n_rec, layout.N_REC))
         written = np.zeros(len(cols), dtype=np.int64)
         if len(rest):
             result, rec[rest], written[rest] = run_columns(cols.take(rest), numerics, n_rec,
-                                                           rec_every, timings)
+                                                           rec_every, timings, codes)
             parts.append(result)
         order = np.argsort(np.concatenate([adh, rest]), kind="stable")
-        return ({name: np.concatenate([p[name] for p in parts])[order] for name in parts[0]},
+        return ({name: _concatenate([p[name] for p in parts], order) for name in parts[0]},
                 rec, written)
-    out, rec, path_names, explicit_euler, steps_per_T, refused = _run(
+    out, rec, paths, explicit_euler, steps_per_T, refused = _run(
         cols, numerics, n_rec, rec_every, timings)
     written = out[:, layout.OUT_N_REC].astype(np.int64)
-    return unpack(cols, out, path_names, explicit_euler, steps_per_T, refused), rec, written
+    return (unpack(cols, out, paths, explicit_euler, steps_per_T, refused, codes), rec,
+            written)
+
+
+def _concatenate(pieces: list, order: np.ndarray):
+    """Return result columns (arrays, or :class:`Coded` with their own names) joined, in ``order``."""
+    if not isinstance(pieces[0], Coded):
+        return np.concatenate(pieces)[order]
+    names = tuple(dict.fromkeys(name for p in pieces for name in p.names))
+    index = {name: i for i, name in enumerate(names)}
+    codes = []
+    for p in pieces:  # each piece's codes in the joined names (-1 stays -1: the last entry)
+        lookup = np.array([index[name] for name in p.names] + [-1], dtype=np.int16)
+        codes.append(lookup[p.codes])
+    return Coded(np.concatenate(codes)[order], names)
 
 
 def _run(cols: SceneColumns, numerics: Numerics, n_rec: int, rec_every: int,
-         timings: dict | None) -> tuple[np.ndarray, ...]:
+         timings: dict | None
+         ) -> tuple[np.ndarray, np.ndarray, Coded, np.ndarray, np.ndarray, np.ndarray]:
     """Route, pack and run a batch; return the kernel rows and what unpack takes.
 
     Route, pack and run: the kernel rows ``out``, the trajectory buffer, and per
-    row the path name, explicit Euler, steps per ``T`` and refusal that
+    row the path (:class:`~vimpact.engine.result.Coded`, ``-1`` where none ran),
+    explicit Euler, steps per ``T`` and refusal that
     :func:`~vimpact.engine.unpack.unpack` takes (:func:`run_columns`).
     """
     n = len(cols)
     routes = route(cols, numerics)
     out = np.zeros((n, layout.N_OUT))
     rec = np.zeros((n, n_rec, layout.N_REC))
-    path_names = np.empty(n, dtype=object)  # (NumPy fills an object array with None)
+    path_codes = np.full(n, -1, dtype=np.int16)  # (-1: no path, an invalid row)
+    path_list: list[str] = []
     explicit_euler = np.zeros(n, dtype=bool)
     steps_per_T = np.zeros(n)
     refused = np.empty(n, dtype=object)
@@ -156,7 +178,9 @@ def _run(cols: SceneColumns, numerics: Numerics, n_rec: int, rec_every: int,
             idx = idx[order]
             if arrays is not None:
                 arrays = {key: value[order] for key, value in arrays.items()}
-        sub = _rows(cols, idx)
+        # (the kernel reads a few columns of the rows, the element inputs none: taken
+        # when read)
+        sub = _taken(cols, idx)
         whole = sub is cols  # all rows in order: the kernel writes the batch's own buffers
         sub_out = out if whole else np.zeros((len(idx), layout.N_OUT))
         sub_rec = rec if whole else np.zeros((len(idx), n_rec, layout.N_REC))
@@ -176,7 +200,9 @@ def _run(cols: SceneColumns, numerics: Numerics, n_rec: int, rec_every: int,
             out[idx] = sub_out
             if n_rec:
                 rec[idx] = sub_rec
-        path_names[idx] = path.name
+        if path.name not in path_list:
+            path_list.append(path.name)
+        path_codes[idx] = path_list.index(path.name)
         if path.kind == CONTINUUM_STICK:
             status = sub_out[:, layout.OUT_STATUS]
             back = (status == layout.STATUS_ASSUMPTION) | (status == layout.STATUS_TIME_LIMIT)
@@ -186,7 +212,7 @@ def _run(cols: SceneColumns, numerics: Numerics, n_rec: int, rec_every: int,
                 queue.extend((p, rows[again.group == k]) for k, p in enumerate(again.paths))
     if timings is not None:
         timings["kernel_s"] = timings.get("kernel_s", 0.0) + kernel_s
-    return out, rec, path_names, explicit_euler, steps_per_T, refused
+    return out, rec, Coded(path_codes, tuple(path_list)), explicit_euler, steps_per_T, refused
 
 
 def _read_only(a: np.ndarray) -> np.ndarray:
@@ -206,16 +232,47 @@ def _threads() -> int:
     return max(1, numba.get_num_threads())
 
 
+class _Taken:
+    """The rows ``idx`` of ``cols``, each column taken when it is first read.
+
+    What :func:`~vimpact.engine.pack.run_path` reads of the rows of a continuum path
+    (``dashpot_time``, ``T``, the arms, ...): a column (stored or derived, all row by
+    row) taken from ``cols`` when asked for, the same values as from ``cols.take(idx)``
+    without copying the columns nobody reads (17 of them, some 20 ms per 1e5 rows).
+    """
+
+    def __init__(self, cols: SceneColumns, idx: np.ndarray):
+        self._cols, self._idx = cols, idx
+
+    def __len__(self) -> int:
+        return len(self._idx)
+
+    def __getattr__(self, name: str):
+        value = getattr(self._cols, name)[self._idx]
+        setattr(self, name, value)  # (read once)
+        return value
+
+
+def _taken(cols: SceneColumns, idx: np.ndarray) -> SceneColumns:
+    """:func:`_rows`, each column taken when first read (:class:`_Taken`)."""
+    if len(idx) <= 1 or _all_in_order(cols, idx):
+        return _rows(cols, idx)
+    return cast(SceneColumns, _Taken(cols, idx))
+
+
+def _all_in_order(cols: SceneColumns, idx: np.ndarray) -> bool:
+    """Whether ``idx`` is all the rows of ``cols`` in order."""
+    return len(idx) == len(cols) and (len(idx) <= 1 or (
+        idx[0] == 0 and idx[-1] == len(idx) - 1 and bool(np.all(np.diff(idx) == 1))))
+
+
 def _rows(cols: SceneColumns, idx: np.ndarray) -> SceneColumns:
     """Return the rows ``idx`` of ``cols``, without a copy when they are all of it.
 
     ``cols.take(idx)``, or ``cols`` itself if ``idx`` is all its rows in order
     (one path for the whole batch, as for a single impact: no copy).
     """
-    if len(idx) == len(cols) and (len(idx) <= 1 or (idx[0] == 0 and idx[-1] == len(idx) - 1
-                                                    and bool(np.all(np.diff(idx) == 1)))):
-        return cols
-    return cols.take(idx)
+    return cols if _all_in_order(cols, idx) else cols.take(idx)
 
 
 def simulate_batch(scenes, numerics: Numerics | str | None = None, *,
@@ -330,9 +387,11 @@ def _simulate(scene: Scene, numerics: Numerics, trajectory: bool) -> ImpactResul
             rec_every = max(1, int(per_t_H) // TRAJECTORY_ROWS_PER_T_H)
             n_rec = int(a["max_steps"][0] // rec_every) + 2
         n_rec = min(n_rec, MAX_TRAJECTORY_ROWS)
-    out, rec, path_names, explicit_euler, steps_per_T, refused = _run(
+    out, rec, paths, explicit_euler, steps_per_T, refused = _run(
         cols, numerics, n_rec, rec_every, None)
-    row = unpack_row(cols, out[0], path_names[0], bool(explicit_euler[0]),
+    code = int(paths.codes[0])  # (-1: refused, no path ran)
+    row = unpack_row(cols, out[0], paths.names[code] if code >= 0 else None,
+                     bool(explicit_euler[0]),
                      float(steps_per_T[0]), refused[0])
     traj = None
     if trajectory:

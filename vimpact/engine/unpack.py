@@ -8,7 +8,14 @@ from typing import Any
 import numpy as np
 
 from vimpact.engine.columns import SceneColumns
-from vimpact.engine.result import FINISHED, RESULT_FIELDS, STATUSES
+from vimpact.engine.result import (
+    FINISHED,
+    RESULT_FIELDS,
+    STATUS_CODE,
+    STATUS_NAMES,
+    STATUSES,
+    Coded,
+)
 from vimpact.kernels import layout
 from vimpact.kernels import status as status_table
 from vimpact.model.numerics import MIN_CONTACT_STEPS
@@ -20,6 +27,18 @@ KERNEL_STATUSES = {
     **status_table.BY_CODE,
     layout.STATUS_ASSUMPTION: "non_finite",  # only reached if a hand-over failed
 }
+
+#: kernel status code -> status code of the engine (index in ``STATUS_NAMES``)
+_KERNEL_CODES = {k: STATUS_CODE[name] for k, name in KERNEL_STATUSES.items()}
+#: status codes of the statuses the checks below set or test
+_OK, _INVALID, _NON_FINITE = (STATUS_CODE[name] for name in ("ok", status_table.INVALID,
+                                                              "non_finite"))
+#: per status code: the status name (object, for the text column), finished, and kept
+#: within the passive bounds (:func:`clip_round_off`)
+_NAMES = np.array(STATUS_NAMES, dtype=object)
+_FINISHED = np.array([name in FINISHED for name in STATUS_NAMES])
+_CLIPPED = np.array([name in ("ok", "vc0_zero", "normal_only", "half_space")
+                     for name in STATUS_NAMES])
 
 #: Energy a passive impact may gain from rounding and integration error
 #: (relative to the contact energy); more is status ``unstable`` (or
@@ -34,32 +53,38 @@ OUTPUTS = ("e_z", "e_x", "beta_x", "t_contact", "u_max", "a_max", "energy_ratio"
 TANGENTIAL_OUTPUTS = ("e_x", "beta_x", "mu_eff", "gross_slip_fraction")
 
 
-def unpack(cols: SceneColumns, out: np.ndarray, path_names: np.ndarray, explicit_euler: np.ndarray,
-           steps_per_T: np.ndarray, refused: np.ndarray) -> dict[str, np.ndarray]:
+def unpack(cols: SceneColumns, out: np.ndarray, path_names: np.ndarray | Coded,
+           explicit_euler: np.ndarray, steps_per_T: np.ndarray, refused: np.ndarray,
+           codes: bool = False) -> dict[str, Any]:
     """SI result columns (:data:`vimpact.engine.result.RESULT_FIELDS`) of kernel rows.
 
     Parameters
     ----------
     cols : the scenes
     out : ``(n, N_OUT)`` kernel rows (anything in invalid rows)
-    path_names : object array, the path of each row (``None`` for invalid rows)
+    path_names : the path of each row (``None`` for invalid rows): an object array, or
+        :class:`~vimpact.engine.result.Coded` (code ``-1`` for invalid rows)
     explicit_euler : rows integrated by explicit Euler (energy gain expected)
     steps_per_T : time steps per time unit ``T`` of each element-path row (0 on
         continuum rows): with the contact time, how well the contact was resolved
     refused : object array, ``(status, reason)`` of a valid row that was not run
         (cost bounds, an unreachable tolerance), else ``None``
+    codes : return ``status`` and ``path`` as :class:`~vimpact.engine.result.Coded`
+        (status codes into :data:`~vimpact.engine.result.STATUS_NAMES`) instead of
+        object arrays of ``str`` (the sweep stores them without a string per row)
     """
     n = len(cols)
     valid = cols.valid
     kstatus = out[:, layout.OUT_STATUS].astype(np.int64)
-    status = np.empty(n, dtype=object)
-    status[:] = status_table.INVALID  # (np.full would make a str per row: 30x slower)
+    # statuses as int8 codes (STATUS_NAMES): compared and masked without a str per row
+    status = np.full(n, _INVALID, dtype=np.int8)
     ran = valid & is_none(refused)
-    for code, name in KERNEL_STATUSES.items():
-        status[ran & (kstatus == code)] = name
-    for i in np.flatnonzero(valid & ~ran):
-        status[i] = refused[i][0]
-    ok = status == "ok"
+    for kcode, code in _KERNEL_CODES.items():
+        status[ran & (kstatus == kcode)] = code
+    refused_rows = np.flatnonzero(valid & ~ran)
+    for i in refused_rows:
+        status[i] = STATUS_CODE[refused[i][0]]
+    ok = status == _OK
     tangential = cols.computes_tangential
     v_z0, v_c0, mu_t = cols.v_z0, cols.v_c0, cols.contact_mass_factor
     vz_end = out[:, layout.OUT_VZ_END]
@@ -84,68 +109,91 @@ def unpack(cols: SceneColumns, out: np.ndarray, path_names: np.ndarray, explicit
         # (rotation off) is outside it, so its work on the sphere cannot count as a gain
         contact0 = v_z0**2 + v_c0**2 / mu_t
         contact1 = v_z_end**2 + (vc_end * v_c0) ** 2 / mu_t
+        # a tangential output of a batch without a tangential row is its fill value
+        # throughout (np.where picks none of it): not computed
+        some = bool(tangential.any())
         values = {
             "e_z": np.abs(vz_end),
-            "e_x": np.where(tangential, np.abs(vc_end), np.nan),
-            "beta_x": np.where(tangential, -vc_end, np.nan),
+            "e_x": _tangential(some, tangential, lambda: np.abs(vc_end), np.nan),
+            "beta_x": _tangential(some, tangential, lambda: -vc_end, np.nan),
             "t_contact": out[:, layout.OUT_T_CONTACT] * cols.T,
             "u_max": out[:, layout.OUT_U_MAX] * cols.d,
             "a_max": out[:, layout.OUT_B_MAX] * cols.a_H,
             "energy_ratio": energy1 / energy0,
             "v_z_end": v_z_end, "v_x_end": v_x_end, "omega_end": omega_end,
-            "mu_eff": np.where(tangential, np.abs(impulse) / (v_z0 - v_z_end), np.nan),
+            "mu_eff": _tangential(some, tangential,
+                                  lambda: np.abs(impulse) / (v_z0 - v_z_end), np.nan),
             "rebound_angle": np.degrees(np.arctan2(v_x_end, -v_z_end)),
-            "gross_slip_fraction": np.where(
-                tangential, out[:, layout.OUT_T_GROSS_SLIP] / out[:, layout.OUT_T_CONTACT], np.nan),
-            "friction_energy": np.where(
-                tangential, out[:, layout.OUT_W_FRICTION] * cols.m * v_c0**2, 0.0),
+            "gross_slip_fraction": _tangential(
+                some, tangential,
+                lambda: out[:, layout.OUT_T_GROSS_SLIP] / out[:, layout.OUT_T_CONTACT], np.nan),
+            "friction_energy": _tangential(
+                some, tangential, lambda: out[:, layout.OUT_W_FRICTION] * cols.m * v_c0**2,
+                0.0),
             # without adhesion an element leaves before it would pull: no tensile force
             "F_tensile_max": np.zeros(n),
         }
         # the contact point's tangential speed cannot grow either (|beta_x| <= 1): the
         # normal energy is far larger when v_c0 << v_z0, so the sum above misses it
         gain = ((contact1 > contact0 * (1.0 + PASSIVITY_SLACK))
-                | (np.abs(vz_end) > 1.0 + PASSIVITY_SLACK)
-                | (tangential & (np.abs(vc_end) > 1.0 + PASSIVITY_SLACK)))
+                | (np.abs(vz_end) > 1.0 + PASSIVITY_SLACK))
+        if some:
+            gain |= tangential & (np.abs(vc_end) > 1.0 + PASSIVITY_SLACK)
         contact_steps = out[:, layout.OUT_T_CONTACT] * steps_per_T
         unresolved = contact_steps < MIN_CONTACT_STEPS
         relative_gain = contact1 / contact0 - 1.0
     incremental = cols.memory == TANGENTIAL_MEMORY.index("incremental")
-    status[ok & gain & incremental & ~explicit_euler] = "unstable"
-    status[ok & gain & incremental & explicit_euler] = "energy_gain"
-    status[ok & gain & ~incremental] = "not_passive"
+    gained = ok & gain
+    status[gained & incremental & ~explicit_euler] = STATUS_CODE["unstable"]
+    status[gained & incremental & explicit_euler] = STATUS_CODE["energy_gain"]
+    status[gained & ~incremental] = STATUS_CODE["not_passive"]
     passive = incremental & ~explicit_euler
-    status[ok & (steps_per_T > 0) & unresolved] = "unresolved"
-    ok = status == "ok"
-    status[ok & (values["a_max"] > HALF_SPACE_LIMIT * cols.R)] = "half_space"
-    ok = status == "ok"
-    status[ok & (cols.tangential == TANGENTIAL_EFFECTS.index("none"))] = "normal_only"
-    ok = status == "ok"
-    status[ok & (v_c0 == 0.0)] = "vc0_zero"
-    clip_round_off(values, np.isin(status, ("ok", "vc0_zero", "normal_only", "half_space")),
-                   passive)
+    status[ok & (steps_per_T > 0) & unresolved] = STATUS_CODE["unresolved"]
+    ok = status == _OK
+    status[ok & (values["a_max"] > HALF_SPACE_LIMIT * cols.R)] = STATUS_CODE["half_space"]
+    ok = status == _OK
+    status[ok & (cols.tangential == TANGENTIAL_EFFECTS.index("none"))] = \
+        STATUS_CODE["normal_only"]
+    ok = status == _OK
+    status[ok & (v_c0 == 0.0)] = STATUS_CODE["vc0_zero"]
+    clip_round_off(values, _CLIPPED[status], passive)
     dead = guard(values, status, tangential)
-    why = np.full(n, None, dtype=object)
-    for i in np.flatnonzero(valid & ~ran):  # refused rows only
-        why[i] = refused[i][1]
-    error = np.where(valid, why, cols.reasons)
-    error = np.where(status == "non_finite", _nan_message(values, status, error), error)
+    error = cols.reasons.copy()  # (None on a valid row: cols.valid)
+    for i in refused_rows:  # refused rows only
+        error[i] = refused[i][1]
+    for i in np.flatnonzero(status == _NON_FINITE):
+        if error[i] is None:
+            error[i] = "the integration produced a non-finite value"
     _explain(status, error, contact_steps, relative_gain, dead)
     with np.errstate(all="ignore"):
         result = {
             **values,
             "t_hertz": cols.t_H, "d_hertz": cols.d, "a_hertz": cols.a_H,
             "Q1": cols.Q1, "Q2": cols.Q2, "nu": cols.nu,
-            "status": status, "n_steps": out[:, layout.OUT_STEPS].astype(np.int64),
-            "path": path_names, "error": error,
+            "n_steps": out[:, layout.OUT_STEPS].astype(np.int64), "error": error,
         }
+    if codes:
+        result["status"] = Coded(status, STATUS_NAMES)
+        result["path"] = (path_names if isinstance(path_names, Coded)
+                          else Coded.encode(path_names))
+    else:
+        result["status"] = _NAMES[status]
+        result["path"] = (path_names.decode() if isinstance(path_names, Coded)
+                          else path_names)
     for name in ("t_hertz", "d_hertz", "a_hertz", "Q1", "Q2", "nu"):
         result[name] = np.where(valid, result[name], np.nan)
     result["n_steps"] = np.where(valid, result["n_steps"], 0)
     return {name: result[name] for name in RESULT_FIELDS}
 
 
-def unpack_row(cols: SceneColumns, out: np.ndarray, path_name: str, explicit_euler: bool,
+def _tangential(some: bool, tangential: np.ndarray, value, fill: float) -> np.ndarray:
+    """``np.where(tangential, value(), fill)``; ``fill`` throughout, uncomputed, if not ``some``."""
+    if not some:
+        return np.full(tangential.shape[0], fill)
+    return np.where(tangential, value(), fill)
+
+
+def unpack_row(cols: SceneColumns, out: np.ndarray, path_name: str | None, explicit_euler: bool,
                steps_per_T: float, refused: tuple[str, str] | None) -> dict[str, Any]:
     """:func:`unpack` of a one-row batch whose row is valid, as Python scalars.
 
@@ -310,52 +358,41 @@ def guard(values: dict[str, np.ndarray], status: np.ndarray,
           tangential: np.ndarray) -> np.ndarray:
     """NaN only with a status that says why.
 
-    Outputs of a row whose status is not finished become NaN; a finished row with an
-    unexplained NaN or inf becomes ``non_finite`` (all outputs NaN). Returns the rows
-    not finished now (bool).
+    ``status``: codes into :data:`~vimpact.engine.result.STATUS_NAMES` (changed in
+    place). Outputs of a row whose status is not finished become NaN; a finished row
+    with an unexplained NaN or inf becomes ``non_finite`` (all outputs NaN). Returns the
+    rows not finished now (bool).
     """
-    finished = member(status, FINISHED)
+    finished = _FINISHED[status]
     bad = np.zeros(status.shape[0], dtype=bool)
     for name, v in values.items():
         unexplained = ~np.isfinite(v)
         if name in TANGENTIAL_OUTPUTS:
             unexplained &= tangential
         bad |= finished & unexplained
-    status[bad] = "non_finite"
+    status[bad] = _NON_FINITE
     dead = ~finished | bad  # (non_finite is not a finished status: no second pass)
-    for v in values.values():
-        v[dead] = np.nan
+    if dead.any():
+        for v in values.values():
+            v[dead] = np.nan
     return dead
 
 
-def member(values: np.ndarray, names: tuple[str, ...]) -> np.ndarray:
-    """Return elementwise ``value in names`` for an object array of strings.
-
-    Elementwise ``value in names`` for an object array of strings (``np.isin``
-    sorts, which costs some 100 us on a one-row batch; a plain pass over a short
-    array costs about 1 us).
-    """
-    if values.shape[0] <= _SHORT:
-        return np.fromiter((x in names for x in values), dtype=bool, count=values.shape[0])
-    return np.isin(values, names)
-
-
-#: up to this many rows :func:`member` loops in Python (cheaper than ``np.isin`` there)
-_SHORT = 256
+def finished_codes(status: np.ndarray) -> np.ndarray:
+    """Return elementwise ``name in FINISHED`` of status codes (:data:`STATUS_NAMES`)."""
+    return _FINISHED[status]
 
 
 def _explain(status: np.ndarray, error: np.ndarray, contact_steps: np.ndarray,
-             relative_gain: np.ndarray, dead: np.ndarray | None = None) -> None:
+             relative_gain: np.ndarray, dead: np.ndarray) -> None:
     """Give a reason to every row whose status is not finished and has none yet.
 
-    No row ends without numbers and without saying why. ``dead``: the rows not
-    finished, if known (:func:`guard`'s answer), else found here.
+    No row ends without numbers and without saying why. ``status``: codes;
+    ``dead``: the rows not finished (:func:`guard`'s answer).
     """
-    if dead is None:
-        dead = ~member(status, FINISHED)
-    explain = dead | (status == "not_passive")
+    explain = dead | (status == STATUS_CODE["not_passive"])
     for i in unexplained(explain, error):
-        error[i] = _reason(status[i], contact_steps[i], relative_gain[i])
+        error[i] = _reason(STATUS_NAMES[status[i]], contact_steps[i], relative_gain[i])
 
 
 def _reason(status: str, contact_steps: float, relative_gain: float) -> str:
@@ -375,12 +412,3 @@ def _reason(status: str, contact_steps: float, relative_gain: float) -> str:
                 "(|beta_x| > 1), in a passive scene: the numerical solution is not "
                 "converged (more steps or elements)")
     return STATUSES.get(status, status)
-
-
-def _nan_message(values: dict, status: np.ndarray, error: np.ndarray) -> np.ndarray:
-    """Why a row is ``non_finite``: the kernel said so, or which outputs were not finite."""
-    msg = error.copy()
-    for i in np.flatnonzero(status == "non_finite"):
-        if msg[i] is None:
-            msg[i] = "the integration produced a non-finite value"
-    return msg

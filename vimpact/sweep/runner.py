@@ -87,15 +87,18 @@ def run_batch(spec: SweepSpec, scene_cols: dict, timings: dict | None = None) ->
 
     What :func:`vimpact.simulate_batch` runs (validation, routing, kernels, SI results:
     :func:`vimpact.engine.simulate.run_columns`) without building its DataFrame: the
-    sweep takes the NumPy columns as they are. ``timings`` receives ``kernel_s`` (s in
-    the kernels) and ``total_s`` (s of the whole call), summed over calls.
+    sweep takes the NumPy columns as they are, ``status`` and ``path`` as
+    :class:`~vimpact.engine.result.Coded` (integer codes and their names). ``timings``
+    receives ``kernel_s`` (s in the kernels) and ``total_s`` (s of the whole call),
+    summed over calls.
     """
     from vimpact.engine.columns import scene_columns
     from vimpact.engine.simulate import run_columns
 
     t0 = time.perf_counter()
     try:
-        return run_columns(scene_columns(scene_cols), spec.numerics, timings=timings)[0]
+        return run_columns(scene_columns(scene_cols), spec.numerics, timings=timings,
+                           codes=True)[0]
     finally:
         if timings is not None:
             timings["total_s"] = timings.get("total_s", 0.0) + time.perf_counter() - t0
@@ -114,28 +117,30 @@ def compute_chunk(spec: SweepSpec, chunk: int, timings: dict | None = None):
     in the engine: validation, routing, kernels, results) summed over calls.
     """
     import pyarrow as pa
-    import pyarrow.compute as pc
 
-    from vimpact.engine.result import FINISHED
+    from vimpact.engine.result import STATUS_CODE, STATUS_NAMES
+    from vimpact.engine.unpack import finished_codes
     from vimpact.sweep.parameters import engine_columns
 
     start, stop = spec.chunk_rows(chunk)
     n = stop - start
     params = spec.chunk_parameters(chunk)
     batches, inputs = engine_columns(spec, params)
+    outputs = RESULTS | (ADHESION_RESULTS if spec.has_adhesion else {})
     cols: dict[str, np.ndarray] = {"row": np.arange(start, stop, dtype=np.int64)}
     for c in spec.columns():
-        if c not in ("row",) + LABELS:
+        if c not in ("row",) + LABELS and c not in outputs:
             cols[c] = np.full(n, np.nan)
     for key, values in {**params, **inputs}.items():
         if key in cols:
             cols[key][:] = values
-    # a row no batch reaches stays invalid; one batch of all the chunk's rows in order
-    # (the usual case) hands over its label columns as they are
-    status = np.empty(n, dtype=object)
-    status[:] = "invalid"  # one str (np.full makes one per row: 30x slower)
+    # statuses and paths as integer codes (STATUS_NAMES; path_names), text only in the
+    # Arrow column; a row no batch reaches stays invalid; one batch of all the chunk's
+    # rows in order (the usual case) hands over its result columns as they are
+    status = np.full(n, STATUS_CODE["invalid"], dtype=np.int8)
     error = np.full(n, None, dtype=object)
-    path = np.full(n, None, dtype=object)
+    path = np.full(n, -1, dtype=np.int16)
+    path_names: list[str] = []
     for rows, scene_cols in batches:
         if len(rows) == 0:
             continue
@@ -143,16 +148,26 @@ def compute_chunk(spec: SweepSpec, chunk: int, timings: dict | None = None):
         try:
             result = run_batch(spec, scene_cols, timings)
         except Exception as exc:  # noqa: BLE001 - recorded as the rows' status
-            status[rows], error[rows] = "failed", f"{type(exc).__name__}: {exc}"
+            status[rows], error[rows] = STATUS_CODE["failed"], f"{type(exc).__name__}: {exc}"
             continue
-        st = result["status"]
+        st, paths = result["status"].codes, result["path"]
+        lookup = np.full(len(paths.names) + 1, -1, dtype=np.int16)  # (-1 stays -1)
+        for j, name in enumerate(paths.names):  # the batch's path codes in the chunk's
+            if name not in path_names:
+                path_names.append(name)
+            lookup[j] = path_names.index(name)
         if whole:
-            status, error, path = st.copy(), result["error"].copy(), result["path"].copy()
+            status, error, path = st, result["error"], lookup[paths.codes]
         else:
-            status[rows], error[rows], path[rows] = st, result["error"], result["path"]
-        for name, source in (RESULTS | (ADHESION_RESULTS if spec.has_adhesion else {})).items():
-            cols[name][rows] = result[source]
-        valid = st != "invalid"
+            status[rows], error[rows], path[rows] = st, result["error"], lookup[paths.codes]
+        for name, source in outputs.items():
+            if whole:  # (the result's own array: no copy)
+                cols[name] = result[source]
+            else:
+                if name not in cols:
+                    cols[name] = np.full(n, np.nan)
+                cols[name][rows] = result[source]
+        valid = st != STATUS_CODE["invalid"]
         if spec.mode == "random" and spec.model != "prony":
             cols["Q1"][rows] = result["Q1"]
             if spec.model == "standard_solid" and "G_arm1_Pa" not in scene_cols:
@@ -163,6 +178,9 @@ def compute_chunk(spec: SweepSpec, chunk: int, timings: dict | None = None):
                 cols["Q2"][rows] = np.nan  # the Kelvin-Voigt limit G2 -> inf (never 0: log 0)
         if spec.mode == "grid" and spec.model == "elastic":
             cols["Q1"][rows] = np.where(valid, 0.0, np.nan)
+    for name in outputs:  # no batch reached these rows (none, or every one raised)
+        if name not in cols:
+            cols[name] = np.full(n, np.nan)
     with np.errstate(divide="ignore", invalid="ignore"):
         for name, (num, den) in RELATIVE.items():
             cols[name] = cols[num] / cols[den]
@@ -170,17 +188,34 @@ def compute_chunk(spec: SweepSpec, chunk: int, timings: dict | None = None):
         vc0 = params["v_x0_m_s"] + params["R_m"] * params["omega0_rad_s"]
     else:  # the reference scene's v_x0 (1, or psi's; 0 on a lam axis), omega0 = 0
         vc0 = inputs["v_x0_m_s"]
-    status_arrow = pa.array(status, type=pa.string())
-    finished = pc.is_in(status_arrow, value_set=pa.array(FINISHED, type=pa.string()))
-    if guard_nan(cols, status, error, (vc0 == 0.0) | (spec.tangential == "none"),
-                 finished.to_numpy(zero_copy_only=False)).any():
-        status_arrow = pa.array(status, type=pa.string())
-    labels = {"model": _repeated(inputs["model"], n), "path": pa.array(path, type=pa.string()),
-              "status": status_arrow, "error": pa.array(error, type=pa.string())}
+    guard_nan(cols, status, error, (vc0 == 0.0) | (spec.tangential == "none"),
+              finished_codes(status))
+    labels = {"model": _repeated(inputs["model"], n),
+              "path": _decoded(path, path_names), "status": _decoded(status, STATUS_NAMES),
+              "error": pa.array(error, type=pa.string())}
     schema = spec.schema()
     arrays = [labels[c] if c in labels else pa.array(cols[c], type=f.type)
               for c, f in zip(spec.columns(), schema)]
     return pa.Table.from_arrays(arrays, schema=schema)
+
+
+def _decoded(codes: np.ndarray, names):
+    """Return codes into ``names`` (``-1``: null) as a ``pyarrow`` string array.
+
+    Through a dictionary array (or one repeated value): the same string column as from
+    the names per row, without a Python string per row.
+    """
+    import pyarrow as pa
+
+    n = len(codes)
+    first = int(codes[0]) if n else -1
+    if n and bool(np.all(codes == first)):  # one value (the usual case): no strings made
+        return (pa.repeat(pa.scalar(names[first], type=pa.string()), n) if first >= 0
+                else pa.nulls(n, type=pa.string()))
+    missing = codes < 0
+    return pa.DictionaryArray.from_arrays(
+        codes, pa.array(list(names), type=pa.string()),
+        mask=missing if missing.any() else None).cast(pa.string())
 
 
 def _repeated(values: np.ndarray, n: int):
@@ -188,9 +223,7 @@ def _repeated(values: np.ndarray, n: int):
     import pyarrow as pa
 
     if n and isinstance(values[0], str) and bool(np.all(values == values[0])):
-        return pa.DictionaryArray.from_arrays(np.zeros(n, dtype=np.int32),
-                                              pa.array([values[0]], type=pa.string())
-                                              ).cast(pa.string())
+        return pa.repeat(pa.scalar(values[0], type=pa.string()), n)
     return pa.array(values, type=pa.string())
 
 
@@ -198,7 +231,8 @@ def guard_nan(cols: dict, status: np.ndarray, error: np.ndarray, vc0_zero: np.nd
               finished: np.ndarray) -> np.ndarray:
     """Allow NaN only with a status that explains it.
 
-    A finished row with a NaN output that no
+    ``status``: names (an object array), or codes into
+    :data:`vimpact.engine.result.STATUS_NAMES`, changed in place. A finished row with a NaN output that no
     status explains (``e_x``, ``beta_x`` are NaN when ``v_c0 = 0``) becomes
     ``non_finite`` with all outputs NaN and the columns named in ``error``.
     Returns the rows changed (bool).
@@ -208,10 +242,14 @@ def guard_nan(cols: dict, status: np.ndarray, error: np.ndarray, vc0_zero: np.nd
     bad_cols = {c: np.isnan(cols[c]) & finished
                 & ~(explained if c in TANGENTIAL_OUTPUTS else nothing) for c in OUTPUTS}
     bad = np.logical_or.reduce(list(bad_cols.values()))
+    coded = status.dtype != object  # codes into STATUS_NAMES (compute_chunk), or names
+    if coded:
+        from vimpact.engine.result import STATUS_CODE, STATUS_NAMES
     for k in np.flatnonzero(bad):  # rare: the message names this row's columns
         names = ", ".join(c for c, m in bad_cols.items() if m[k])
-        error[k] = f"NaN in {names} of a row with status {status[k]!r}"
-    status[bad] = "non_finite"
+        name = STATUS_NAMES[status[k]] if coded else status[k]
+        error[k] = f"NaN in {names} of a row with status {name!r}"
+    status[bad] = STATUS_CODE["non_finite"] if coded else "non_finite"
     for c in OUTPUTS:
         cols[c][bad] = np.nan
     return bad

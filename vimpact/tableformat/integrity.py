@@ -13,6 +13,7 @@ existed) is accepted with the hash check skipped.
 from __future__ import annotations
 
 import hashlib
+import os
 from pathlib import Path
 
 from vimpact.model.validation import InputError
@@ -76,11 +77,26 @@ class ContentHash:
             if not hasher._streams:
                 hasher._streams = [(hashlib.sha256(), hashlib.sha256(), hashlib.sha256())
                                    for _ in names]
+        # each stream takes one piece per call, so the streams are fed side by side
+        # (hashlib releases the GIL on large pieces): the same bytes in the same order
+        # per stream, the same digests, in a fraction of the time on several cores
+        jobs: list[tuple] = []
         for k, column in enumerate(table.columns):
             pieces = _canonical(column)
             for hasher in hashers:
-                for stream, piece in zip(hasher._streams[k], pieces):
-                    stream.update(piece)
+                jobs.extend(zip(hasher._streams[k], pieces))
+        threads = _hash_threads(sum(_size(piece) for _, piece in jobs))
+        if threads > 1:
+            from concurrent.futures import ThreadPoolExecutor
+
+            # the largest first: the threads finish together
+            jobs.sort(key=lambda job: -_size(job[1]))
+            with ThreadPoolExecutor(threads) as pool:
+                for _ in pool.map(_feed, jobs):
+                    pass
+        else:
+            for job in jobs:
+                _feed(job)
         for hasher in hashers:
             hasher.rows += table.num_rows
         return self
@@ -95,6 +111,34 @@ class ContentHash:
             for stream in (valid, values, data):
                 h.update(stream.digest())
         return h.hexdigest()
+
+
+#: Bytes of one :meth:`ContentHash.update` from which its streams are hashed on
+#: several threads (below, starting them costs more than it saves).
+PARALLEL_HASH_BYTES = 2**22
+#: Threads that hash a table's streams side by side at most.
+MAX_HASH_THREADS = 4
+
+
+def _hash_threads(nbytes: int) -> int:
+    """Return the threads to hash ``nbytes`` of streams with (1 below PARALLEL_HASH_BYTES)."""
+    if nbytes < PARALLEL_HASH_BYTES:
+        return 1
+    try:
+        cores = len(os.sched_getaffinity(0))
+    except AttributeError:  # not on Linux
+        cores = os.cpu_count() or 1
+    return max(1, min(MAX_HASH_THREADS, cores))
+
+
+def _size(piece: bytes | memoryview) -> int:
+    """Bytes of a piece (a memoryview's ``len`` counts its elements)."""
+    return piece.nbytes if isinstance(piece, memoryview) else len(piece)
+
+
+def _feed(job: tuple) -> None:
+    """Feed one piece to its SHA-256 stream (``job``: ``(stream, piece)``)."""
+    job[0].update(job[1])
 
 
 def content_hash(table) -> str:
