@@ -209,6 +209,18 @@ _D7 = 69997945.0 / 29380423.0
 _LS, _LV, _LT = 0, 1, 2
 _US, _UV, _UT, _UU = 0, 1, 2, 3
 
+#: Dormand-Prince weights of the stages: row ``r`` (2..5) gives stage ``r``'s state from
+#: ``K[0..r-1]``, row 6 the fifth-order update (row 1, ``a_21`` alone, is written out)
+_STAGE = np.array([
+    [0.0] * 7,
+    [_A21] + [0.0] * 6,
+    [_A31, _A32] + [0.0] * 5,
+    [_A41, _A42, _A43] + [0.0] * 4,
+    [_A51, _A52, _A53, _A54] + [0.0] * 3,
+    [_A61, _A62, _A63, _A64, _A65] + [0.0] * 2,
+    [_B1, 0.0, _B3, _B4, _B5, _B6, 0.0],
+])
+
 _N_CHECK = 200  # steps of the post-separation surface check
 #: first unloading step as a fraction of the step the loading phase proposed
 UNLOAD_FIRST_STEP = 1e-3
@@ -398,13 +410,13 @@ def _rhs(phase, y0, x, K, r, advance, tau0, g, itau, n, kappa, mu_t, tang, rc, h
         wc = x[o]
         vc = x[o + 1]
     k, th = _edge(rc, hs, nh, s, kh)
-    te = _dense(rc, k, th, _LT)
+    te = _dense(rc, k, th, np.int64(_LT))
     ue = s * s
     # the loading step's dense output at the edge, for the arm quantities there
     sk = rc[k, 0, _LS]
     vk = rc[k, 0, _LV]
     dte = te - rc[k, 0, _LT]
-    ve = _dense(rc, k, th, _LV) if n > 0 else 0.0
+    ve = _dense(rc, k, th, np.int64(_LV)) if n > 0 else 0.0
     rate_e = 0.5 * ve / s if s > 0.0 else 0.0
     rate_k = 0.5 * vk / sk if sk > 0.0 else 0.0
     accel_k = 0.0
@@ -561,14 +573,14 @@ def _edge(rc, hs, nh, s_t, kh):
     for _ in range(60):
         if not (lo <= th <= hi):
             th = 0.5 * (lo + hi)
-        p = _dense(rc, k, th, 0) - s_t
+        p = _dense(rc, k, th, np.int64(0)) - s_t
         if p == 0.0:
             return k, th
         if p < 0.0:
             lo = th
         else:
             hi = th
-        dp = _dense_d(rc, k, th, 0)
+        dp = _dense_d(rc, k, th, np.int64(0))
         thn = th - p / dp if dp > 0.0 else 0.5 * (lo + hi)
         if not (lo < thn < hi):
             thn = 0.5 * (lo + hi)
@@ -593,24 +605,15 @@ def _step(phase, m, y, h, K, y1, tmp, mask, n_rk, tau0, g, itau, n, kappa, mu_t,
         if r == 1:
             for c in range(m):
                 tmp[c] = y[c] + h * _A21 * K[0, c]
-        elif r == 2:
-            for c in range(m):
-                tmp[c] = y[c] + h * (_A31 * K[0, c] + _A32 * K[1, c])
-        elif r == 3:
-            for c in range(m):
-                tmp[c] = y[c] + h * (_A41 * K[0, c] + _A42 * K[1, c] + _A43 * K[2, c])
-        elif r == 4:
-            for c in range(m):
-                tmp[c] = y[c] + h * (_A51 * K[0, c] + _A52 * K[1, c] + _A53 * K[2, c]
-                                     + _A54 * K[3, c])
-        elif r == 5:
-            for c in range(m):
-                tmp[c] = y[c] + h * (_A61 * K[0, c] + _A62 * K[1, c] + _A63 * K[2, c]
-                                     + _A64 * K[3, c] + _A65 * K[4, c])
         else:
+            # one loop over the tableau's row instead of six unrolled copies (less to
+            # compile); the same sums in the same order
             for c in range(m):
-                tmp[c] = y[c] + h * (_B1 * K[0, c] + _B3 * K[2, c] + _B4 * K[3, c]
-                                     + _B5 * K[4, c] + _B6 * K[5, c])
+                acc = _STAGE[r, 0] * K[0, c]
+                for q in range(1, r):
+                    if _STAGE[r, q] != 0.0:  # b_2 = 0: no K[1] term in the update
+                        acc += _STAGE[r, q] * K[q, c]
+                tmp[c] = y[c] + h * acc
         _rhs(phase, y, tmp, K, r, np.bool_(True), tau0, g, itau, n, kappa, mu_t, tang, rc, hs,
              nh, ah, e_val, kh)
     for c in range(m):
@@ -659,9 +662,9 @@ def _grown_history(rc, hs, ah, nh):
     helpers; one flat loop per array instead of one per component compiles less).
     """
     cap = rc.shape[0]
-    rc2 = np.empty((2 * cap, rc.shape[1], rc.shape[2]))
-    hs2 = np.empty(2 * cap + 1)
-    ah2 = np.empty((2 * cap, ah.shape[1]))
+    rc2 = np.zeros((2 * cap, rc.shape[1], rc.shape[2]))
+    hs2 = np.zeros(2 * cap + 1)
+    ah2 = np.zeros((2 * cap, ah.shape[1]))
     src = rc.reshape(-1)
     dst = rc2.reshape(-1)
     for j in range(nh * rc.shape[1] * rc.shape[2]):
@@ -676,11 +679,13 @@ def _grown_history(rc, hs, ah, nh):
 
 
 @jit(internal=True)
-def _surface_catches(u_end, v_end, a_end, n, g, tau, tau0, tol):
+def _surface_catches(u_end, v_end, work, n, g, tau, tau0, tol):
     """Return whether the free centre element catches the sphere after separation.
 
-    The element starts at ``w = u_end`` with arms ``a_end``; the sphere moves on as
-    ``u = u_end + v_end (t - t_end)`` (kernel units).
+    The element starts at ``w = u_end`` with arms ``work[0, :n]`` (overwritten);
+    the sphere moves on as ``u = u_end + v_end (t - t_end)`` (kernel units).
+    ``work`` is the caller's scratch, at least ``(4, n)``: rows 1-3 receive the
+    arms' step factors.
     """
     if not (v_end < 0.0):
         return True
@@ -690,12 +695,12 @@ def _surface_catches(u_end, v_end, a_end, n, g, tau, tau0, tol):
     if t_h <= 0.0:
         return False
     h = t_h / _N_CHECK
-    q = a_end[:n].copy()
+    q = work[0]
+    E = work[1]
+    omE = work[2]
+    phi = work[3]
     w = u_end
     G = 0.0
-    E = np.empty(n)
-    omE = np.empty(n)
-    phi = np.empty(n)
     for i in range(n):
         G += g[i]
         x = h / tau[i] if tau[i] > 0.0 else np.inf
@@ -774,9 +779,11 @@ def maxwell_stick_impact(tau0, g, tau, kappa, mu_t, tangential, rtol, max_steps,
         out[OUT_STEPS] = 0
         out[OUT_N_REC] = 0
         return 0
-    ga = np.empty(n)
-    ta = np.empty(n)
-    itau = np.empty(n)
+    # every array of the kernel through np.zeros with int64 sizes: numba compiles
+    # the allocation once per distinct shape type (a literal size is its own type)
+    ga = np.zeros(n)
+    ta = np.zeros(n)
+    itau = np.zeros(n)
     j = 0
     for i in range(nin):
         if g[i] > 0.0 and tau[i] > 0.0:
@@ -804,7 +811,9 @@ def maxwell_stick_impact(tau0, g, tau, kappa, mu_t, tangential, rtol, max_steps,
     if tau0 > 0.8:
         s_scale = (0.8 / tau0) ** (1.0 / 3.0)
         v_scale = s_scale * s_scale / tau0
-    atol = np.full(mm, rtol)
+    atol = np.zeros(mm)
+    for c in range(mm):
+        atol[c] = rtol
     atol[0] = rtol * s_scale
     atol[1] = rtol * v_scale
 
@@ -812,11 +821,11 @@ def maxwell_stick_impact(tau0, g, tau, kappa, mu_t, tangential, rtol, max_steps,
     y1 = np.zeros(mm)
     tmp = np.zeros(mm)
     mask = np.zeros(mm)
-    K = np.zeros((7, mm))
+    K = np.zeros((np.int64(7), mm))
     e_val = np.zeros(5 * n + 1)  # decay factors, edge force density, step weights
     kh = np.zeros(1, dtype=np.int64)  # the history step of the last edge
-    cap = 64
-    rc = np.zeros((cap, 5, m_l))
+    cap = np.int64(64)
+    rc = np.zeros((cap, np.int64(5), m_l))
     hs = np.zeros(cap + 1)
     ah = np.zeros((cap, 4 * n))
     nh = np.int64(0)
@@ -966,21 +975,17 @@ def maxwell_stick_impact(tau0, g, tau, kappa, mu_t, tangential, rtol, max_steps,
             # misses most of its error (measured: 10-20x the error otherwise)
             h = h_next * UNLOAD_FIRST_STEP
             err_old = 1e-4
-            if n_rec > 0 and steps % rec_every == 0:
-                i_rec = _rec_state(rec, i_rec, phase, y, K, tau0, ga, itau, n, kappa, mu_t,
-                                   tang, rc, hs, nh, ah, e_val, kh)
-            continue
         if phase == 0 and y[0] * y[0] > u_max:
             u_max = y[0] * y[0]
         if n_rec > 0 and steps % rec_every == 0:
             i_rec = _rec_state(rec, i_rec, phase, y, K, tau0, ga, itau, n, kappa, mu_t, tang, rc,
                                hs, nh, ah, e_val, kh)
     if status == STATUS_OK and (n > 0 or tau0 > 0.0):
-        a_end = np.empty(n if n > 0 else np.int64(1))
+        # the stages K are free now: scratch of the check (no allocation here)
         for i in range(n):
-            a_end[i] = y[3] - y[4 + i]  # A_i = u - D_i
+            K[0, i] = y[3] - y[4 + i]  # A_i = u - D_i
         tol_c = 10.0 * rtol * max(u_max, 1e-300)
-        if _surface_catches(y[3], y[1], a_end, n, ga, ta, tau0, tol_c):
+        if _surface_catches(y[3], y[1], K, n, ga, ta, tau0, tol_c):
             status = STATUS_ASSUMPTION
     if n_rec > 0:
         i_rec = _rec_state(rec, min(i_rec, n_rec - 1), phase, y, K, tau0, ga, itau, n, kappa,
