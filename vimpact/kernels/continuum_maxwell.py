@@ -209,18 +209,6 @@ _D7 = 69997945.0 / 29380423.0
 _LS, _LV, _LT = 0, 1, 2
 _US, _UV, _UT, _UU = 0, 1, 2, 3
 
-#: Dormand-Prince weights of the stages: row ``r`` (2..5) gives stage ``r``'s state from
-#: ``K[0..r-1]``, row 6 the fifth-order update (row 1, ``a_21`` alone, is written out)
-_STAGE = np.array([
-    [0.0] * 7,
-    [_A21] + [0.0] * 6,
-    [_A31, _A32] + [0.0] * 5,
-    [_A41, _A42, _A43] + [0.0] * 4,
-    [_A51, _A52, _A53, _A54] + [0.0] * 3,
-    [_A61, _A62, _A63, _A64, _A65] + [0.0] * 2,
-    [_B1, 0.0, _B3, _B4, _B5, _B6, 0.0],
-])
-
 _N_CHECK = 200  # steps of the post-separation surface check
 #: first unloading step as a fraction of the step the loading phase proposed
 UNLOAD_FIRST_STEP = 1e-3
@@ -605,15 +593,24 @@ def _step(phase, m, y, h, K, y1, tmp, mask, n_rk, tau0, g, itau, n, kappa, mu_t,
         if r == 1:
             for c in range(m):
                 tmp[c] = y[c] + h * _A21 * K[0, c]
-        else:
-            # one loop over the tableau's row instead of six unrolled copies (less to
-            # compile); the same sums in the same order
+        elif r == 2:
             for c in range(m):
-                acc = _STAGE[r, 0] * K[0, c]
-                for q in range(1, r):
-                    if _STAGE[r, q] != 0.0:  # b_2 = 0: no K[1] term in the update
-                        acc += _STAGE[r, q] * K[q, c]
-                tmp[c] = y[c] + h * acc
+                tmp[c] = y[c] + h * (_A31 * K[0, c] + _A32 * K[1, c])
+        elif r == 3:
+            for c in range(m):
+                tmp[c] = y[c] + h * (_A41 * K[0, c] + _A42 * K[1, c] + _A43 * K[2, c])
+        elif r == 4:
+            for c in range(m):
+                tmp[c] = y[c] + h * (_A51 * K[0, c] + _A52 * K[1, c] + _A53 * K[2, c]
+                                     + _A54 * K[3, c])
+        elif r == 5:
+            for c in range(m):
+                tmp[c] = y[c] + h * (_A61 * K[0, c] + _A62 * K[1, c] + _A63 * K[2, c]
+                                     + _A64 * K[3, c] + _A65 * K[4, c])
+        else:
+            for c in range(m):
+                tmp[c] = y[c] + h * (_B1 * K[0, c] + _B3 * K[2, c] + _B4 * K[3, c]
+                                     + _B5 * K[4, c] + _B6 * K[5, c])
         _rhs(phase, y, tmp, K, r, np.bool_(True), tau0, g, itau, n, kappa, mu_t, tang, rc, hs,
              nh, ah, e_val, kh)
     for c in range(m):
