@@ -530,7 +530,7 @@ def _dense_d(rc, k, th, c):
             + (2.0 * th - 6.0 * th * th + 4.0 * th * th * th) * r4)
 
 
-@jit(internal=True)
+@jit(inline="always")
 def _edge(rc, hs, nh, s_t, kh):
     """Return the loading step ``k`` and ``theta`` with ``s(k, theta) = s_t``.
 
