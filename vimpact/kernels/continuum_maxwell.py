@@ -217,17 +217,17 @@ _Z_SERIES = 0.2
 _INV_FACT = np.array([1.0 / math.factorial(k) for k in range(16)])
 
 
-@jit()
+@jit(internal=True)
 def _n_load(n, tang):
     return 4 + 3 * n + (4 + 3 * n if tang else 0)
 
 
-@jit()
+@jit(internal=True)
 def _n_unload(n, tang):
     return 5 + 2 * n + (3 + n if tang else 0)
 
 
-@jit()
+@jit(internal=True)
 def _rk_mask(phase, n, tang, mask):
     """Write the Runge-Kutta mask of a phase's state into ``mask``; return its count.
 
@@ -255,7 +255,7 @@ def _rk_mask(phase, n, tang, mask):
     return 4 + (2 if tang else 0)
 
 
-@jit()
+@jit(internal=True)
 def _filter_weights(z):
     """Weights of the exact filter updates (module docstring) for ``z = Delta/tau``.
 
@@ -294,13 +294,13 @@ def _filter_weights(z):
             24.0 * p3 - 72.0 * p4)
 
 
-@jit()
+@jit(internal=True)
 def _arm(x0, ez, w0, wr, wj, dt, p0, pr, j):
     """Return the quadratic-drive filter update ``exp(-z) X_0 + Delta (w_0 P_0 + w_r P_r) + w_J J``."""
     return ez * x0 + dt * (w0 * p0 + wr * pr) + wj * j
 
 
-@jit()
+@jit(internal=True)
 def _arm3(x0, ez, c0, c1, cr, cj, dt, p0, dp0, pr, j):
     """Return the cubic-drive filter update of an arm quantity.
 
@@ -309,7 +309,7 @@ def _arm3(x0, ez, c0, c1, cr, cj, dt, p0, dp0, pr, j):
     return ez * x0 + dt * (c0 * p0 + c1 * dt * dp0 + cr * pr) + cj * j
 
 
-@jit()
+@jit(internal=True)
 def _rhs(phase, y0, x, K, r, advance, tau0, g, itau, n, kappa, mu_t, tang, rc, hs, nh, ah,
          e_val, kh):
     """Right-hand side ``dx/dsigma`` into ``K[r]``; returns ``(F_z, F_x)``.
@@ -398,13 +398,13 @@ def _rhs(phase, y0, x, K, r, advance, tau0, g, itau, n, kappa, mu_t, tang, rc, h
         wc = x[o]
         vc = x[o + 1]
     k, th = _edge(rc, hs, nh, s, kh)
-    te = _dense(rc, k, th, _LT)
+    te = _dense(rc, k, th, np.int64(_LT))
     ue = s * s
     # the loading step's dense output at the edge, for the arm quantities there
     sk = rc[k, 0, _LS]
     vk = rc[k, 0, _LV]
     dte = te - rc[k, 0, _LT]
-    ve = _dense(rc, k, th, _LV) if n > 0 else 0.0
+    ve = _dense(rc, k, th, np.int64(_LV)) if n > 0 else 0.0
     rate_e = 0.5 * ve / s if s > 0.0 else 0.0
     rate_k = 0.5 * vk / sk if sk > 0.0 else 0.0
     accel_k = 0.0
@@ -510,7 +510,7 @@ def _rhs_once(phase, y0, x, K, r, tau0, g, itau, n, kappa, mu_t, tang, rc, hs, n
                 nh, ah, e_val, kh)
 
 
-@jit(inline="always")
+@jit(internal=True)
 def _dense(rc, k, th, c):
     """Dense-output value of component ``c`` of stored step ``k`` at ``theta = th``."""
     th1 = 1.0 - th
@@ -518,7 +518,7 @@ def _dense(rc, k, th, c):
                                                                        + th1 * rc[k, 4, c])))
 
 
-@jit(inline="always")
+@jit(internal=True)
 def _dense_d(rc, k, th, c):
     """``d/dtheta`` of :func:`_dense`."""
     r1 = rc[k, 1, c]
@@ -561,14 +561,14 @@ def _edge(rc, hs, nh, s_t, kh):
     for _ in range(60):
         if not (lo <= th <= hi):
             th = 0.5 * (lo + hi)
-        p = _dense(rc, k, th, 0) - s_t
+        p = _dense(rc, k, th, np.int64(0)) - s_t
         if p == 0.0:
             return k, th
         if p < 0.0:
             lo = th
         else:
             hi = th
-        dp = _dense_d(rc, k, th, 0)
+        dp = _dense_d(rc, k, th, np.int64(0))
         thn = th - p / dp if dp > 0.0 else 0.5 * (lo + hi)
         if not (lo < thn < hi):
             thn = 0.5 * (lo + hi)
@@ -578,7 +578,7 @@ def _edge(rc, hs, nh, s_t, kh):
     return k, th
 
 
-@jit()
+@jit(internal=True)
 def _step(phase, m, y, h, K, y1, tmp, mask, n_rk, tau0, g, itau, n, kappa, mu_t, tang, rc, hs,
           nh, ah, e_val, atol, rtol, kh):
     """Take one Dormand-Prince 5(4) step of length ``h`` (/ T) from ``y``; return its error norm.
@@ -625,7 +625,7 @@ def _step(phase, m, y, h, K, y1, tmp, mask, n_rk, tau0, g, itau, n, kappa, mu_t,
     return math.sqrt(acc / n_rk)
 
 
-@jit()
+@jit(internal=True)
 def _store(rc, hs, ah, nh, y, y1, K, h, m, n, tang):
     """Write the dense output of an accepted loading step into row ``nh``.
 
@@ -650,12 +650,39 @@ def _store(rc, hs, ah, nh, y, y1, K, h, m, n, tang):
             ah[nh, 2 * n + i] = y[o + 3 + i]
 
 
-@jit()
-def _surface_catches(u_end, v_end, a_end, n, g, tau, tau0, tol):
+@jit(internal=True)
+def _grown_history(rc, hs, ah, nh):
+    """Return the loading history with twice the rows, the first ``nh`` steps copied.
+
+    Copied element by element over each array's contiguous prefix (an array slice
+    assignment compiles numba's shape-mismatch error message, about 25 string
+    helpers; one flat loop per array instead of one per component compiles less).
+    """
+    cap = rc.shape[0]
+    rc2 = np.zeros((2 * cap, rc.shape[1], rc.shape[2]))
+    hs2 = np.zeros(2 * cap + 1)
+    ah2 = np.zeros((2 * cap, ah.shape[1]))
+    src = rc.reshape(-1)
+    dst = rc2.reshape(-1)
+    for j in range(nh * rc.shape[1] * rc.shape[2]):
+        dst[j] = src[j]
+    src = ah.reshape(-1)
+    dst = ah2.reshape(-1)
+    for j in range(nh * ah.shape[1]):
+        dst[j] = src[j]
+    for j in range(nh + 1):
+        hs2[j] = hs[j]
+    return rc2, hs2, ah2
+
+
+@jit(internal=True)
+def _surface_catches(u_end, v_end, work, n, g, tau, tau0, tol):
     """Return whether the free centre element catches the sphere after separation.
 
-    The element starts at ``w = u_end`` with arms ``a_end``; the sphere moves on as
-    ``u = u_end + v_end (t - t_end)`` (kernel units).
+    The element starts at ``w = u_end`` with arms ``work[0, :n]`` (overwritten);
+    the sphere moves on as ``u = u_end + v_end (t - t_end)`` (kernel units).
+    ``work`` is the caller's scratch, at least ``(4, n)``: rows 1-3 receive the
+    arms' step factors.
     """
     if not (v_end < 0.0):
         return True
@@ -665,12 +692,12 @@ def _surface_catches(u_end, v_end, a_end, n, g, tau, tau0, tol):
     if t_h <= 0.0:
         return False
     h = t_h / _N_CHECK
-    q = a_end[:n].copy()
+    q = work[0]
+    E = work[1]
+    omE = work[2]
+    phi = work[3]
     w = u_end
     G = 0.0
-    E = np.empty(n)
-    omE = np.empty(n)
-    phi = np.empty(n)
     for i in range(n):
         G += g[i]
         x = h / tau[i] if tau[i] > 0.0 else np.inf
@@ -749,9 +776,11 @@ def maxwell_stick_impact(tau0, g, tau, kappa, mu_t, tangential, rtol, max_steps,
         out[OUT_STEPS] = 0
         out[OUT_N_REC] = 0
         return 0
-    ga = np.empty(n)
-    ta = np.empty(n)
-    itau = np.empty(n)
+    # every array of the kernel through np.zeros with int64 sizes: numba compiles
+    # the allocation once per distinct shape type (a literal size is its own type)
+    ga = np.zeros(n)
+    ta = np.zeros(n)
+    itau = np.zeros(n)
     j = 0
     for i in range(nin):
         if g[i] > 0.0 and tau[i] > 0.0:
@@ -779,7 +808,9 @@ def maxwell_stick_impact(tau0, g, tau, kappa, mu_t, tangential, rtol, max_steps,
     if tau0 > 0.8:
         s_scale = (0.8 / tau0) ** (1.0 / 3.0)
         v_scale = s_scale * s_scale / tau0
-    atol = np.full(mm, rtol)
+    atol = np.zeros(mm)
+    for c in range(mm):
+        atol[c] = rtol
     atol[0] = rtol * s_scale
     atol[1] = rtol * v_scale
 
@@ -787,13 +818,11 @@ def maxwell_stick_impact(tau0, g, tau, kappa, mu_t, tangential, rtol, max_steps,
     y1 = np.zeros(mm)
     tmp = np.zeros(mm)
     mask = np.zeros(mm)
-    K = np.zeros((7, mm))
-    Ks = np.zeros((7, mm))
-    ys = np.zeros(mm)
+    K = np.zeros((np.int64(7), mm))
     e_val = np.zeros(5 * n + 1)  # decay factors, edge force density, step weights
     kh = np.zeros(1, dtype=np.int64)  # the history step of the last edge
-    cap = 64
-    rc = np.zeros((cap, 5, m_l))
+    cap = np.int64(64)
+    rc = np.zeros((cap, np.int64(5), m_l))
     hs = np.zeros(cap + 1)
     ah = np.zeros((cap, 4 * n))
     nh = np.int64(0)
@@ -838,11 +867,7 @@ def maxwell_stick_impact(tau0, g, tau, kappa, mu_t, tangential, rtol, max_steps,
             g0 = y[comp]
             best_h = h
             best_g = y1[comp]
-            for c in range(m):
-                ys[c] = y1[c]
-            for r in range(7):
-                for c in range(m):
-                    Ks[r, c] = K[r, c]
+            last_h = h  # the step whose state y1 and stages K[1:] hold
             hp = h * g0 / (g0 - y1[comp])
             tiny = 4.0 * _EPS * (abs(sig) + h)
             for _ in range(40):
@@ -850,15 +875,11 @@ def maxwell_stick_impact(tau0, g, tau, kappa, mu_t, tangential, rtol, max_steps,
                     hp = 0.5 * (lo + hi)
                 _step(phase, m, y, hp, K, y1, tmp, mask, n_rk, tau0, ga, itau, n, kappa, mu_t,
                       tang, rc, hs, nh, ah, e_val, atol, rtol, kh)
+                last_h = hp
                 gv = y1[comp]
                 if abs(gv) <= abs(best_g):
                     best_h = hp
                     best_g = gv
-                    for c in range(m):
-                        ys[c] = y1[c]
-                    for r in range(1, 7):
-                        for c in range(m):
-                            Ks[r, c] = K[r, c]
                 if gv == 0.0:
                     break
                 if gv > 0.0:
@@ -873,29 +894,16 @@ def maxwell_stick_impact(tau0, g, tau, kappa, mu_t, tangential, rtol, max_steps,
                     break
                 hp = hn
             h = best_h
-            for c in range(m):
-                y1[c] = ys[c]
-            for r in range(1, 7):
-                for c in range(m):
-                    K[r, c] = Ks[r, c]
+            if last_h != best_h:
+                # take the best step again rather than keep copies of every candidate's
+                # state and stages: a step is a function of (y, K[0], h) alone, so this
+                # is the same state; the copy loops (unrolled over the seven stages and
+                # vectorized) were a third of this function's compiled code
+                _step(phase, m, y, h, K, y1, tmp, mask, n_rk, tau0, ga, itau, n, kappa, mu_t,
+                      tang, rc, hs, nh, ah, e_val, atol, rtol, kh)
         if phase == 0:
             if nh + 1 >= rc.shape[0]:  # grow the history (rare: doubling)
-                # copied element by element: an array slice assignment compiles
-                # numba's shape-mismatch error message (about 25 string helpers)
-                rc2 = np.empty((2 * rc.shape[0], 5, m_l))
-                hs2 = np.empty(2 * rc.shape[0] + 1)
-                ah2 = np.empty((2 * rc.shape[0], 4 * n))
-                for kc in range(nh):
-                    for p in range(5):
-                        for c in range(m_l):
-                            rc2[kc, p, c] = rc[kc, p, c]
-                    for c in range(4 * n):
-                        ah2[kc, c] = ah[kc, c]
-                for kc in range(nh + 1):
-                    hs2[kc] = hs[kc]
-                rc = rc2
-                hs = hs2
-                ah = ah2
+                rc, hs, ah = _grown_history(rc, hs, ah, nh)
             _store(rc, hs, ah, nh, y, y1, K, h, m, n, tang)
             nh += 1
         elif y1[0] > y[0] + 100.0 * rtol * s_max:  # edge moving outward: re-entry
@@ -925,7 +933,10 @@ def maxwell_stick_impact(tau0, g, tau, kappa, mu_t, tangential, rtol, max_steps,
             u_max = s_max * s_max
             t_turn = y[2]
             hs[nh] = s_max
-            z = np.zeros(mm)
+            # the unloading state is built in y1 (free between steps), then copied
+            z = y1
+            for c in range(mm):
+                z[c] = 0.0
             z[0] = s_max
             z[1] = 0.0
             z[2] = t_turn
@@ -961,21 +972,17 @@ def maxwell_stick_impact(tau0, g, tau, kappa, mu_t, tangential, rtol, max_steps,
             # misses most of its error (measured: 10-20x the error otherwise)
             h = h_next * UNLOAD_FIRST_STEP
             err_old = 1e-4
-            if n_rec > 0 and steps % rec_every == 0:
-                i_rec = _rec_state(rec, i_rec, phase, y, K, tau0, ga, itau, n, kappa, mu_t,
-                                   tang, rc, hs, nh, ah, e_val, kh)
-            continue
         if phase == 0 and y[0] * y[0] > u_max:
             u_max = y[0] * y[0]
         if n_rec > 0 and steps % rec_every == 0:
             i_rec = _rec_state(rec, i_rec, phase, y, K, tau0, ga, itau, n, kappa, mu_t, tang, rc,
                                hs, nh, ah, e_val, kh)
     if status == STATUS_OK and (n > 0 or tau0 > 0.0):
-        a_end = np.empty(n if n > 0 else np.int64(1))
+        # the stages K are free now: scratch of the check (no allocation here)
         for i in range(n):
-            a_end[i] = y[3] - y[4 + i]  # A_i = u - D_i
+            K[0, i] = y[3] - y[4 + i]  # A_i = u - D_i
         tol_c = 10.0 * rtol * max(u_max, 1e-300)
-        if _surface_catches(y[3], y[1], a_end, n, ga, ta, tau0, tol_c):
+        if _surface_catches(y[3], y[1], K, n, ga, ta, tau0, tol_c):
             status = STATUS_ASSUMPTION
     if n_rec > 0:
         i_rec = _rec_state(rec, min(i_rec, n_rec - 1), phase, y, K, tau0, ga, itau, n, kappa,
@@ -998,7 +1005,7 @@ def maxwell_stick_impact(tau0, g, tau, kappa, mu_t, tangential, rtol, max_steps,
     return i_rec
 
 
-@jit()
+@jit(internal=True)
 def _rec_state(rec, i_rec, phase, y, K, tau0, g, itau, n, kappa, mu_t, tang, rc, hs, nh, ah,
                e_val, kh):
     """Record the current state (forces recomputed at it)."""

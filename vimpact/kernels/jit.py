@@ -11,11 +11,20 @@ before numba starts them.
 
 from __future__ import annotations
 
-from typing import Literal
+from typing import Any, Literal
 
 import numba
 
 
-def jit(parallel: bool = False, inline: Literal["never", "always"] = "never"):
-    """Return the decorator that compiles one of the package's numba kernels."""
-    return numba.njit(cache=True, error_model="numpy", parallel=parallel, inline=inline)
+def jit(parallel: bool = False, inline: Literal["never", "always"] = "never",
+        internal: bool = False):
+    """Return the decorator that compiles one of the package's numba kernels.
+
+    ``internal``: a function only other kernels call, never Python. numba then
+    compiles no Python entry point for it (no argument unboxing, no C-callable
+    wrapper), which every caller's module would otherwise carry along.
+    """
+    # (numba's type stubs do not list the wrapper options)
+    wrappers: dict[str, Any] = {"no_cpython_wrapper": internal, "no_cfunc_wrapper": internal}
+    return numba.njit(cache=True, error_model="numpy", parallel=parallel, inline=inline,
+                      **wrappers)
