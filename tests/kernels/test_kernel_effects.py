@@ -1,0 +1,95 @@
+"""Which compiled element kernel runs the rows of a :class:`KernelSpec`, and the
+run-time friction flag.
+
+Friction and full stick share one kernel where the tangential problem has
+incremental memory: the row's ``mu`` decides (``inf`` sticks). The flag must
+take the same arithmetic path as a kernel compiled for that one effect: the
+kernels compiled with friction fixed at 0 or 1 are the oracle, compared bit for
+bit on random rows (trajectories included). Those extra compiles are what the
+shared kernel saves, so that comparison is a slow test.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from vimpact.kernels.elements import (
+    EULER,
+    N_OUT,
+    N_REC,
+    RUNTIME,
+    SYMPLECTIC_EULER,
+    VERLET,
+    KernelSpec,
+    element_impact,
+    impact_kernel,
+    kernel_effects,
+)
+
+
+def test_friction_and_stick_share_the_incremental_kernel():
+    for integrator in (EULER, SYMPLECTIC_EULER, VERLET):
+        for arms in (False, True):
+            for dashpot in (False, True):
+                stick = KernelSpec(integrator, True, 0, arms, dashpot, False)
+                fric = KernelSpec(integrator, True, 0, arms, dashpot, True)
+                assert kernel_effects(stick) == kernel_effects(fric)
+                assert kernel_effects(fric) == (integrator, True, 0, arms, dashpot, RUNTIME)
+                # seed memory: no friction code at all; normal only: no tangential code
+                seed = KernelSpec(integrator, True, 1, arms, dashpot, False)
+                assert kernel_effects(seed) == (integrator, True, 1, arms, dashpot, 0)
+                normal = KernelSpec(integrator, False, 1, arms, dashpot, False)
+                assert kernel_effects(normal) == (integrator, False, 0, arms, dashpot, 0)
+    assert element_impact(KernelSpec(VERLET, True, 0, False, True, False)) is element_impact(
+        KernelSpec(VERLET, True, 0, False, True, True))
+
+
+def test_friction_with_seed_memory_is_refused():
+    with pytest.raises(ValueError, match="memory=1, friction=True"):
+        kernel_effects(KernelSpec(VERLET, True, 1, False, True, True))
+    with pytest.raises(ValueError, match="incremental memory"):
+        impact_kernel((VERLET, True, 1, False, True, RUNTIME))
+
+
+def _rows(rng, n, arms, dashpot, friction):
+    """Random kernel-unit rows: (tau0, g, tau, kappa, mu_t, mu, h, n_elem, dxi, max_steps)."""
+    rows = []
+    for _ in range(n):
+        nu = rng.uniform(0.0, 0.5)
+        n_arms = rng.integers(1, 3) if arms else 0
+        g = rng.uniform(0.3, 3.0, n_arms)
+        tau = 10.0 ** rng.uniform(-2.0, 1.0, n_arms)
+        tau0 = 10.0 ** rng.uniform(-3.0, 0.0) if dashpot else 0.0
+        # friction rows: gross slip, stick-slip and near stick; stick rows: mu = inf
+        mu = 10.0 ** rng.uniform(-1.5, 1.5) if friction else math.inf
+        h = 2.9432751843 / rng.uniform(200.0, 500.0)
+        dxi = 1.0 / rng.uniform(30.0, 60.0)
+        rows.append((tau0, g, tau, 2.0 * (1.0 - nu) / (2.0 - nu), 1.0 + 1.0 / rng.uniform(0.2, 2.0),
+                     mu, h, int(math.ceil(1.3 / dxi)), dxi, int(60.0 / h)))
+    return rows
+
+
+def _run(kernel, row):
+    out = np.zeros(N_OUT)
+    rec = np.zeros((30, N_REC))
+    kernel(*row, rec, np.int64(11), out)
+    return out, rec
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("integrator", [VERLET, SYMPLECTIC_EULER, EULER])
+@pytest.mark.parametrize("arms,dashpot", [(False, False), (False, True), (True, False),
+                                          (True, True)])
+def test_runtime_friction_flag_is_the_specialized_kernel_bit_for_bit(integrator, arms, dashpot):
+    rng = np.random.default_rng([integrator, arms, dashpot])
+    shared = impact_kernel((integrator, True, 0, arms, dashpot, RUNTIME))
+    for friction in (0, 1):
+        special = impact_kernel((integrator, True, 0, arms, dashpot, friction))
+        for row in _rows(rng, 4, arms, dashpot, friction):
+            out_s, rec_s = _run(special, row)
+            out_r, rec_r = _run(shared, row)
+            np.testing.assert_array_equal(out_r, out_s)
+            np.testing.assert_array_equal(rec_r, rec_s)
