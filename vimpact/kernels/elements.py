@@ -54,12 +54,11 @@ own values: numba reads them as constants and drops the branches they switch
 off before typing, so a normal-only Kelvin-Voigt kernel carries no tangential
 and no arm code at all. (Inlining one body into a wrapper per kernel instead
 costs most of the compile: numba copies an inlined body's IR block by block,
-each block with the whole scope.) Friction is
-the one effect read at run time where the tangential problem has incremental
-memory (:func:`kernel_effects`): friction and full stick share that kernel, a
-stick row carries ``mu = inf`` and takes the same statements as a kernel
-compiled without friction. vimpact/bench/specialization.py measures what
-each effect costs as a run-time flag.
+each block with the whole scope.) Friction is read from the row instead where
+the tangential problem has incremental memory (:func:`kernel_effects`; a stick
+row carries ``mu = inf``), and takes the same statements as in a kernel
+compiled for its value; vimpact/bench/specialization.py measures what each
+effect costs as a run-time flag.
 """
 
 from __future__ import annotations
@@ -159,7 +158,8 @@ def _impact(tau0, g, tau, kappa, mu_t, mu_k, h, n_elem, dxi, max_steps, rec, rec
     reads a global as a constant and drops the branches it switches off before
     typing, so a kernel carries no code of an effect it lacks. ``FRICTION``
     may be :data:`RUNTIME`: the row's ``mu_k`` decides (``inf``: full stick,
-    the same statements as a kernel compiled without friction). The arguments
+    the same statements as a kernel compiled without friction); so may
+    ``DASHPOT`` (the row's ``tau0 > 0``, and ``NCORR`` with it). The arguments
     are kernel-unit inputs (module docstring).
 
     Parameters
@@ -180,22 +180,30 @@ def _impact(tau0, g, tau, kappa, mu_t, mu_k, h, n_elem, dxi, max_steps, rec, rec
     # Coulomb friction: every element in contact keeps |f_t| <= mu f_n
     # (docs/physics.md#coulomb-friction); a constant of the kernel, or the row's mu
     FRIC = FRICTION == 1 if FRICTION != RUNTIME else mu_k < math.inf
+    # the parallel dashpot: a constant of the kernel, or the row's (tau0 > 0), and
+    # with it NCOR, the partial-contact weighting of the normal force (NCORR below)
+    DASH = DASHPOT == 1 if DASHPOT != RUNTIME else tau0 > 0.0
+    NCOR = NCORR == 1 if NCORR != RUNTIME else DASH
     n_arms = g.shape[0] if ARMS else 0
-    E, omE, phi = arm_coefficients(tau, h)
     G = 0.0
     sum_gphi = 0.0
-    for i in range(n_arms):
-        G += g[i]
-        sum_gphi += g[i] * phi[i]
-    c0 = tau0 if DASHPOT else 0.0
+    ca = 0.0
+    if ARMS:  # (a kernel without arms compiles none of the arm helpers)
+        E, omE, phi = arm_coefficients(tau, h)
+        for i in range(n_arms):
+            G += g[i]
+            sum_gphi += g[i] * phi[i]
+        # Verlet: each arm's step impulse is exact for the drift path; its first half
+        # takes the arm stresses weighted by kap and the damping ca implicitly in the
+        # half-step velocity, like the dashpot (arm_implicit_coefficients), so arms
+        # faster than the step stay second order and stable (IMPLICIT: Verlet with arms)
+        kap, ca = arm_implicit_coefficients(g[:n_arms], tau[:n_arms], h)
+    else:
+        E = omE = phi = kap = tau[:0]
+    c0 = tau0 if DASH else 0.0
     tau0_h = c0 / h
     den_free = tau0_h + 1.0 + G - sum_gphi
-    decay0 = math.exp(-h / c0) if DASHPOT else 0.0
-    # Verlet: each arm's step impulse is exact for the drift path; its first half
-    # takes the arm stresses weighted by kap and the damping ca implicitly in the
-    # half-step velocity, like the dashpot (arm_implicit_coefficients), so arms
-    # faster than the step stay second order and stable (IMPLICIT: Verlet with arms)
-    kap, ca = arm_implicit_coefficients(g[:n_arms], tau[:n_arms], h)
+    decay0 = math.exp(-h / c0) if DASH else 0.0
     # the arms' end stress on the straight drift path misses the path's curvature:
     # on w0 + v t + a t^2 / 2 it is larger by sum g tau (1 + E - 2 (1 - E) / x) a h / 2,
     # which is ca (ve - v_test): the force that decides whether an element still
@@ -279,7 +287,7 @@ def _impact(tau0, g, tau, kappa, mu_t, mu_k, h, n_elem, dxi, max_steps, rec, rec
             Ft_pos = Ft_s if IMPLICIT else Ft_el
             if FRIC and IMPLICIT:  # slipping: mu times the normal force as the kick takes it
                 Ft_pos = Ft_pos + Css * v_test
-            elif FRIC and DASHPOT:  # slipping elements: mu times their normal force, whose
+            elif FRIC and DASH:  # slipping elements: mu times their normal force, whose
                 # dashpot part takes this step's normal velocity (as the normal kick)
                 Ft_pos = Ft_pos + Cs * (v if INTEGRATOR == EULER else v_test)
             if INTEGRATOR == EULER:
@@ -385,7 +393,7 @@ def _impact(tau0, g, tau, kappa, mu_t, mu_k, h, n_elem, dxi, max_steps, rec, rec
                             alpha = 1.0
                         else:
                             alpha = T0 / (T0 - T1)
-                        if NCORR:  # minus what the first half-kick applied
+                        if NCOR:  # minus what the first half-kick applied
                             if IMPLICIT:
                                 corr_n += alpha * T0 - (fs[j] + (c0 + ca) * v_test)
                             else:
@@ -399,7 +407,7 @@ def _impact(tau0, g, tau, kappa, mu_t, mu_k, h, n_elem, dxi, max_steps, rec, rec
                             if IMPLICIT:
                                 T1t += cae * (vce - vc_test)
                             sg = fsgn[j] if FRIC else 0.0
-                            if sg != 0.0 and not NCORR:  # slipping: mu times the normal
+                            if sg != 0.0 and not NCOR:  # slipping: mu times the normal
                                 T0t = 0.0  # force, which takes no correction here
                                 A_t = 0.0
                                 T1t = 0.0
@@ -430,7 +438,7 @@ def _impact(tau0, g, tau, kappa, mu_t, mu_k, h, n_elem, dxi, max_steps, rec, rec
                 contact[j] = False
                 continue
             entry_n = 0.0  # what the normal force over the entering part adds
-            if NCORR and not was_in:  # from f_entry to the end force over theta h
+            if NCOR and not was_in:  # from f_entry to the end force over theta h
                 if IMPLICIT:  # (the arms at their exact mean over it)
                     entry_n = (theta * (f_entry - fa_entry + w1 + c0 * ve + 2.0 * arm_mean)
                                - fj)
@@ -505,7 +513,7 @@ def _impact(tau0, g, tau, kappa, mu_t, mu_k, h, n_elem, dxi, max_steps, rec, rec
                     else:
                         fol = _follow_over(s0, s1, p[j], g, tau, theta * h)
                 trial = s1 + fol
-                if DASHPOT:
+                if DASH:
                     trial += c0 * vc_test
                 cone = mu_k * fj / kappa  # element stress at the cone, tangential units
                 if mu_k == math.inf or abs(trial) <= cone:  # stick
@@ -547,7 +555,7 @@ def _impact(tau0, g, tau, kappa, mu_t, mu_k, h, n_elem, dxi, max_steps, rec, rec
                     if PARTIAL:  # mu times the normal force, entering or not
                         ftp[j] = sgn * mu_k / kappa * r_end
                         fsgn[j] = sgn
-                        if NCORR and not was_in:
+                        if NCOR and not was_in:
                             corr_t += sgn * mu_k / kappa * entry_n
         if n_c == 0 and t_leave > 0.0:
             t_exit = t_leave  # the last elements left within this step
@@ -575,7 +583,7 @@ def _impact(tau0, g, tau, kappa, mu_t, mu_k, h, n_elem, dxi, max_steps, rec, rec
         # ---- sphere: second half ----
         if INTEGRATOR == VERLET:
             v = v_test - 0.5 * h * (F_el1 + C1 * v_test + k_el * corr_n)
-            if FRIC and DASHPOT:
+            if FRIC and DASH:
                 vc = vc_test - 0.5 * h * mu_t * (Ft_el1 + Ct1 * vc_test + Cs1 * v_test
                                                  + k_el * kappa * corr_t)
             elif TANGENTIAL:
@@ -608,7 +616,7 @@ def _impact(tau0, g, tau, kappa, mu_t, mu_k, h, n_elem, dxi, max_steps, rec, rec
         # ---- end of impact: no contact, moving away, no free surface can catch up ----
         if n_c == 0 and v < 0.0:
             caught = False
-            if DASHPOT or ARMS:  # an elastic surface is back at rest at once
+            if DASH or ARMS:  # an elastic surface is back at rest at once
                 for j in range(active):
                     if _free_rate(w[j], q[j], g, tau, c0) < v * (1.0 + 1e-9):
                         caught = True
@@ -658,8 +666,9 @@ class KernelSpec(NamedTuple):
     friction: bool = False
 
 
-#: value of ``FRICTION`` in :func:`kernel_effects` for a kernel that takes friction
-#: from the row (``mu_k < inf``) instead of compiling it in or out
+#: value of ``FRICTION`` (or ``DASHPOT``) in the compiled effects of a kernel that
+#: reads the effect from the row (``mu_k < inf``, ``tau0 > 0``) instead of compiling
+#: it in or out
 RUNTIME = -1
 
 # The effects the impact body reads as globals (:func:`_impact`). Each kernel runs a
@@ -669,21 +678,24 @@ TANGENTIAL = False
 MEMORY = 0
 INTEGRATOR = VERLET
 ARMS = False
-DASHPOT = False
+DASHPOT: int = 0
 FRICTION: int = 0
 IMPLICIT = False
 PARTIAL = False
-NCORR = False
+NCORR: int = 0
 
 
-def kernel_effects(spec: KernelSpec) -> tuple[int, bool, int, bool, bool, int]:
+def kernel_effects(spec: KernelSpec) -> tuple[int, bool, int, bool, int, int]:
     """Return the compiled effects of the kernel that runs the rows of ``spec`` (checked).
 
     ``(integrator, tangential, memory, arms, dashpot, friction)`` as plain Python
-    constants, ``memory`` 0 without a tangential problem and ``friction``
-    :data:`RUNTIME` with incremental tangential memory: friction and full stick
-    share that kernel (the specialization bought 0-6 % of its run time and cost
-    a compile of its own; vimpact/bench/specialization.py measures it).
+    constants: ``memory`` 0 without a tangential problem, ``friction``
+    :data:`RUNTIME` with incremental tangential memory (friction and full stick
+    share that kernel: its friction rows run as fast as on a kernel compiled with
+    friction, its stick rows 0-20 % slower than without, and those rows take the
+    continuum kernel unless it is switched off). The others stay compiled in
+    (vimpact/bench/specialization.py measures what each would cost at run time;
+    the dashpot would cost 3-13 %).
     """
     integrator, tangential, memory = int(spec.integrator), bool(spec.tangential), int(spec.memory)
     arms, dashpot, friction = bool(spec.arms), bool(spec.dashpot), bool(spec.friction)
@@ -693,31 +705,36 @@ def kernel_effects(spec: KernelSpec) -> tuple[int, bool, int, bool, bool, int]:
                          "element to the total contact-point displacement, which slip cannot "
                          "change")
     if not tangential:
-        return integrator, False, 0, arms, dashpot, 0
-    return integrator, True, memory, arms, dashpot, RUNTIME if memory == 0 else 0
+        return integrator, False, 0, arms, int(dashpot), 0
+    return integrator, True, memory, arms, int(dashpot), RUNTIME if memory == 0 else 0
 
 
 def _effects(key: tuple) -> dict:
     """Return the globals of the impact body for the compiled effects ``key``.
 
-    ``key`` as :func:`kernel_effects` returns it; ``friction`` 0, 1 or :data:`RUNTIME`.
+    ``key`` as :func:`kernel_effects` returns it; ``dashpot`` and ``friction`` 0, 1
+    or :data:`RUNTIME`.
     """
     integrator, tangential, memory, arms, dashpot, friction = key
     if friction != 0 and not (tangential and memory == 0):
         raise ValueError(f"compiled effects {key}: friction needs the tangential problem with "
                          "incremental memory")
     partial = integrator == VERLET  # Verlet weighs partial contact within a step
+    # ... in the normal force with a dashpot or arms (the row's dashpot decides only
+    # for a Verlet kernel without arms)
+    ncorr = (RUNTIME if dashpot == RUNTIME and partial and not arms
+             else int(partial and (arms or dashpot == 1)))
     return {"TANGENTIAL": tangential, "MEMORY": memory, "INTEGRATOR": integrator, "ARMS": arms,
-            "DASHPOT": dashpot, "FRICTION": friction, "IMPLICIT": partial and arms,
-            "PARTIAL": partial, "NCORR": partial and (dashpot or arms)}
+            "DASHPOT": int(dashpot), "FRICTION": int(friction), "IMPLICIT": partial and arms,
+            "PARTIAL": partial, "NCORR": ncorr}
 
 
 def _tag(key: tuple) -> str:
     """Name the compiled effects ``key`` (part of a kernel's qualified name)."""
     integrator, tangential, memory, arms, dashpot, friction = key
-    fric = "R" if friction == RUNTIME else str(int(friction))
+    dash, fric = ("R" if x == RUNTIME else str(int(x)) for x in (dashpot, friction))
     return (f"integrator{integrator}_tangential{int(tangential)}_memory{memory}"
-            f"_arms{int(arms)}_dashpot{int(dashpot)}_friction{fric}")
+            f"_arms{int(arms)}_dashpot{dash}_friction{fric}")
 
 
 def _bind(key: tuple):
