@@ -11,9 +11,9 @@ Every top-level compile (a dispatcher compiling a new signature, its callees
 included) is attributed to the test that triggered it; the terminal summary
 lists them by time, and ``COMPILE_PROFILE_OUT`` (default
 ``.pytest_cache/numba_compiles.json``) gets the rows. Element kernels are
-labelled with their closure constants, in the alphabetical order of their
-names: ``arms, dashpot, friction, integrator, memory, tangential``. Compiles
-in subprocesses (command-line tests) are not seen.
+named after their compiled effects (``..._integrator2_tangential1_memory0_arms0_
+dashpot1_frictionR``, ``R``: friction read from the row). Compiles in
+subprocesses (command-line tests) are not seen.
 
 Package functions compiled for more than one signature are listed too: a
 callee that receives a bare literal (``f(x, 0)``, or a counter that starts at

@@ -12,12 +12,14 @@ from vimpact.bench.machine import annotate
 
 @pytest.mark.slow
 def test_specialization_quick_outputs_identical(tmp_path):
-    """The run-time-flag kernel computes exactly what the specialized one does."""
+    """The run-time-flag kernels compute exactly what the specialized ones do."""
     data = annotate("specialization", specialization, specialization.run(quick=True), True)
     json.dumps(data, allow_nan=False)
-    assert set(data["cases"]) == set(specialization.CASES)
-    for case in data["cases"].values():
-        assert case["identical_outputs"] and case["rows"] > 0
+    assert set(data["candidates"]) == set(specialization.QUICK)
+    for cand in data["candidates"].values():
+        assert len(cand["families"]) == 2
+        for case in cand["families"].values():
+            assert case["identical_outputs"] and case["rows"] > 0
     specialization.plot(data, tmp_path / "s.png")
     assert (tmp_path / "s.png").stat().st_size > 0
 

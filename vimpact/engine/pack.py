@@ -56,12 +56,16 @@ def element_arrays(cols: SceneColumns, numerics: Numerics, spec: KernelSpec) -> 
 
     ``tau0`` dashpot time, ``g``/``tau`` the arms (``(n, max_arms)``, the real
     arms of a row first, ``n_arms`` of them), ``kappa``, ``mu_t`` contact-point
-    mass factor, ``mu`` friction in tangential units (``mu v_z0 / |v_c0|``),
+    mass factor, ``mu`` friction in tangential units (``mu v_z0 / |v_c0|``; ``inf``
+    for a spec without friction),
     ``h`` step, ``n_elem``/``dxi`` the half row, ``max_steps`` the time limit.
     """
     g, tau, n_arms = arm_arrays(cols, spec.arms)
-    with np.errstate(divide="ignore"):
-        mu = np.where(np.isfinite(cols.mu), cols.mu * cols.v_z0 / np.abs(cols.v_c0), np.inf)
+    if spec.friction:
+        with np.errstate(divide="ignore"):
+            mu = np.where(np.isfinite(cols.mu), cols.mu * cols.v_z0 / np.abs(cols.v_c0), np.inf)
+    else:  # full stick (a finite mu of these rows is below rounding: routing.friction_rows);
+        mu = np.full(len(cols), np.inf)  # a kernel that takes friction from the row sticks
     a = {
         "tau0": cols.dashpot_time / cols.T,
         "g": g,

@@ -9,7 +9,8 @@ A scene names its effects (tangential problem or not, rotation, rheology);
 - ``elements``: the MDR element kernel, compiled for exactly the scene's
   effects (:class:`vimpact.kernels.elements.KernelSpec`): no tangential state
   without a tangential problem, no arm variables without Maxwell arms, no
-  dashpot term without a dashpot.
+  dashpot term without a dashpot (friction and full stick share a kernel
+  that skips the slip work of a row with ``mu = inf``).
 
 ``Path.reasons`` says why, in words (``vimpact simulate --explain``).
 """

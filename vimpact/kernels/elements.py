@@ -46,12 +46,19 @@ Integrators (the value of ``integrator``):
     stress over its ramp; the force that decides whether an element still
     pushes at the step end takes the arms' damping part at the end velocity.
 
-Compile-time specialization: the impact body :func:`_impact` takes
-the scene's effects as its first arguments (``tangential``, ``memory``,
-``integrator``, ``arms``, ``dashpot``) and is inlined into a batch kernel
-built by :func:`element_kernel` for one :class:`KernelSpec`, where these are
-closure constants: LLVM folds the branches away, so a normal-only
-Kelvin-Voigt kernel carries no tangential and no arm code at all.
+Compile-time specialization: the impact body :func:`_impact` reads the
+effects (``TANGENTIAL``, ``MEMORY``, ``INTEGRATOR``, ``ARMS``, ``DASHPOT``,
+``FRICTION``) as globals, and each kernel (:func:`impact_kernel`, and
+:func:`batch_kernel` around it) is a copy of that body whose globals hold its
+own values: numba reads them as constants and drops the branches they switch
+off before typing, so a normal-only Kelvin-Voigt kernel carries no tangential
+and no arm code at all. (Inlining one body into a wrapper per kernel instead
+costs most of the compile: numba copies an inlined body's IR block by block,
+each block with the whole scope.) Friction is read from the row instead where
+the tangential problem has incremental memory (:func:`kernel_effects`; a stick
+row carries ``mu = inf``), and takes the same statements as in a kernel
+compiled for its value; vimpact/bench/specialization.py measures what each
+effect costs as a run-time flag.
 """
 
 from __future__ import annotations
@@ -141,31 +148,28 @@ def _path_in_cone(L0, L1, C0, C1, alpha):
     return ts * L0 + 0.5 * ts * ts * dL + sg * 0.5 * (C0 + ts * dC) * (alpha - ts)
 
 
-@jit(inline="always")
-def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT, FRICTION,
-            tau0, g, tau, kappa, mu_t, mu_k, h, n_elem, dxi, max_steps, rec, rec_every, out):
+def _impact(tau0, g, tau, kappa, mu_t, mu_k, h, n_elem, dxi, max_steps, rec, rec_every, out):
     """Advance one impact to its end and write the results into ``out``.
 
-    The first five arguments are the compile-time effects (constants in the
-    kernels built by :func:`element_kernel`); the others are kernel-unit
-    inputs (module docstring).
+    The body of every element kernel, never compiled as it stands: :func:`_bind`
+    gives each kernel a copy whose globals hold its effects (:func:`_effects`;
+    ``TANGENTIAL``, ``MEMORY``, ``INTEGRATOR``, ``ARMS``, ``DASHPOT``,
+    ``FRICTION`` and the derived ``IMPLICIT``, ``PARTIAL``, ``NCORR``). numba
+    reads a global as a constant and drops the branches it switches off before
+    typing, so a kernel carries no code of an effect it lacks. ``FRICTION``
+    may be :data:`RUNTIME`: the row's ``mu_k`` decides (``inf``: full stick,
+    the same statements as a kernel compiled without friction); so may
+    ``DASHPOT`` (the row's ``tau0 > 0``, and ``NCORR`` with it). The arguments
+    are kernel-unit inputs (module docstring).
 
     Parameters
     ----------
-    TANGENTIAL : advance the tangential problem (False: normal only, or ``v_c0 = 0``)
-    MEMORY : 0 incremental (Maw-Barber-Fawcett), 1 seed (thesis eq. 4.16)
-    INTEGRATOR : ``EULER``, ``SYMPLECTIC_EULER`` or ``VERLET``
-    ARMS : the material has Maxwell arms (``g``, ``tau`` non-empty)
-    DASHPOT : the material has a parallel dashpot (``tau0 > 0``)
-    FRICTION : Coulomb friction: every element in contact keeps
-        ``|f_t| <= mu f_n`` (docs/physics.md#coulomb-friction); needs ``TANGENTIAL`` and
-        incremental memory
     tau0 : parallel dashpot time ``eta0 / (G_inf T)``
     g, tau : arm moduli ``G_i / G_inf`` and times ``tau_i / T`` (1-D, equal length)
     kappa : ``c_t / c_n``
     mu_t : inverse effective tangential mass times m: ``1 + m R^2 / Theta``
-    mu_k : friction coefficient in kernel units, ``mu v_z0 / |v_c0|`` (read
-        only with ``FRICTION``; ``inf`` sticks)
+    mu_k : friction coefficient in kernel units, ``mu v_z0 / |v_c0|`` (``inf``
+        sticks; read only by a kernel with friction)
     h : time step / T
     n_elem, dxi : elements in the half row and their spacing / a_H
     max_steps : time limit in steps
@@ -173,23 +177,33 @@ def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT, FRICTION,
     rec_every : record every this many steps (ignored without rows)
     out : (N_OUT,) result row
     """
+    # Coulomb friction: every element in contact keeps |f_t| <= mu f_n
+    # (docs/physics.md#coulomb-friction); a constant of the kernel, or the row's mu
+    FRIC = FRICTION == 1 if FRICTION != RUNTIME else mu_k < math.inf
+    # the parallel dashpot: a constant of the kernel, or the row's (tau0 > 0), and
+    # with it NCOR, the partial-contact weighting of the normal force (NCORR below)
+    DASH = DASHPOT == 1 if DASHPOT != RUNTIME else tau0 > 0.0
+    NCOR = NCORR == 1 if NCORR != RUNTIME else DASH
     n_arms = g.shape[0] if ARMS else 0
-    E, omE, phi = arm_coefficients(tau, h)
     G = 0.0
     sum_gphi = 0.0
-    for i in range(n_arms):
-        G += g[i]
-        sum_gphi += g[i] * phi[i]
-    c0 = tau0 if DASHPOT else 0.0
+    ca = 0.0
+    if ARMS:  # (a kernel without arms compiles none of the arm helpers)
+        E, omE, phi = arm_coefficients(tau, h)
+        for i in range(n_arms):
+            G += g[i]
+            sum_gphi += g[i] * phi[i]
+        # Verlet: each arm's step impulse is exact for the drift path; its first half
+        # takes the arm stresses weighted by kap and the damping ca implicitly in the
+        # half-step velocity, like the dashpot (arm_implicit_coefficients), so arms
+        # faster than the step stay second order and stable (IMPLICIT: Verlet with arms)
+        kap, ca = arm_implicit_coefficients(g[:n_arms], tau[:n_arms], h)
+    else:
+        E = omE = phi = kap = tau[:0]
+    c0 = tau0 if DASH else 0.0
     tau0_h = c0 / h
     den_free = tau0_h + 1.0 + G - sum_gphi
-    decay0 = math.exp(-h / c0) if DASHPOT else 0.0
-    # Verlet: each arm's step impulse is exact for the drift path; its first half
-    # takes the arm stresses weighted by kap and the damping ca implicitly in the
-    # half-step velocity, like the dashpot (arm_implicit_coefficients), so arms
-    # faster than the step stay second order and stable
-    IMPLICIT = INTEGRATOR == VERLET and ARMS
-    kap, ca = arm_implicit_coefficients(g[:n_arms], tau[:n_arms], h)
+    decay0 = math.exp(-h / c0) if DASH else 0.0
     # the arms' end stress on the straight drift path misses the path's curvature:
     # on w0 + v t + a t^2 / 2 it is larger by sum g tau (1 + E - 2 (1 - E) / x) a h / 2,
     # which is ca (ve - v_test): the force that decides whether an element still
@@ -211,7 +225,6 @@ def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT, FRICTION,
     # last normal force (Verlet: its spring part) of each element in contact / k_el
     f = np.zeros(n_elem)
     fs = np.zeros(n_elem if IMPLICIT else 0)  # ... its start-of-step form (IMPLICIT)
-    FRIC = FRICTION and TANGENTIAL
     n_af = n_arms if FRIC else 0
     p_save = np.empty(n_af)  # arms of a slip candidate before the stick trial
     E_e = np.empty(n_af)  # arm coefficients over the in-contact part of an entering step
@@ -219,11 +232,10 @@ def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT, FRICTION,
     phi_e = np.empty(n_af)
     Cs = 0.0  # slipping elements: tangential force per unit normal velocity (mu f_n's dashpot)
     t_gross = 0.0
-    PARTIAL = INTEGRATOR == VERLET  # weigh partial contact within a step (see below)
-    # ... in the normal force only where it jumps at entry: the dashpot (else the
-    # force is continuous at entry and exit, and the elastic Verlet impact stays
-    # time reversible: e_z = 1 to rounding)
-    NCORR = PARTIAL and (DASHPOT or ARMS)  # (an arm faster than the step acts as a dashpot)
+    # PARTIAL (Verlet): weigh partial contact within a step (see below); NCORR: ...
+    # in the normal force only where it jumps at entry: the dashpot or an arm (else
+    # the force is continuous at entry and exit, and the elastic Verlet impact stays
+    # time reversible: e_z = 1 to rounding; an arm faster than the step acts as a dashpot)
     # last step's position part of each element's tangential force (/ k_el kappa)
     # and, with friction, its slip direction (0: sticking)
     ftp = np.zeros(n_t if PARTIAL else 0)
@@ -275,7 +287,7 @@ def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT, FRICTION,
             Ft_pos = Ft_s if IMPLICIT else Ft_el
             if FRIC and IMPLICIT:  # slipping: mu times the normal force as the kick takes it
                 Ft_pos = Ft_pos + Css * v_test
-            elif FRIC and DASHPOT:  # slipping elements: mu times their normal force, whose
+            elif FRIC and DASH:  # slipping elements: mu times their normal force, whose
                 # dashpot part takes this step's normal velocity (as the normal kick)
                 Ft_pos = Ft_pos + Cs * (v if INTEGRATOR == EULER else v_test)
             if INTEGRATOR == EULER:
@@ -381,7 +393,7 @@ def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT, FRICTION,
                             alpha = 1.0
                         else:
                             alpha = T0 / (T0 - T1)
-                        if NCORR:  # minus what the first half-kick applied
+                        if NCOR:  # minus what the first half-kick applied
                             if IMPLICIT:
                                 corr_n += alpha * T0 - (fs[j] + (c0 + ca) * v_test)
                             else:
@@ -395,7 +407,7 @@ def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT, FRICTION,
                             if IMPLICIT:
                                 T1t += cae * (vce - vc_test)
                             sg = fsgn[j] if FRIC else 0.0
-                            if sg != 0.0 and not NCORR:  # slipping: mu times the normal
+                            if sg != 0.0 and not NCOR:  # slipping: mu times the normal
                                 T0t = 0.0  # force, which takes no correction here
                                 A_t = 0.0
                                 T1t = 0.0
@@ -426,7 +438,7 @@ def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT, FRICTION,
                 contact[j] = False
                 continue
             entry_n = 0.0  # what the normal force over the entering part adds
-            if NCORR and not was_in:  # from f_entry to the end force over theta h
+            if NCOR and not was_in:  # from f_entry to the end force over theta h
                 if IMPLICIT:  # (the arms at their exact mean over it)
                     entry_n = (theta * (f_entry - fa_entry + w1 + c0 * ve + 2.0 * arm_mean)
                                - fj)
@@ -501,7 +513,7 @@ def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT, FRICTION,
                     else:
                         fol = _follow_over(s0, s1, p[j], g, tau, theta * h)
                 trial = s1 + fol
-                if DASHPOT:
+                if DASH:
                     trial += c0 * vc_test
                 cone = mu_k * fj / kappa  # element stress at the cone, tangential units
                 if mu_k == math.inf or abs(trial) <= cone:  # stick
@@ -543,7 +555,7 @@ def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT, FRICTION,
                     if PARTIAL:  # mu times the normal force, entering or not
                         ftp[j] = sgn * mu_k / kappa * r_end
                         fsgn[j] = sgn
-                        if NCORR and not was_in:
+                        if NCOR and not was_in:
                             corr_t += sgn * mu_k / kappa * entry_n
         if n_c == 0 and t_leave > 0.0:
             t_exit = t_leave  # the last elements left within this step
@@ -571,7 +583,7 @@ def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT, FRICTION,
         # ---- sphere: second half ----
         if INTEGRATOR == VERLET:
             v = v_test - 0.5 * h * (F_el1 + C1 * v_test + k_el * corr_n)
-            if FRIC and DASHPOT:
+            if FRIC and DASH:
                 vc = vc_test - 0.5 * h * mu_t * (Ft_el1 + Ct1 * vc_test + Cs1 * v_test
                                                  + k_el * kappa * corr_t)
             elif TANGENTIAL:
@@ -604,7 +616,7 @@ def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT, FRICTION,
         # ---- end of impact: no contact, moving away, no free surface can catch up ----
         if n_c == 0 and v < 0.0:
             caught = False
-            if DASHPOT or ARMS:  # an elastic surface is back at rest at once
+            if DASH or ARMS:  # an elastic surface is back at rest at once
                 for j in range(active):
                     if _free_rate(w[j], q[j], g, tau, c0) < v * (1.0 + 1e-9):
                         caught = True
@@ -630,7 +642,7 @@ def _impact(TANGENTIAL, MEMORY, INTEGRATOR, ARMS, DASHPOT, FRICTION,
 
 
 class KernelSpec(NamedTuple):
-    """The compile-time effects of an element kernel (one compiled kernel each).
+    """The effects of the rows an element kernel runs (routing groups rows by it).
 
     Attributes
     ----------
@@ -641,7 +653,9 @@ class KernelSpec(NamedTuple):
     dashpot : the material has a parallel dashpot; with ``arms`` it also selects how
         an element in contact for part of a step is weighted, so a kernel must only
         run rows whose dashpot and arms match its flags (routing groups rows that way)
-    friction : Coulomb friction (finite ``mu``); ``False`` is full stick
+    friction : Coulomb friction (finite ``mu``); ``False`` is full stick. Not a
+        compile-time effect where the tangential problem has incremental memory:
+        one kernel runs both, the stick rows with ``mu = inf`` (:func:`kernel_effects`)
     """
 
     integrator: int
@@ -652,8 +666,37 @@ class KernelSpec(NamedTuple):
     friction: bool = False
 
 
-def _constants(spec: KernelSpec) -> tuple[int, bool, int, bool, bool, bool]:
-    """Return the effects of ``spec`` as plain Python constants (checked)."""
+#: value of ``FRICTION`` (or ``DASHPOT``) in the compiled effects of a kernel that
+#: reads the effect from the row (``mu_k < inf``, ``tau0 > 0``) instead of compiling
+#: it in or out
+RUNTIME = -1
+
+# The effects the impact body reads as globals (:func:`_impact`). Each kernel runs a
+# copy of the body whose globals hold its own values (:func:`_bind`); the module's
+# values here are placeholders for the linters, never compiled.
+TANGENTIAL = False
+MEMORY = 0
+INTEGRATOR = VERLET
+ARMS = False
+DASHPOT: int = 0
+FRICTION: int = 0
+IMPLICIT = False
+PARTIAL = False
+NCORR: int = 0
+
+
+def kernel_effects(spec: KernelSpec) -> tuple[int, bool, int, bool, int, int]:
+    """Return the compiled effects of the kernel that runs the rows of ``spec`` (checked).
+
+    ``(integrator, tangential, memory, arms, dashpot, friction)`` as plain Python
+    constants: ``memory`` 0 without a tangential problem, ``friction``
+    :data:`RUNTIME` with incremental tangential memory (friction and full stick
+    share that kernel: its friction rows run as fast as on a kernel compiled with
+    friction, its stick rows 0-20 % slower than without, and those rows take the
+    continuum kernel unless it is switched off). The others stay compiled in
+    (vimpact/bench/specialization.py measures what each would cost at run time;
+    the dashpot would cost 3-13 %).
+    """
     integrator, tangential, memory = int(spec.integrator), bool(spec.tangential), int(spec.memory)
     arms, dashpot, friction = bool(spec.arms), bool(spec.dashpot), bool(spec.friction)
     if friction and tangential and memory != 0:
@@ -661,82 +704,126 @@ def _constants(spec: KernelSpec) -> tuple[int, bool, int, bool, bool, bool]:
                          "friction needs incremental memory (0); the seed memory sets every "
                          "element to the total contact-point displacement, which slip cannot "
                          "change")
-    return integrator, tangential, memory, arms, dashpot, friction
+    if not tangential:
+        return integrator, False, 0, arms, int(dashpot), 0
+    return integrator, True, memory, arms, int(dashpot), RUNTIME if memory == 0 else 0
+
+
+def _effects(key: tuple) -> dict:
+    """Return the globals of the impact body for the compiled effects ``key``.
+
+    ``key`` as :func:`kernel_effects` returns it; ``dashpot`` and ``friction`` 0, 1
+    or :data:`RUNTIME`.
+    """
+    integrator, tangential, memory, arms, dashpot, friction = key
+    if friction != 0 and not (tangential and memory == 0):
+        raise ValueError(f"compiled effects {key}: friction needs the tangential problem with "
+                         "incremental memory")
+    partial = integrator == VERLET  # Verlet weighs partial contact within a step
+    # ... in the normal force with a dashpot or arms (the row's dashpot decides only
+    # for a Verlet kernel without arms)
+    ncorr = (RUNTIME if dashpot == RUNTIME and partial and not arms
+             else int(partial and (arms or dashpot == 1)))
+    return {"TANGENTIAL": tangential, "MEMORY": memory, "INTEGRATOR": integrator, "ARMS": arms,
+            "DASHPOT": int(dashpot), "FRICTION": int(friction), "IMPLICIT": partial and arms,
+            "PARTIAL": partial, "NCORR": ncorr}
+
+
+def _tag(key: tuple) -> str:
+    """Name the compiled effects ``key`` (part of a kernel's qualified name)."""
+    integrator, tangential, memory, arms, dashpot, friction = key
+    dash, fric = ("R" if x == RUNTIME else str(int(x)) for x in (dashpot, friction))
+    return (f"integrator{integrator}_tangential{int(tangential)}_memory{memory}"
+            f"_arms{int(arms)}_dashpot{dash}_friction{fric}")
+
+
+def _bind(key: tuple):
+    """Return a copy of the impact body (:func:`_impact`) with the effects ``key`` as globals."""
+    body = types.FunctionType(_impact.__code__, {**globals(), **_effects(key)}, "element_impact")
+    body.__qualname__ = body.__name__
+    return _named(body, key)
 
 
 @functools.cache
+def impact_kernel(key: tuple):
+    """Return the serial one-impact kernel of the compiled effects ``key`` (compiled on first use).
+
+    ``key`` as :func:`kernel_effects` returns it, or with ``friction`` fixed at 0 or 1
+    (the specialized kernels vimpact/bench/specialization.py compares with).
+    """
+    return jit()(_bind(key))
+
+
 def element_impact(spec: KernelSpec):
-    """Return the serial one-impact kernel specialized for ``spec`` (compiled on first use, cached).
+    """Return the serial one-impact kernel for the rows of ``spec`` (compiled on first use, cached).
 
     Signature: ``impact(tau0, g, tau, kappa, mu_t, mu, h, n_elem, dxi, max_steps,
     rec, rec_every, out)``, the scalars and arrays of one row of
     :func:`element_kernel` (``g``, ``tau`` only the row's real arms, ``rec``
-    ``(n_rec, N_REC)``, ``out`` ``(N_OUT,)``); writes exactly what the batch
-    kernel writes for that row. A single scene runs it instead of the parallel
-    batch kernel, whose cold compile costs more (the parallel launch around
-    the same inlined impact).
+    ``(n_rec, N_REC)``, ``out`` ``(N_OUT,)``; ``mu`` ``inf`` for a row of a
+    spec without friction); writes exactly what the batch kernel writes for
+    that row. A single scene runs it instead of the parallel batch kernel,
+    whose cold compile costs more (the parallel launch around the same impact).
     """
-    integrator, tangential, memory, arms, dashpot, friction = _constants(spec)
-
-    def impact(tau0, g, tau, kappa, mu_t, mu, h, n_elem, dxi, max_steps, rec, rec_every, out):
-        _impact(tangential, memory, integrator, arms, dashpot, friction, tau0, g, tau, kappa,
-                mu_t, mu, h, n_elem, dxi, max_steps, rec, rec_every, out)
-
-    return jit()(_named_for(impact, spec))
+    return impact_kernel(kernel_effects(spec))
 
 
-@functools.cache
 def element_kernel(spec: KernelSpec):
-    """Return the batch kernel specialized for ``spec`` (compiled on first use, cached on disk).
+    """Return the batch kernel for the rows of ``spec`` (compiled on first use, cached on disk).
 
     Signature: ``run(tau0, g, tau, n_arms, kappa, mu_t, mu, h, n_elem, dxi,
     max_steps, rec, rec_every, out)`` with per-set arrays of length ``n``
     (``g``, ``tau`` padded to ``(n, max_arms)``; ``h``, ``n_elem``, ``dxi``
     per set; ``mu`` the friction coefficient in tangential kernel units,
-    ``mu v_z0 / |v_c0|``, read only by kernels with ``spec.friction``), shared ``rec_every``,
+    ``mu v_z0 / |v_c0|``, ``inf`` for a spec without friction), shared ``rec_every``,
     a trajectory buffer ``rec`` of shape
     ``(n, n_rec, N_REC)`` (``n_rec`` may be 0) and ``out`` of shape
     ``(n, N_OUT)``. ``prange`` runs over the parameter sets; each writes its
     own row.
     """
-    # the prange body calls the serial kernel of the same spec (compiled once, shared
+    return batch_kernel(kernel_effects(spec))
+
+
+@functools.cache
+def batch_kernel(key: tuple):
+    """Return the parallel batch kernel of the compiled effects ``key`` (:func:`element_kernel`)."""
+    # the prange body calls the serial kernel of the same effects (compiled once, shared
     # with single scenes) instead of inlining the impact a second time. It is a global
     # of this copy of the batch function, not a closure cell: numba keys a closure's
     # cache entry on its pickled cells, and a dispatcher pickles with a random id per
-    # process (the batch would never load from the cache); the spec's constants are
-    # the one cell, so each spec has its own cache entry.
-    template = _batch_template(_constants(spec))
-    run = types.FunctionType(template.__code__, {**globals(), "_spec_impact": element_impact(spec)},
+    # process (the batch would never load from the cache); the effects are
+    # the one cell, so each has its own cache entry.
+    template = _batch_template(key)
+    run = types.FunctionType(template.__code__, {**globals(), "_spec_impact": impact_kernel(key)},
                              template.__name__, None, template.__closure__)
-    return jit(parallel=True)(_named_for(run, spec))
+    return jit(parallel=True)(_named(run, key))
 
 
-def _named_for(function, spec: KernelSpec):
-    """Return ``function`` with a qualified name that names the effects of ``spec``.
+def _named(function, key: tuple):
+    """Return ``function`` with a qualified name that names the compiled effects ``key``.
 
     numba names a compiled function's machine-code symbol after its qualified name
-    and a counter that restarts in every process. Every specialization of a
-    factory shares one qualified name, so a kernel compiled now and a batch loaded
-    from the on-disk cache (compiled in another process, where its callee got the
-    same count) could define the same symbol with different code, and the batch
-    would run the wrong specialization's impact. A name per spec keeps the symbols
-    of different specializations apart (and gives each its own cache index).
+    and a counter that restarts in every process, and keys its on-disk cache on
+    the qualified name (not on the globals that hold a kernel's effects). Every
+    kernel made from one body shares one qualified name, so a kernel compiled now
+    and a batch loaded from the on-disk cache (compiled in another process, where
+    its callee got the same count) could define the same symbol with different
+    code, and the batch would run the wrong kernel's impact. A name per key keeps
+    the symbols and cache entries of different kernels apart.
     """
-    integrator, tangential, memory, arms, dashpot, friction = _constants(spec)
-    tag = (f"integrator{integrator}_tangential{int(tangential)}_memory{memory}"
-           f"_arms{int(arms)}_dashpot{int(dashpot)}_friction{int(friction)}")
+    tag = _tag(key)
     function.__qualname__ = f"{function.__qualname__}_{tag}"
     function.__name__ = f"{function.__name__}_{tag}"
     return function
 
 
 #: the impact a batch loop calls: not bound here (a declaration for the type checker);
-#: :func:`element_kernel` binds it per specialization in the loop's globals
+#: :func:`batch_kernel` binds it per kernel in the loop's globals
 _spec_impact: Callable[..., None]
 
 
 def _batch_template(key: tuple):
-    """Return the batch loop over ``_spec_impact`` (bound by :func:`element_kernel`), keyed by ``key``."""
+    """Return the batch loop over ``_spec_impact`` (bound by :func:`batch_kernel`), keyed by ``key``."""
 
     def run(tau0, g, tau, n_arms, kappa, mu_t, mu, h, n_elem, dxi, max_steps, rec, rec_every, out):
         if False:  # noqa: SIM108 - keeps key a cell of the function (its cache key), never run
