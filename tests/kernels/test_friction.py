@@ -67,6 +67,9 @@ ALL = [slow_unless(r) for r in RHEOLOGIES]
 
 @pytest.mark.parametrize("rheology", ALL)
 def test_mu_inf_is_stick_bit_for_bit(rheology):
+    # a stick spec and mu = inf run the one shared kernel: this checks the routing and that
+    # mu = inf never slips; the kernel compiled without friction is compared with it in
+    # tests/kernels/test_kernel_effects.py
     stick, rec_s = run(rheology, friction=False, n_rec=40, rec_every=10)
     fric, rec_f = run(rheology, mu=math.inf, n_rec=40, rec_every=10)
     assert np.array_equal(stick, fric)

@@ -30,6 +30,7 @@ from vimpact.kernels.elements import (
     impact_kernel,
     kernel_effects,
 )
+from vimpact.kernels.layout import OUT_T_CONTACT
 
 
 def test_shared_kernels():
@@ -79,6 +80,22 @@ def _run(kernel, row):
     rec = np.zeros((30, N_REC))
     kernel(*row, rec, np.int64(11), out)
     return out, rec
+
+
+def test_stick_rows_of_the_shared_kernel_are_the_stick_kernel_bit_for_bit():
+    """The default run's share of the slow comparison below: one kernel compiled without
+    friction (elastic, Verlet: the cheapest to compile) against the package's shared
+    kernel on stick rows (``mu = inf``), trajectories included."""
+    rng = np.random.default_rng(7)
+    shared = element_impact(KernelSpec(VERLET, True, 0, False, False, False))
+    special = impact_kernel((VERLET, True, 0, False, 0, 0))
+    assert shared is not special
+    for row in _rows(rng, 4, False, False, False):
+        out_s, rec_s = _run(special, row)
+        out_r, rec_r = _run(shared, row)
+        assert out_s[OUT_T_CONTACT] > 0.0  # an impact ran, not an untouched row
+        np.testing.assert_array_equal(out_r, out_s)
+        np.testing.assert_array_equal(rec_r, rec_s)
 
 
 @pytest.mark.slow
