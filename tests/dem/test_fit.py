@@ -131,3 +131,58 @@ def test_tangential_grid_search_recovers_known_lammps_constants(ln_k, ln_x):
     z = grid_search(lambda z: np.mean((beta(z[:, :1], z[:, 1:]) - target) ** 2, axis=1),
                     SEARCH_START, SEARCH_HALF_WIDTH, (-5.0, math.log(1e-6)), (5.0, math.log(1e12)))
     assert z == pytest.approx([ln_k, ln_x], abs=0.01)
+
+
+def test_lockstep_tangential_searches_equal_the_searches_one_by_one():
+    """Two contacts with different mass factors ``F``, friction ``mu`` and known constants,
+    searched in lockstep (:func:`grid_search_many`, one stepped call per round over both
+    contacts' candidates, per-point ``F`` and ``mu``) end exactly where :func:`grid_search`
+    ends for each alone (scalar ``F``, ``mu``): the stepped law is elementwise, and a search
+    that has stopped drops out without moving the other."""
+    import math
+
+    from vimpact.dem.fit import grid_search, grid_search_many
+    from vimpact.dem.lammps import FIT_STEPS, SEARCH_HALF_WIDTH, SEARCH_START
+
+    alpha = np.array([1e-4, 3e-4, 1e-3, 3e-3])  # A v0 / d_H at four speeds
+    kappa0 = 0.6
+    contacts = [  # (F, mu, w0, known (ln k, ln x)): a solid sphere at 45 deg; a hollow one
+        (3.5, 0.5, np.ones(4), (-0.2, -0.58)),
+        (2.5, 0.3, np.tan(np.radians([15.0, 30.0, 45.0, 60.0])), (0.5, 2.0)),
+    ]
+
+    def beta(k, ln_kappa, ln_gamma):
+        F, mu, w0, _ = contacts[k]
+        return laws.hertz_mindlin_coulomb(alpha, kappa0 * np.exp(ln_kappa), np.exp(ln_gamma),
+                                          F, mu, w0, FIT_STEPS)[1]
+
+    targets = [beta(k, *contacts[k][3]) for k in range(2)]
+    bounds = (-5.0, math.log(1e-6)), (5.0, math.log(1e12))
+    alone = [grid_search(lambda z, k=k: np.mean((beta(k, z[:, :1], z[:, 1:]) - targets[k]) ** 2,
+                                                axis=1), SEARCH_START, SEARCH_HALF_WIDTH, *bounds)
+             for k in range(2)]
+
+    rounds = [0, 0]
+
+    def costs(grids):
+        args = []
+        for k, z in grids:
+            rounds[k] += 1
+            F, mu, w0, _ = contacts[k]
+            args.append(np.broadcast_arrays(alpha, kappa0 * np.exp(z[:, :1]), np.exp(z[:, 1:]),
+                                            F, mu, w0))
+        b = laws.hertz_mindlin_coulomb(*(np.concatenate([a[i].ravel() for a in args])
+                                         for i in range(6)), steps=FIT_STEPS)[1]
+        out, start = [], 0
+        for (k, _), a in zip(grids, args):
+            out.append(np.mean((b[start:start + a[0].size].reshape(a[0].shape) - targets[k]) ** 2,
+                               axis=1))
+            start += a[0].size
+        return out
+
+    together = grid_search_many(costs, [SEARCH_START] * 2, [SEARCH_HALF_WIDTH] * 2,
+                                [bounds[0]] * 2, [bounds[1]] * 2)
+    for k in range(2):
+        np.testing.assert_array_equal(together[k], alone[k])
+        assert alone[k] == pytest.approx(contacts[k][3], abs=0.01)
+    assert rounds[0] != rounds[1]  # one search dropped out while the other ran on

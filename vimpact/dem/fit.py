@@ -339,7 +339,8 @@ def grid_search(cost, start, half_width, lower, upper, xatol: float = 5e-4, n: i
     parameter (up to 4 times the first: the minimum lies further out). Shrinking after
     every move instead crawls along a curved valley of the cost by ever smaller steps
     and stops far from its bottom. Stops when the spacing is below ``xatol`` in both
-    parameters, or after ``max_rounds`` rounds.
+    parameters, or after ``max_rounds`` rounds. The one-search case of
+    :func:`grid_search_many`.
 
     Parameters
     ----------
@@ -352,24 +353,55 @@ def grid_search(cost, start, half_width, lower, upper, xatol: float = 5e-4, n: i
     -------
     the best candidate, shape ``(2,)``
     """
-    c = np.asarray(start, dtype=float)
-    h = np.asarray(half_width, dtype=float)
-    lo, hi = np.asarray(lower, dtype=float), np.asarray(upper, dtype=float)
+    return grid_search_many(lambda grids: [cost(grids[0][1])], [start], [half_width], [lower],
+                            [upper], xatol, n, max_rounds)[0]
+
+
+def grid_search_many(costs, starts, half_widths, lowers, uppers, xatol: float = 5e-4,
+                     n: int = 7, max_rounds: int = 40) -> list[np.ndarray]:
+    """Run several :func:`grid_search` searches in lockstep, every round's grids in one call.
+
+    Each search follows :func:`grid_search`'s rule on its own (its decisions depend
+    only on its own costs); a search that has stopped drops out of the later rounds.
+
+    Parameters
+    ----------
+    costs : list of ``(search index, (k_i, 2) candidates)`` of the searches still
+        running -> list of their ``(k_i,)`` costs, in the same order
+    starts, half_widths, lowers, uppers : one pair of numbers per search (the
+        parameters' units)
+    xatol, n, max_rounds : as in :func:`grid_search`
+
+    Returns
+    -------
+    the best candidate of each search, shape ``(2,)`` each
+    """
+    c = [np.asarray(a, dtype=float) for a in starts]
+    h = [np.asarray(a, dtype=float) for a in half_widths]
+    lo = [np.asarray(a, dtype=float) for a in lowers]
+    hi = [np.asarray(a, dtype=float) for a in uppers]
     u = np.linspace(-1.0, 1.0, n)
-    h_max = 4.0 * h
+    h_max = [4.0 * a for a in h]
+    running = list(range(len(c)))
     for _ in range(max_rounds):
-        axes = [np.unique(np.clip(c[i] + h[i] * u, lo[i], hi[i])) for i in range(2)]
-        z = np.stack([g.ravel() for g in np.meshgrid(*axes, indexing="ij")], axis=1)
-        f = cost(z)
-        centre = int(np.argmin(np.abs(z - c).sum(axis=1)))  # the grid point at the centre
-        j = int(np.argmin(f))
-        if f[j] >= f[centre] * (1.0 - 1e-12):  # ties keep the centre: shrink around it
-            h = h * 2.0 / (n - 1)
-            if np.all(h < xatol):
-                break
-            continue
-        for i in range(2):  # an edge inside the bounds: the minimum lies further out
-            if axes[i].size > 1 and z[j, i] in (axes[i][0], axes[i][-1]) and lo[i] < z[j, i] < hi[i]:
-                h[i] = min(2.0 * h[i], h_max[i])
-        c = z[j]
+        if not running:
+            break
+        axes = {s: [np.unique(np.clip(c[s][i] + h[s][i] * u, lo[s][i], hi[s][i]))
+                    for i in range(2)] for s in running}
+        z = {s: np.stack([g.ravel() for g in np.meshgrid(*axes[s], indexing="ij")], axis=1)
+             for s in running}
+        f = dict(zip(running, costs([(s, z[s]) for s in running])))
+        for s in list(running):
+            centre = int(np.argmin(np.abs(z[s] - c[s]).sum(axis=1)))  # the grid point at the centre
+            j = int(np.argmin(f[s]))
+            if f[s][j] >= f[s][centre] * (1.0 - 1e-12):  # ties keep the centre: shrink around it
+                h[s] = h[s] * 2.0 / (n - 1)
+                if np.all(h[s] < xatol):
+                    running.remove(s)
+                continue
+            for i in range(2):  # an edge inside the bounds: the minimum lies further out
+                ax = axes[s][i]
+                if ax.size > 1 and z[s][j, i] in (ax[0], ax[-1]) and lo[s][i] < z[s][j, i] < hi[s][i]:
+                    h[s][i] = min(2.0 * h[s][i], h_max[s][i])
+            c[s] = z[s][j]
     return c

@@ -54,7 +54,7 @@ from vimpact.dem.fit import (
     Residual,
     Targets,
     fit_viscoelastic_hertz,
-    grid_search,
+    grid_search_many,
     viscoelastic_hertz_prediction,
 )
 from vimpact.dem.problem import Contact, DemProblem, ParticleType, WallType
@@ -94,20 +94,30 @@ def fit(problem: DemProblem, targets: dict[str, Targets]) -> list[ContactFit]:
     """Fit the damping constant ``A`` (s) per contact at the nominal sizes.
 
     The prediction at the other size levels includes LAMMPS' mass scaling of the
-    damping.
+    damping. In phases: the normal law of every contact; the tangential searches of
+    the contacts with friction, in lockstep (:func:`_search_oblique`); the rest per
+    contact.
     """
-    fits = []
+    normal = []
     for c in problem.contacts:
         t = targets[c.key]
         _, m_nom = c.nominal()
         A, _ = fit_viscoelastic_hertz(t.subset(t.nominal), c.E_star)
         e = viscoelastic_hertz_prediction(t, c.E_star, A, mass_factor=t.m / m_nom)
+        normal.append((c, t, A, e, contact_constants(c, A)))
+    oblique = []
+    for c, t, A, _, params in normal:
+        if t.beta_x is not None and t.oblique is not None:
+            oblique.append((c, t.oblique, A, params))
+    searched = {c.key: z for (c, *_), z in zip(oblique, _search_oblique(oblique))}
+    fits = []
+    for c, t, A, e, params in normal:
         notes = []
-        params = contact_constants(c, A)
         b = res_b = b_ob = None
         if t.beta_x is not None:
             k_relaxed = params["k_t"]
-            params["k_t"], params["x_gamma_t"], b = _fit_tangential(c, t, A, params)
+            params["k_t"], params["x_gamma_t"], b = _fit_tangential(c, t, A, params,
+                                                                    searched.get(c.key))
             res_b = Residual.of(b, t.beta_x)
             basis = "in full stick"
             if t.oblique is not None:
@@ -244,38 +254,80 @@ def oblique_beta(c: Contact, ob: Oblique, A: float, params: dict, k_t, x_gamma,
     points) and the contact's friction (the stepped law
     :func:`vimpact.dem.laws.hertz_mindlin_coulomb`).
     """
-    from vimpact.dem import laws, linear
+    from vimpact.dem import laws
 
-    alpha = A * ob.v / laws.hertz_overlap(c.E_star, ob.R, ob.m, ob.v)
-    mu = params["mu_s"]
-    return laws.hertz_mindlin_coulomb(alpha, k_t / (2.0 * params["E_star_Pa"]), x_gamma,
-                                      linear.mass_factor(c), mu, ob.w0,
+    alpha, kappa, x_gamma, F, mu, w0 = _oblique_law(c, ob, A, params, k_t, x_gamma)
+    return laws.hertz_mindlin_coulomb(alpha, kappa, x_gamma, F, mu, w0,
                                       steps or laws.FRICTION_STEPS)[1]
 
 
-def _fit_tangential(c: Contact, t: Targets, A: float, params: dict
-                    ) -> tuple[float, float, np.ndarray]:
+def _oblique_law(c: Contact, ob: Oblique, A: float, params: dict, k_t, x_gamma) -> tuple:
+    """Return the arguments of :func:`vimpact.dem.laws.hertz_mindlin_coulomb` for :func:`oblique_beta`.
+
+    ``(alpha, kappa, x_gamma, F, mu, w0)``: ``alpha``, ``w0`` per point of ``ob``;
+    ``kappa`` from ``k_t`` (Pa) and ``x_gamma`` as given (numbers or arrays of
+    candidates); ``F``, ``mu`` the contact's numbers.
+    """
+    from vimpact.dem import laws, linear
+
+    alpha = A * ob.v / laws.hertz_overlap(c.E_star, ob.R, ob.m, ob.v)
+    return (alpha, k_t / (2.0 * params["E_star_Pa"]), x_gamma, linear.mass_factor(c),
+            params["mu_s"], ob.w0)
+
+
+def _search_oblique(items: list[tuple[Contact, Oblique, float, dict]]) -> list[np.ndarray]:
+    """Search ``(ln(k_t / k_relaxed), ln x_gamma_t)`` of contacts with friction, in lockstep.
+
+    ``items``: ``(contact, oblique targets, A, params)`` per contact, ``params["k_t"]`` the
+    relaxed Mindlin stiffness (Pa). Every round of :func:`vimpact.dem.fit.grid_search_many`
+    steps the candidates of every running search at all their oblique points in one
+    call of :func:`vimpact.dem.laws.hertz_mindlin_coulomb` (per-point ``F`` and ``mu``);
+    each search's costs, and so its result, are those of its own search alone (the
+    stepped law is elementwise). Returns the best point of each search.
+    """
+    from vimpact.dem import laws
+
+    def costs(grids: list[tuple[int, np.ndarray]]) -> list[np.ndarray]:
+        parts = []
+        for i, z in grids:  # every candidate at every point, flattened, one contact after another
+            c, ob, A, params = items[i]
+            args = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in _oblique_law(
+                c, ob, A, params, params["k_t"] * np.exp(z[:, :1]), np.exp(z[:, 1:]))))
+            parts.append(args)
+        alpha, kappa, x_gamma, F, mu, w0 = (np.concatenate([a[k].ravel() for a in parts])
+                                            for k in range(6))
+        b = laws.hertz_mindlin_coulomb(alpha, kappa, x_gamma, F, mu, w0, FIT_STEPS)[1]
+        out, start = [], 0
+        for (i, _), args in zip(grids, parts):
+            shape = args[0].shape
+            piece = b[start:start + args[0].size].reshape(shape)
+            start += args[0].size
+            out.append(np.mean((piece - items[i][1].beta_x) ** 2, axis=1))
+        return out
+
+    n = len(items)
+    return grid_search_many(costs, [SEARCH_START] * n, [SEARCH_HALF_WIDTH] * n,
+                            [(-5.0, math.log(1e-6))] * n, [(5.0, math.log(1e12))] * n)
+
+
+def _fit_tangential(c: Contact, t: Targets, A: float, params: dict,
+                    z: np.ndarray | None = None) -> tuple[float, float, np.ndarray]:
     """Fit ``k_t`` (Pa) and ``x_gamma_t`` >= 0 to vimpact's ``beta_x`` (least RMS).
 
     Over the oblique impacts with the contact's friction when it has one (``t.oblique``), else in
     full stick at a few nominal speeds; starting from 0.74 x the relaxed Mindlin stiffness
     and ``x_gamma_t = 0.4``, near the fits of Kelvin-Voigt pairs (with friction: shrinking
-    grids in ``(ln(k_t / k_relaxed), ln x_gamma_t)``, :func:`vimpact.dem.fit.grid_search`, every
-    candidate of a grid stepped at once). Returns them and the law's full-stick ``beta`` at
-    every point of ``t``.
+    grids in ``(ln(k_t / k_relaxed), ln x_gamma_t)``, :func:`_search_oblique`, every
+    candidate of a grid stepped at once; ``z`` its result when already searched). Returns
+    them and the law's full-stick ``beta`` at every point of ``t``.
     """
     from scipy.optimize import minimize
 
     k0 = params["k_t"]
     ob = t.oblique
     if ob is not None:
-        def costs(z: np.ndarray) -> np.ndarray:  # every candidate in one stepped run
-            b = oblique_beta(c, ob, A, params, k0 * np.exp(z[:, :1]), np.exp(z[:, 1:]),
-                             steps=FIT_STEPS)
-            return np.mean((b - ob.beta_x) ** 2, axis=1)
-
-        z = grid_search(costs, SEARCH_START, SEARCH_HALF_WIDTH, (-5.0, math.log(1e-6)),
-                        (5.0, math.log(1e12)))
+        if z is None:
+            z = _search_oblique([(c, ob, A, params)])[0]
         k, x = k0 * math.exp(float(z[0])), math.exp(float(z[1]))
         return k, x, _tangential_beta(c, t, A, params, k, x)
     else:

@@ -227,7 +227,7 @@ def viscoelastic_hertz_mindlin(alpha: float, kappa: float, x_gamma: float, F: fl
 FRICTION_STEPS = 2000
 
 
-def hertz_mindlin_coulomb(alpha, kappa, x_gamma, F: float, mu: float, w0,
+def hertz_mindlin_coulomb(alpha, kappa, x_gamma, F, mu, w0,
                           steps: int = FRICTION_STEPS) -> tuple[np.ndarray, np.ndarray]:
     """Return the normal and tangential restitution of LAMMPS' Hertz-Mindlin law with friction.
 
@@ -249,7 +249,8 @@ def hertz_mindlin_coulomb(alpha, kappa, x_gamma, F: float, mu: float, w0,
     alpha, w0 : arrays (or numbers) of the same shape: ``A v0 / d_H`` and ``v_c0 / v_z0``
     kappa, x_gamma : as in :func:`viscoelastic_hertz_mindlin`; numbers, or arrays that
         broadcast with ``alpha`` (one candidate per point: a fit runs many at once)
-    F : as in :func:`viscoelastic_hertz_mindlin`; mu : Coulomb coefficient (``inf``: stick)
+    F : as in :func:`viscoelastic_hertz_mindlin`; mu : Coulomb coefficient (``inf``: stick);
+        numbers, or arrays that broadcast with ``alpha`` (points of several contacts at once)
     steps : steps per elastic Hertz contact time (``2.943 T``)
 
     Returns
@@ -258,8 +259,9 @@ def hertz_mindlin_coulomb(alpha, kappa, x_gamma, F: float, mu: float, w0,
     """
     alpha, w0, kappa, x_gamma = np.broadcast_arrays(
         *(np.asarray(a, dtype=float) for a in (alpha, w0, kappa, x_gamma)))
-    return _stepped(alpha, w0, mu, steps, _mindlin_force(kappa.ravel(), x_gamma.ravel()),
-                    float(F))
+    return _stepped(alpha, w0, mu if np.ndim(mu) else float(mu), steps,
+                    _mindlin_force(kappa.ravel(), x_gamma.ravel()),
+                    F if np.ndim(F) else float(F))
 
 
 def _mindlin_force(kappa: np.ndarray, x_gamma: np.ndarray):
@@ -278,7 +280,7 @@ def _mindlin_force(kappa: np.ndarray, x_gamma: np.ndarray):
     return force
 
 
-def mercury_mindlin_coulomb(alpha, K, D, F: float, mu: float, w0,
+def mercury_mindlin_coulomb(alpha, K, D, F, mu, w0,
                             steps: int = FRICTION_STEPS) -> tuple[np.ndarray, np.ndarray]:
     """Return the normal and tangential restitution of MercuryDPM's Hertz-Mindlin species.
 
@@ -296,7 +298,8 @@ def mercury_mindlin_coulomb(alpha, K, D, F: float, mu: float, w0,
     Parameters
     ----------
     alpha, D, w0 : arrays (or numbers) that broadcast; K : number or array like them (one
-        candidate per point: a fit runs many at once); F, mu : numbers
+        candidate per point: a fit runs many at once); F, mu : numbers, or arrays that
+        broadcast with ``alpha`` (points of several contacts at once)
 
     Returns
     -------
@@ -483,7 +486,7 @@ def _stepped_result(live: np.ndarray, e: np.ndarray, wend: np.ndarray, w0: np.nd
     return e.reshape(shape), (-wend / w0).reshape(shape)
 
 
-def _stepped(alpha: np.ndarray, w0: np.ndarray, mu: float, steps: int, force, F: float,
+def _stepped(alpha: np.ndarray, w0: np.ndarray, mu, steps: int, force, F,
              lever=None, contact_time: float = HERTZ_TIME_FACTOR) -> tuple[np.ndarray, np.ndarray]:
     """Step many oblique impacts with velocity Verlet until each contact ends; return ``(e, beta)``.
 
@@ -493,16 +496,20 @@ def _stepped(alpha: np.ndarray, w0: np.ndarray, mu: float, steps: int, force, F:
     acceleration and the tangential force per unit mass (positive decelerates) and the
     history after the friction cap. The centre moves by ``-a_t``, the spin (``R omega``)
     by ``arm (F - 1) a_t`` with the lever ``arm = 1 - lever x`` (``lever`` per point, or
-    0), and the contact point with ``w = u_x - arm R omega``.
+    0), and the contact point with ``w = u_x - arm R omega``. ``mu`` and ``F``: numbers, or
+    arrays that broadcast with ``alpha`` (per point; the force then gets ``mu`` per point).
     """
     alpha, w0 = np.broadcast_arrays(alpha, w0)
     shape = alpha.shape
     alpha, w0 = alpha.ravel().copy(), w0.ravel().copy()
     lev = (np.zeros_like(w0) if lever is None
            else np.broadcast_to(np.asarray(lever, dtype=float), shape).ravel())
-    spin = F - 1.0
+    spin = (np.broadcast_to(np.asarray(F, dtype=float), shape).ravel() - 1.0 if np.ndim(F)
+            else F - 1.0)
     h = contact_time / steps
-    cap = min(float(mu), 1e300)  # stick: the tangential force still ends with the normal one
+    # stick: the tangential force still ends with the normal one
+    cap = (np.minimum(np.broadcast_to(np.asarray(mu, dtype=float), shape).ravel(), 1e300)
+           if np.ndim(mu) else min(float(mu), 1e300))
     x = np.zeros_like(alpha)
     v = np.ones_like(alpha)
     s = np.zeros_like(alpha)

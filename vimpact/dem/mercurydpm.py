@@ -33,7 +33,7 @@ import math
 import numpy as np
 
 from vimpact.dem import laws, linear
-from vimpact.dem.fit import ContactFit, Residual, Targets, fit_viscoelastic_hertz, grid_search
+from vimpact.dem.fit import ContactFit, Residual, Targets, fit_viscoelastic_hertz, grid_search_many
 from vimpact.dem.problem import Contact, DemProblem
 
 CODE = "mercurydpm"
@@ -60,19 +60,27 @@ def mercury_beta(c: Contact, A: float, G, c_t, mu: float, v, R, m, w0,
     effective radius ``R`` (m) and mass ``m`` (kg), and ``w0 = v_c0 / v_z0`` (arrays;
     ``G`` and ``c_t`` numbers, or arrays of candidates that broadcast with them).
     """
-    E = c.E_star
-    d = laws.hertz_overlap(E, R, m, v)
-    D = c_t * np.sqrt(8.0 * G * m) * (R * d)**0.25 * v / (4.0 / 3.0 * E * np.sqrt(R) * d**1.5)
-    return laws.mercury_mindlin_coulomb(A * v / d, 4.0 * G / E, D, linear.mass_factor(c), mu, w0,
+    alpha, K, D, F, mu_, w0_ = _mercury_law(c, A, G, c_t, mu, v, R, m, w0)
+    return laws.mercury_mindlin_coulomb(alpha, K, D, F, mu_, w0_,
                                         steps or laws.FRICTION_STEPS)[1]
 
 
-def _fit_tangential(c: Contact, t: Targets, A: float, G0: float):
-    """Fit MercuryDPM's effective shear modulus (Pa) and sliding dissipation to ``beta_x``.
+def _mercury_law(c: Contact, A: float, G, c_t, mu: float, v, R, m, w0) -> tuple:
+    """Return the arguments ``(alpha, K, D, F, mu, w0)`` of :func:`vimpact.dem.laws.mercury_mindlin_coulomb`.
 
-    Closest to vimpact's ``beta_x`` in RMS, over the oblique impacts with the
-    contact's friction (``t.oblique``), else in full stick at a few nominal
-    speeds. Returns ``(G, c_t, beta at the fit points, target, basis)``.
+    For :func:`mercury_beta` (same parameters and units).
+    """
+    E = c.E_star
+    d = laws.hertz_overlap(E, R, m, v)
+    D = c_t * np.sqrt(8.0 * G * m) * (R * d)**0.25 * v / (4.0 / 3.0 * E * np.sqrt(R) * d**1.5)
+    return A * v / d, 4.0 * G / E, D, linear.mass_factor(c), mu, w0
+
+
+def _tangential_points(c: Contact, t: Targets) -> tuple:
+    """Return the points of the tangential fit of ``c``: ``(v, R, m, w0, target, mu)``.
+
+    The oblique impacts with the contact's friction (``t.oblique``), else full stick
+    at a few nominal speeds (``mu`` infinite); speeds in m/s, ``R`` in m, ``m`` in kg.
     """
     ob = t.oblique
     if ob is not None:
@@ -86,16 +94,56 @@ def _fit_tangential(c: Contact, t: Targets, A: float, G0: float):
                                  .round().astype(int))]
         v, R, m, target, mu = t.v[pick], t.R[pick], t.m[pick], t.beta_x[pick], math.inf
         w0 = np.ones_like(v)
+    return v, R, m, w0, target, mu
 
-    def costs(z: np.ndarray) -> np.ndarray:  # every candidate in one stepped run
-        b = mercury_beta(c, A, G0 * np.exp(z[:, :1]), np.exp(z[:, 1:]), mu, v, R, m, w0,
-                         FIT_STEPS)
-        return np.mean((b - target) ** 2, axis=1)
 
-    z = grid_search(costs, SEARCH_START, SEARCH_HALF_WIDTH, (-5.0, math.log(1e-6)),
-                    (5.0, math.log(1e6)))
+def _search_tangential(items: list[tuple[Contact, Targets, float, float]]) -> list[np.ndarray]:
+    """Search ``(ln(G / G0), ln c_t)`` of several contacts in lockstep.
+
+    ``items``: ``(contact, targets, A, G0)`` per contact (``A`` in s, ``G0`` the
+    relaxed shear modulus, Pa). Every round of :func:`vimpact.dem.fit.grid_search_many`
+    steps the candidates of every running search at all their points in one call of
+    :func:`vimpact.dem.laws.mercury_mindlin_coulomb` (per-point ``F`` and ``mu``); the
+    stepped law is elementwise, so each search's costs are those of its own search alone.
+    Returns the best point of each search.
+    """
+    points = [_tangential_points(c, t) for c, t, _, _ in items]
+
+    def costs(grids: list[tuple[int, np.ndarray]]) -> list[np.ndarray]:
+        parts = []
+        for i, z in grids:  # every candidate at every point, flattened, one contact after another
+            c, _, A, G0 = items[i]
+            v, R, m, w0, _, mu = points[i]
+            parts.append(np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in _mercury_law(
+                c, A, G0 * np.exp(z[:, :1]), np.exp(z[:, 1:]), mu, v, R, m, w0))))
+        alpha, K, D, F, mu, w0 = (np.concatenate([a[k].ravel() for a in parts])
+                                  for k in range(6))
+        b = laws.mercury_mindlin_coulomb(alpha, K, D, F, mu, w0, FIT_STEPS)[1]
+        out, start = [], 0
+        for (i, _), args in zip(grids, parts):
+            piece = b[start:start + args[0].size].reshape(args[0].shape)
+            start += args[0].size
+            out.append(np.mean((piece - points[i][4]) ** 2, axis=1))
+        return out
+
+    n = len(items)
+    return grid_search_many(costs, [SEARCH_START] * n, [SEARCH_HALF_WIDTH] * n,
+                            [(-5.0, math.log(1e-6))] * n, [(5.0, math.log(1e6))] * n)
+
+
+def _fit_tangential(c: Contact, t: Targets, A: float, G0: float, z: np.ndarray | None = None):
+    """Fit MercuryDPM's effective shear modulus (Pa) and sliding dissipation to ``beta_x``.
+
+    Closest to vimpact's ``beta_x`` in RMS, over the oblique impacts with the
+    contact's friction (``t.oblique``), else in full stick at a few nominal
+    speeds (:func:`_search_tangential`; ``z`` its result when already searched).
+    Returns ``(G, c_t, beta at the fit points, target, basis)``.
+    """
+    v, R, m, w0, target, mu = _tangential_points(c, t)
+    if z is None:
+        z = _search_tangential([(c, t, A, G0)])[0]
     G, c_t = G0 * math.exp(float(z[0])), math.exp(float(z[1]))
-    return G, c_t, mercury_beta(c, A, G, c_t, mu, v, R, m, w0), target, ob is not None
+    return G, c_t, mercury_beta(c, A, G, c_t, mu, v, R, m, w0), target, t.oblique is not None
 
 
 def fit(problem: DemProblem, targets: dict[str, Targets]) -> list[ContactFit]:
@@ -103,20 +151,27 @@ def fit(problem: DemProblem, targets: dict[str, Targets]) -> list[ContactFit]:
 
     The effective modulus is the pair's ``E*`` (Pa); the effective shear modulus
     (Pa) and sliding dissipation are fitted when vimpact's ``beta_x`` is among the
-    targets.
+    targets. In phases: the normal law of every contact; the tangential searches in
+    lockstep (:func:`_search_tangential`); the rest per contact.
     """
-    fits = []
+    normal = []
     for c in problem.contacts:
         t = targets[c.key]
         A, e = fit_viscoelastic_hertz(t, c.E_star)
         mat = c.material
         G0 = mat.G_inf / (2.0 - mat.nu)  # Mindlin: 8 G* a with G* of the pair's half-space
+        normal.append((c, t, A, e, G0))
+    tangential = [(c, t, A, G0) for c, t, A, _, G0 in normal
+                  if t.beta_x is not None or t.oblique is not None]
+    searched = {c.key: z for (c, *_), z in zip(tangential, _search_tangential(tangential))}
+    fits = []
+    for c, t, A, e, G0 in normal:
         params = {"effectiveElasticModulus": c.E_star, "dissipation": A,
                   "effectiveShearModulus": G0, "slidingDissipation": 0.0, "mu": c.mu}
         notes = []
         b = res_b = b_ob = None
         if t.beta_x is not None or t.oblique is not None:
-            G, c_t, b_fit, target, oblique = _fit_tangential(c, t, A, G0)
+            G, c_t, b_fit, target, oblique = _fit_tangential(c, t, A, G0, searched.get(c.key))
             params["effectiveShearModulus"], params["slidingDissipation"] = G, c_t
             res_b = Residual.of(b_fit, target)
             if oblique:
