@@ -107,7 +107,7 @@ def test_unpack_row_is_unpack_of_one_row():
             refused = (("too_costly", "a reason") if rng.random() < 0.03 else None)
             refused_col = np.full(1, None, dtype=object)
             refused_col[0] = refused
-            want = unpack(cols, out[i:i + 1], np.array(["p"], dtype=object),
+            want = unpack(cols, out[i:i + 1], Coded.encode(np.array(["p"], dtype=object)),
                           np.array([euler]), np.array([steps]), refused_col)
             got = unpack_row(cols, out[i], "p", euler, steps, refused)
             assert list(got) == list(RESULT_FIELDS)
@@ -141,8 +141,8 @@ def test_unpack_row_where_python_floats_raise():
     for scene in _scenes():
         cols = SceneColumns.from_scenes([scene])
         for row in rows:
-            want = unpack(cols, row[None, :], np.array(["p"], dtype=object), np.array([False]),
-                          np.array([50.0]), np.full(1, None, dtype=object))
+            want = unpack(cols, row[None, :], Coded.encode(np.array(["p"], dtype=object)),
+                          np.array([False]), np.array([50.0]), np.full(1, None, dtype=object))
             got = unpack_row(cols, row, "p", False, 50.0, None)
             for name in RESULT_FIELDS:
                 w = want[name][0]

@@ -12,6 +12,7 @@ import pytest
 import vimpact as v
 from tests.sweep import write
 from vimpact import cli
+from vimpact.engine.result import STATUS_CODE, STATUS_NAMES
 from vimpact.sweep import SweepInterrupted, load_spec, parts_dir, read_metadata, run_sweep, runner
 from vimpact.tableformat import schema
 
@@ -418,9 +419,9 @@ def test_nan_without_a_status_becomes_non_finite(tmp_path):
     cols = {"e_z": np.array([0.5, np.nan]), "e_x": np.array([np.nan, 0.1]),
             "beta_x": np.array([np.nan, 0.1])}
     cols.update({c: np.zeros(2) for c in schema.OUTPUTS if c not in cols})
-    status = np.array(["vc0_zero", "half_space"], dtype=object)
+    status = np.array([STATUS_CODE["vc0_zero"], STATUS_CODE["half_space"]], dtype=np.int8)
     error = np.array([None, None], dtype=object)
     runner.guard_nan(cols, status, error, np.array([True, False]), np.array([True, True]))
-    assert list(status) == ["vc0_zero", "non_finite"] and "e_z" in error[1]
+    assert [STATUS_NAMES[c] for c in status] == ["vc0_zero", "non_finite"] and "e_z" in error[1]
     assert error[0] is None and math.isnan(cols["t_contact_s"][1])
     assert spec.rows == 12 and dataclasses.asdict(spec.numerics)["steps"] == 100

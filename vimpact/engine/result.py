@@ -73,6 +73,18 @@ class Coded(NamedTuple):
         lookup[:-1] = self.names
         return lookup[self.codes]
 
+    def codes_in(self, names: list[str]) -> np.ndarray:
+        """Return the codes into ``names`` (``-1`` stays ``-1``), appending names it lacks.
+
+        For joining columns coded with their own names into one list of names.
+        """
+        lookup = np.full(len(self.names) + 1, -1, dtype=np.int16)  # the last entry: -1
+        for j, name in enumerate(self.names):
+            if name not in names:
+                names.append(name)
+            lookup[j] = names.index(name)
+        return lookup[self.codes]
+
     @classmethod
     def encode(cls, values: np.ndarray, names: tuple[str, ...] | None = None) -> Coded:
         """Return the object array ``values`` (``str`` or ``None``) as codes into ``names``.

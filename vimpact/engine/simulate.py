@@ -100,13 +100,9 @@ def _concatenate(pieces: list, order: np.ndarray):
     """Return result columns (arrays, or :class:`Coded` with their own names) joined, in ``order``."""
     if not isinstance(pieces[0], Coded):
         return np.concatenate(pieces)[order]
-    names = tuple(dict.fromkeys(name for p in pieces for name in p.names))
-    index = {name: i for i, name in enumerate(names)}
-    codes = []
-    for p in pieces:  # each piece's codes in the joined names (-1 stays -1: the last entry)
-        lookup = np.array([index[name] for name in p.names] + [-1], dtype=np.int16)
-        codes.append(lookup[p.codes])
-    return Coded(np.concatenate(codes)[order], names)
+    names: list[str] = []
+    codes = [p.codes_in(names) for p in pieces]  # each piece's codes in the joined names
+    return Coded(np.concatenate(codes)[order], tuple(names))
 
 
 def _run(cols: SceneColumns, numerics: Numerics, n_rec: int, rec_every: int,
@@ -255,9 +251,9 @@ class _Taken:
 
 def _taken(cols: SceneColumns, idx: np.ndarray) -> SceneColumns:
     """:func:`_rows`, each column taken when first read (:class:`_Taken`)."""
-    if len(idx) <= 1 or _all_in_order(cols, idx):
-        return _rows(cols, idx)
-    return cast(SceneColumns, _Taken(cols, idx))
+    if _all_in_order(cols, idx):
+        return cols
+    return cols.take(idx) if len(idx) <= 1 else cast(SceneColumns, _Taken(cols, idx))
 
 
 def _all_in_order(cols: SceneColumns, idx: np.ndarray) -> bool:

@@ -53,7 +53,7 @@ OUTPUTS = ("e_z", "e_x", "beta_x", "t_contact", "u_max", "a_max", "energy_ratio"
 TANGENTIAL_OUTPUTS = ("e_x", "beta_x", "mu_eff", "gross_slip_fraction")
 
 
-def unpack(cols: SceneColumns, out: np.ndarray, path_names: np.ndarray | Coded,
+def unpack(cols: SceneColumns, out: np.ndarray, paths: Coded,
            explicit_euler: np.ndarray, steps_per_T: np.ndarray, refused: np.ndarray,
            codes: bool = False) -> dict[str, Any]:
     """SI result columns (:data:`vimpact.engine.result.RESULT_FIELDS`) of kernel rows.
@@ -62,8 +62,8 @@ def unpack(cols: SceneColumns, out: np.ndarray, path_names: np.ndarray | Coded,
     ----------
     cols : the scenes
     out : ``(n, N_OUT)`` kernel rows (anything in invalid rows)
-    path_names : the path of each row (``None`` for invalid rows): an object array, or
-        :class:`~vimpact.engine.result.Coded` (code ``-1`` for invalid rows)
+    paths : the path of each row (:class:`~vimpact.engine.result.Coded`, code ``-1``
+        for invalid rows)
     explicit_euler : rows integrated by explicit Euler (energy gain expected)
     steps_per_T : time steps per time unit ``T`` of each element-path row (0 on
         continuum rows): with the contact time, how well the contact was resolved
@@ -173,13 +173,9 @@ def unpack(cols: SceneColumns, out: np.ndarray, path_names: np.ndarray | Coded,
             "n_steps": out[:, layout.OUT_STEPS].astype(np.int64), "error": error,
         }
     if codes:
-        result["status"] = Coded(status, STATUS_NAMES)
-        result["path"] = (path_names if isinstance(path_names, Coded)
-                          else Coded.encode(path_names))
+        result["status"], result["path"] = Coded(status, STATUS_NAMES), paths
     else:
-        result["status"] = _NAMES[status]
-        result["path"] = (path_names.decode() if isinstance(path_names, Coded)
-                          else path_names)
+        result["status"], result["path"] = _NAMES[status], paths.decode()
     for name in ("t_hertz", "d_hertz", "a_hertz", "Q1", "Q2", "nu"):
         result[name] = np.where(valid, result[name], np.nan)
     result["n_steps"] = np.where(valid, result["n_steps"], 0)

@@ -150,16 +150,12 @@ def compute_chunk(spec: SweepSpec, chunk: int, timings: dict | None = None):
         except Exception as exc:  # noqa: BLE001 - recorded as the rows' status
             status[rows], error[rows] = STATUS_CODE["failed"], f"{type(exc).__name__}: {exc}"
             continue
-        st, paths = result["status"].codes, result["path"]
-        lookup = np.full(len(paths.names) + 1, -1, dtype=np.int16)  # (-1 stays -1)
-        for j, name in enumerate(paths.names):  # the batch's path codes in the chunk's
-            if name not in path_names:
-                path_names.append(name)
-            lookup[j] = path_names.index(name)
+        st = result["status"].codes
+        batch_path = result["path"].codes_in(path_names)  # the batch's paths in the chunk's
         if whole:
-            status, error, path = st, result["error"], lookup[paths.codes]
+            status, error, path = st, result["error"], batch_path
         else:
-            status[rows], error[rows], path[rows] = st, result["error"], lookup[paths.codes]
+            status[rows], error[rows], path[rows] = st, result["error"], batch_path
         for name, source in outputs.items():
             if whole:  # (the result's own array: no copy)
                 cols[name] = result[source]
@@ -231,8 +227,8 @@ def guard_nan(cols: dict, status: np.ndarray, error: np.ndarray, vc0_zero: np.nd
               finished: np.ndarray) -> np.ndarray:
     """Allow NaN only with a status that explains it.
 
-    ``status``: names (an object array), or codes into
-    :data:`vimpact.engine.result.STATUS_NAMES`, changed in place. A finished row with a NaN output that no
+    ``status``: codes into :data:`vimpact.engine.result.STATUS_NAMES`, changed in
+    place. A finished row with a NaN output that no
     status explains (``e_x``, ``beta_x`` are NaN when ``v_c0 = 0``) becomes
     ``non_finite`` with all outputs NaN and the columns named in ``error``.
     Returns the rows changed (bool).
@@ -242,14 +238,12 @@ def guard_nan(cols: dict, status: np.ndarray, error: np.ndarray, vc0_zero: np.nd
     bad_cols = {c: np.isnan(cols[c]) & finished
                 & ~(explained if c in TANGENTIAL_OUTPUTS else nothing) for c in OUTPUTS}
     bad = np.logical_or.reduce(list(bad_cols.values()))
-    coded = status.dtype != object  # codes into STATUS_NAMES (compute_chunk), or names
-    if coded:
-        from vimpact.engine.result import STATUS_CODE, STATUS_NAMES
+    from vimpact.engine.result import STATUS_CODE, STATUS_NAMES
+
     for k in np.flatnonzero(bad):  # rare: the message names this row's columns
         names = ", ".join(c for c, m in bad_cols.items() if m[k])
-        name = STATUS_NAMES[status[k]] if coded else status[k]
-        error[k] = f"NaN in {names} of a row with status {name!r}"
-    status[bad] = STATUS_CODE["non_finite"] if coded else "non_finite"
+        error[k] = f"NaN in {names} of a row with status {STATUS_NAMES[status[k]]!r}"
+    status[bad] = STATUS_CODE["non_finite"]
     for c in OUTPUTS:
         cols[c][bad] = np.nan
     return bad
