@@ -405,3 +405,28 @@ def grid_search_many(costs, starts, half_widths, lowers, uppers, xatol: float = 
                     h[s][i] = min(2.0 * h[s][i], h_max[s][i])
             c[s] = z[s][j]
     return c
+
+
+def lockstep_costs(law, arguments, targets):
+    """Return the ``costs`` of :func:`grid_search_many` for searches that fit a stepped law.
+
+    Every running search's candidates at all its points go through one call of ``law``
+    (a stepped law of :mod:`vimpact.dem.laws`, elementwise, so each search's costs are
+    those it would get alone): ``arguments(i, z)`` gives the law's arguments of search
+    ``i`` for its ``(k, 2)`` candidates ``z``, arrays that broadcast to ``(k, points)``;
+    ``law(*flat_arguments)`` returns ``(e, beta)``; the cost of a candidate is the mean
+    square of ``beta`` minus ``targets[i]`` over the search's points.
+    """
+    def costs(grids: list[tuple[int, np.ndarray]]) -> list[np.ndarray]:
+        parts = [np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in arguments(i, z)))
+                 for i, z in grids]
+        flat = [np.concatenate([args[k].ravel() for args in parts]) for k in range(len(parts[0]))]
+        beta = law(*flat)[1]
+        out, start = [], 0
+        for (i, _), args in zip(grids, parts):  # back to each search's (k, points)
+            piece = beta[start:start + args[0].size].reshape(args[0].shape)
+            start += args[0].size
+            out.append(np.mean((piece - targets[i]) ** 2, axis=1))
+        return out
+
+    return costs

@@ -39,6 +39,7 @@ twice the pull-off force; the report states the ``beta_x`` that limit gives.
 
 from __future__ import annotations
 
+import functools
 import math
 import os
 import subprocess
@@ -55,6 +56,7 @@ from vimpact.dem.fit import (
     Targets,
     fit_viscoelastic_hertz,
     grid_search_many,
+    lockstep_costs,
     viscoelastic_hertz_prediction,
 )
 from vimpact.dem.problem import Contact, DemProblem, ParticleType, WallType
@@ -287,24 +289,12 @@ def _search_oblique(items: list[tuple[Contact, Oblique, float, dict]]) -> list[n
     """
     from vimpact.dem import laws
 
-    def costs(grids: list[tuple[int, np.ndarray]]) -> list[np.ndarray]:
-        parts = []
-        for i, z in grids:  # every candidate at every point, flattened, one contact after another
-            c, ob, A, params = items[i]
-            args = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in _oblique_law(
-                c, ob, A, params, params["k_t"] * np.exp(z[:, :1]), np.exp(z[:, 1:]))))
-            parts.append(args)
-        alpha, kappa, x_gamma, F, mu, w0 = (np.concatenate([a[k].ravel() for a in parts])
-                                            for k in range(6))
-        b = laws.hertz_mindlin_coulomb(alpha, kappa, x_gamma, F, mu, w0, FIT_STEPS)[1]
-        out, start = [], 0
-        for (i, _), args in zip(grids, parts):
-            shape = args[0].shape
-            piece = b[start:start + args[0].size].reshape(shape)
-            start += args[0].size
-            out.append(np.mean((piece - items[i][1].beta_x) ** 2, axis=1))
-        return out
+    def arguments(i: int, z: np.ndarray) -> tuple:
+        c, ob, A, params = items[i]
+        return _oblique_law(c, ob, A, params, params["k_t"] * np.exp(z[:, :1]), np.exp(z[:, 1:]))
 
+    costs = lockstep_costs(functools.partial(laws.hertz_mindlin_coulomb, steps=FIT_STEPS), arguments,
+                           [ob.beta_x for _, ob, _, _ in items])
     n = len(items)
     return grid_search_many(costs, [SEARCH_START] * n, [SEARCH_HALF_WIDTH] * n,
                             [(-5.0, math.log(1e-6))] * n, [(5.0, math.log(1e12))] * n)

@@ -28,12 +28,20 @@ were read from MercuryDPM's sources (``Kernel/Species``,
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
 
 from vimpact.dem import laws, linear
-from vimpact.dem.fit import ContactFit, Residual, Targets, fit_viscoelastic_hertz, grid_search_many
+from vimpact.dem.fit import (
+    ContactFit,
+    Residual,
+    Targets,
+    fit_viscoelastic_hertz,
+    grid_search_many,
+    lockstep_costs,
+)
 from vimpact.dem.problem import Contact, DemProblem
 
 CODE = "mercurydpm"
@@ -109,23 +117,13 @@ def _search_tangential(items: list[tuple[Contact, Targets, float, float]]) -> li
     """
     points = [_tangential_points(c, t) for c, t, _, _ in items]
 
-    def costs(grids: list[tuple[int, np.ndarray]]) -> list[np.ndarray]:
-        parts = []
-        for i, z in grids:  # every candidate at every point, flattened, one contact after another
-            c, _, A, G0 = items[i]
-            v, R, m, w0, _, mu = points[i]
-            parts.append(np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in _mercury_law(
-                c, A, G0 * np.exp(z[:, :1]), np.exp(z[:, 1:]), mu, v, R, m, w0))))
-        alpha, K, D, F, mu, w0 = (np.concatenate([a[k].ravel() for a in parts])
-                                  for k in range(6))
-        b = laws.mercury_mindlin_coulomb(alpha, K, D, F, mu, w0, FIT_STEPS)[1]
-        out, start = [], 0
-        for (i, _), args in zip(grids, parts):
-            piece = b[start:start + args[0].size].reshape(args[0].shape)
-            start += args[0].size
-            out.append(np.mean((piece - points[i][4]) ** 2, axis=1))
-        return out
+    def arguments(i: int, z: np.ndarray) -> tuple:
+        c, _, A, G0 = items[i]
+        v, R, m, w0, _, mu = points[i]
+        return _mercury_law(c, A, G0 * np.exp(z[:, :1]), np.exp(z[:, 1:]), mu, v, R, m, w0)
 
+    costs = lockstep_costs(functools.partial(laws.mercury_mindlin_coulomb, steps=FIT_STEPS),
+                           arguments, [p[4] for p in points])
     n = len(items)
     return grid_search_many(costs, [SEARCH_START] * n, [SEARCH_HALF_WIDTH] * n,
                             [(-5.0, math.log(1e-6))] * n, [(5.0, math.log(1e6))] * n)
