@@ -1,7 +1,10 @@
 """`vimpact dem`: files for every code, bad input in one line with exit 2."""
 
+from pathlib import Path
+
 import pytest
 
+from tests.dem.conftest import cli
 from vimpact.cli.main import main
 from vimpact.dem.export import CODES
 
@@ -41,12 +44,22 @@ FILES = {"lammps": ["lammps_settings.in", "lammps_pair.in", "lammps_walls.in"],
          "mfix": ["mfix.dat"], "rebound": ["vimpact_restitution.py"]}
 
 
-@pytest.mark.parametrize("code", CODES)
-def test_writes_input_and_report_for_every_code(code, tmp_path, capsys):
-    src = tmp_path / "setup.toml"
-    src.write_text(WIRING)
-    out = tmp_path / code
-    assert main(["dem", str(src), "--for", code, "--out", str(out)]) == 0
+@pytest.fixture(scope="module")
+def lammps_json(tmp_path_factory):
+    """``vimpact dem`` on :data:`TOML` (friction, no angles: the default ones) for LAMMPS
+    with ``--json``, run once: the LAMMPS case of the file checks and the JSON check of the
+    tangential residual both read it (the LAMMPS fit is the slowest of the codes; the plain
+    text summary of ``--for lammps`` is the example of docs/dem.md, run by tests/docs)."""
+    d = tmp_path_factory.mktemp("lammps_json")
+    (d / "setup.toml").write_text(TOML)
+    status, out, _ = cli(["dem", str(d / "setup.toml"), "--for", "lammps", "--out", str(d),
+                          "--json"])
+    return status, out, d
+
+
+def check_written(code: str, out: Path) -> None:
+    """The code's files and its report are written; the report names every contact and
+    says what the code cannot represent."""
     for name in FILES[code] + [f"report_{code}.md", f"report_{code}.png"]:
         assert (out / name).stat().st_size > 0, name
     report = (out / f"report_{code}.md").read_text()
@@ -56,16 +69,29 @@ def test_writes_input_and_report_for_every_code(code, tmp_path, capsys):
         assert "not represented" in table
     else:  # every other code gets tangential constants and a beta_x residual
         assert "not represented" not in table
-    text = capsys.readouterr().out
+
+
+@pytest.mark.parametrize("code", [c for c in CODES if c != "lammps"])
+def test_writes_input_and_report_for_every_code(code, wiring_run):
+    """LAMMPS: :func:`test_writes_lammps_input_and_report`."""
+    status, text, out = wiring_run(code)
+    assert status == 0
+    check_written(code, out)
     assert "e_z residual" in text
-    if code == "lammps":  # one pair_coeff per type pair, one wall fix per particle type
-        text = (out / "lammps_pair.in").read_text()
-        assert [ln.split()[1:3] for ln in text.splitlines() if ln.startswith("pair_coeff")] == \
-            [["1", "1"], ["1", "2"], ["2", "2"]]
-        walls = (out / "lammps_walls.in").read_text().splitlines()
-        assert sum(ln.startswith("fix wall_floor_") for ln in walls) == 2
-        settings = (out / "lammps_settings.in").read_text()
-        assert "units si" in settings and "timestep" in text
+
+
+def test_writes_lammps_input_and_report(lammps_json):
+    """One pair_coeff per type pair, one wall fix per particle type."""
+    status, _, out = lammps_json
+    assert status == 0
+    check_written("lammps", out)
+    text = (out / "lammps_pair.in").read_text()
+    assert [ln.split()[1:3] for ln in text.splitlines() if ln.startswith("pair_coeff")] == \
+        [["1", "1"], ["1", "2"], ["2", "2"]]
+    walls = (out / "lammps_walls.in").read_text().splitlines()
+    assert sum(ln.startswith("fix wall_floor_") for ln in walls) == 2
+    settings = (out / "lammps_settings.in").read_text()
+    assert "units si" in settings and "timestep" in text
 
 
 @pytest.mark.parametrize("edit, words", [
@@ -113,21 +139,20 @@ def test_steps_per_contact_only_for_codes_with_a_time_step(tmp_path, capsys):
     assert err.count("\n") == 1 and "--steps-per-contact" in err
 
 
-def test_json_gives_the_tangential_residual_over_the_impact_angles(tmp_path, capsys):
+def test_json_gives_the_tangential_residual_over_the_impact_angles(lammps_json):
     """With friction, the beta_x residual is over oblique impacts at the set-up's angles
     (the default angles when it gives none), and the JSON says so."""
     import json
 
     from vimpact.dem.fit import DEFAULT_ANGLES_DEG
 
-    src = tmp_path / "setup.toml"
-    src.write_text(TOML)
-    assert main(["dem", str(src), "--for", "lammps", "--out", str(tmp_path), "--json"]) == 0
-    data = json.loads(capsys.readouterr().out)
+    status, out, folder = lammps_json
+    assert status == 0
+    data = json.loads(out)
     for c in data["contacts"]:
         basis = c["beta_x_fitted_to"]
         assert basis["friction"] == 0.5
         assert basis["angles_deg"] == list(DEFAULT_ANGLES_DEG)
         assert 0.0 < c["residual_beta_x"]["rms"] <= c["residual_beta_x"]["max_abs"] < 0.1
-    report = (tmp_path / "report_lammps.md").read_text()
+    report = (folder / "report_lammps.md").read_text()
     assert "impact angles 5, 15, 30, 45, 60, 75 deg" in report

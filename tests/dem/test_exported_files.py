@@ -22,13 +22,18 @@ MFIX_KEYS = {"DES_COLL_MODEL", "DES_EN_INPUT", "DES_EN_WALL_INPUT", "KN", "KN_W"
 
 
 @pytest.fixture(scope="module")
-def problem():
-    return problem_from_toml(WIRING, "files")
+def mfix_export(tmp_path_factory):
+    """The MFiX export of :data:`WIRING`, once for the checks of its file and of its fit."""
+    out = tmp_path_factory.mktemp("mfix")
+    return export(problem_from_toml(WIRING, "files"), "mfix", out), out
 
 
-def test_mercurydpm_species_compiles_by_name(problem, tmp_path):
-    export(problem, "mercurydpm", tmp_path)
-    text = (tmp_path / "mercurydpm_species.cpp").read_text()
+def test_mercurydpm_species_compiles_by_name(wiring_run):
+    """The species file ``vimpact dem --for mercurydpm`` wrote for :data:`WIRING` (the same
+    run as the CLI test's)."""
+    status, _, out = wiring_run("mercurydpm")
+    assert status == 0
+    text = (out / "mercurydpm_species.cpp").read_text()
     assert '#include "Species/HertzianBSHPViscoelasticMindlinSpecies.h"' in text
     assert "HertzianBSHPViscoelasticSlidingFrictionSpecies" not in text
     code = "\n".join(ln.split("//")[0] for ln in text.splitlines())
@@ -38,9 +43,9 @@ def test_mercurydpm_species_compiles_by_name(problem, tmp_path):
     assert text.count("setSlidingDissipation") == text.count("setEffectiveShearModulus")
 
 
-def test_mfix_keywords_and_ranges(problem, tmp_path):
-    ex = export(problem, "mfix", tmp_path)
-    lines = [ln.split("!")[0] for ln in (tmp_path / "mfix.dat").read_text().splitlines()]
+def test_mfix_keywords_and_ranges(mfix_export):
+    ex, out = mfix_export
+    lines = [ln.split("!")[0] for ln in (out / "mfix.dat").read_text().splitlines()]
     values = dict(ln.split("=", 1) for ln in lines if "=" in ln)
     values = {k.strip(): v.strip() for k, v in values.items()}
     assert set(values) <= MFIX_KEYS
@@ -51,10 +56,10 @@ def test_mfix_keywords_and_ranges(problem, tmp_path):
         assert 0.0 <= f.params["etat_fac"] <= 1.0 and f.res_beta_x is not None
 
 
-def test_mfix_tangential_factor_is_fitted_with_the_friction(problem):
+def test_mfix_tangential_factor_is_fitted_with_the_friction(mfix_export):
     """With friction, the reported beta_x residual of MFiX is over the oblique impacts,
     MFiX's law run with the MEW written (one value)."""
-    ex = export(problem, "mfix")
+    ex, _ = mfix_export
     for f in ex.fits:
         ob = ex.targets[f.contact.key].oblique
         assert f.beta_oblique is not None and f.beta_oblique.shape == ob.beta_x.shape

@@ -1,5 +1,7 @@
 """Fits reproduce known constants from synthetic targets made by the law itself."""
 
+import functools
+
 import numpy as np
 import pytest
 
@@ -109,27 +111,49 @@ def test_kelvin_voigt_fit_is_close_to_tau_and_residual_is_second_order():
     assert np.max(np.abs(e - t.e_z)) < 0.1 * np.max(1 - t.e_z)
 
 
+#: the stepped law's points of the tangential search tests: A v0 / d_H at four speeds, and
+#: the start of the stiffness ratio
+ALPHA, KAPPA0 = np.array([1e-4, 3e-4, 1e-3, 3e-3]), 0.6
+#: a solid sphere at 45 degrees with mu = 0.5: (F, mu, w0)
+SOLID_45 = (3.5, 0.5, (1.0, 1.0, 1.0, 1.0))
+
+
+def stepped_beta(F, mu, w0, ln_kappa, ln_gamma):
+    """LAMMPS' stepped Hertz-Mindlin-Coulomb beta at :data:`ALPHA` (its fit's step count)."""
+    from vimpact.dem.lammps import FIT_STEPS
+
+    return laws.hertz_mindlin_coulomb(ALPHA, KAPPA0 * np.exp(ln_kappa), np.exp(ln_gamma),
+                                      F, mu, np.asarray(w0, dtype=float), FIT_STEPS)[1]
+
+
+def search_bounds():
+    import math
+
+    return (-5.0, math.log(1e-6)), (5.0, math.log(1e12))
+
+
+@functools.lru_cache
+def search_alone(F: float, mu: float, w0: tuple, known: tuple) -> np.ndarray:
+    """The LAMMPS tangential fit's search (:func:`grid_search` from its start) on beta targets
+    made by the stepped law at ``known = (ln k_t / k_0, ln x_gamma_t)``. Cached: the
+    lockstep test compares with the very search the recovery test runs for the solid
+    sphere at 45 degrees."""
+    from vimpact.dem.fit import grid_search
+    from vimpact.dem.lammps import SEARCH_HALF_WIDTH, SEARCH_START
+
+    target = stepped_beta(F, mu, w0, *known)
+    return grid_search(lambda z: np.mean((stepped_beta(F, mu, w0, z[:, :1], z[:, 1:])
+                                          - target) ** 2, axis=1),
+                       SEARCH_START, SEARCH_HALF_WIDTH, *search_bounds())
+
+
 @pytest.mark.parametrize("ln_k, ln_x", [(-0.18, 7.27), (-0.2, -0.58), (0.5, 2.0), (-1.0, 4.0)])
 def test_tangential_grid_search_recovers_known_lammps_constants(ln_k, ln_x):
     """The shrinking-grid search of the LAMMPS tangential fit, on beta targets made by the
     stepped Hertz-Mindlin-Coulomb law itself at known ``(ln k_t / k_0, ln x_gamma_t)``,
     finds those constants from the fit's own start (the cost has curved valleys: a search
     that shrinks after every move stopped in the wrong one in three of these four)."""
-    import math
-
-    from vimpact.dem.fit import grid_search
-    from vimpact.dem.lammps import FIT_STEPS, SEARCH_HALF_WIDTH, SEARCH_START
-
-    alpha = np.array([1e-4, 3e-4, 1e-3, 3e-3])  # A v0 / d_H at four speeds
-    kappa0, F, mu, w0 = 0.6, 3.5, 0.5, np.ones(4)  # 45 degrees, a solid sphere
-
-    def beta(ln_kappa, ln_gamma):
-        return laws.hertz_mindlin_coulomb(alpha, kappa0 * np.exp(ln_kappa), np.exp(ln_gamma),
-                                          F, mu, w0, FIT_STEPS)[1]
-
-    target = beta(ln_k, ln_x)
-    z = grid_search(lambda z: np.mean((beta(z[:, :1], z[:, 1:]) - target) ** 2, axis=1),
-                    SEARCH_START, SEARCH_HALF_WIDTH, (-5.0, math.log(1e-6)), (5.0, math.log(1e12)))
+    z = search_alone(*SOLID_45, (ln_k, ln_x))  # 45 degrees, a solid sphere
     assert z == pytest.approx([ln_k, ln_x], abs=0.01)
 
 
@@ -138,29 +162,18 @@ def test_lockstep_tangential_searches_equal_the_searches_one_by_one():
     searched in lockstep (:func:`grid_search_many`, one stepped call per round over both
     contacts' candidates, per-point ``F`` and ``mu``) end exactly where :func:`grid_search`
     ends for each alone (scalar ``F``, ``mu``): the stepped law is elementwise, and a search
-    that has stopped drops out without moving the other."""
-    import math
-
-    from vimpact.dem.fit import grid_search, grid_search_many
+    that has stopped drops out without moving the other. (The solid sphere's search alone
+    is the one of test_tangential_grid_search_recovers_known_lammps_constants[-0.2--0.58].)"""
+    from vimpact.dem.fit import grid_search_many
     from vimpact.dem.lammps import FIT_STEPS, SEARCH_HALF_WIDTH, SEARCH_START
 
-    alpha = np.array([1e-4, 3e-4, 1e-3, 3e-3])  # A v0 / d_H at four speeds
-    kappa0 = 0.6
     contacts = [  # (F, mu, w0, known (ln k, ln x)): a solid sphere at 45 deg; a hollow one
-        (3.5, 0.5, np.ones(4), (-0.2, -0.58)),
-        (2.5, 0.3, np.tan(np.radians([15.0, 30.0, 45.0, 60.0])), (0.5, 2.0)),
+        (*SOLID_45, (-0.2, -0.58)),
+        (2.5, 0.3, tuple(np.tan(np.radians([15.0, 30.0, 45.0, 60.0]))), (0.5, 2.0)),
     ]
-
-    def beta(k, ln_kappa, ln_gamma):
-        F, mu, w0, _ = contacts[k]
-        return laws.hertz_mindlin_coulomb(alpha, kappa0 * np.exp(ln_kappa), np.exp(ln_gamma),
-                                          F, mu, w0, FIT_STEPS)[1]
-
-    targets = [beta(k, *contacts[k][3]) for k in range(2)]
-    bounds = (-5.0, math.log(1e-6)), (5.0, math.log(1e12))
-    alone = [grid_search(lambda z, k=k: np.mean((beta(k, z[:, :1], z[:, 1:]) - targets[k]) ** 2,
-                                                axis=1), SEARCH_START, SEARCH_HALF_WIDTH, *bounds)
-             for k in range(2)]
+    targets = [stepped_beta(F, mu, w0, *known) for F, mu, w0, known in contacts]
+    bounds = search_bounds()
+    alone = [search_alone(*contacts[k]) for k in range(2)]
 
     rounds = [0, 0]
 
@@ -169,8 +182,8 @@ def test_lockstep_tangential_searches_equal_the_searches_one_by_one():
         for k, z in grids:
             rounds[k] += 1
             F, mu, w0, _ = contacts[k]
-            args.append(np.broadcast_arrays(alpha, kappa0 * np.exp(z[:, :1]), np.exp(z[:, 1:]),
-                                            F, mu, w0))
+            args.append(np.broadcast_arrays(ALPHA, KAPPA0 * np.exp(z[:, :1]), np.exp(z[:, 1:]),
+                                            F, mu, np.asarray(w0, dtype=float)))
         b = laws.hertz_mindlin_coulomb(*(np.concatenate([a[i].ravel() for a in args])
                                          for i in range(6)), steps=FIT_STEPS)[1]
         out, start = [], 0

@@ -129,11 +129,21 @@ def run_guarded(argv, capsys, limit_s: float = 120.0):
     return result["r"]
 
 
+#: the handshake timeout of the silent service's case (the default, SCHEDULER_TIMEOUT_S, is 5 s:
+#: the refusal is the same, sooner)
+SILENT_TIMEOUT_S = 1.0
+
+
 @pytest.mark.parametrize("case", ["refused", "unknown-host", "http", "silent", "no-port",
                                   "port-range"])
-def test_scheduler_that_does_not_answer_is_one_line_and_leaves_nothing(tmp_path, capsys, case):
+def test_scheduler_that_does_not_answer_is_one_line_and_leaves_nothing(tmp_path, capsys, case,
+                                                                        monkeypatch):
     pytest.importorskip("distributed")
     service = FakeService(case) if case in ("http", "silent") else None
+    if case == "silent":  # nothing answers: the probe waits out connect_scheduler's timeout
+        connect = runner.connect_scheduler
+        monkeypatch.setattr(runner, "connect_scheduler",
+                            lambda address: connect(address, timeout=SILENT_TIMEOUT_S))
     address = {"refused": f"tcp://127.0.0.1:{free_port()}",
                "unknown-host": "tcp://no-such-host.invalid:8786",
                "no-port": "tcp://127.0.0.1", "port-range": "tcp://127.0.0.1:99999"}.get(
@@ -146,6 +156,8 @@ def test_scheduler_that_does_not_answer_is_one_line_and_leaves_nothing(tmp_path,
             service.close()
     one_line(code, err, f"--scheduler = {address!r}")
     assert "EiB" not in err
+    if case == "silent":
+        assert f"gave no answer within {SILENT_TIMEOUT_S:g} s" in err, err
     nothing_written(tmp_path, "s.toml")
 
 

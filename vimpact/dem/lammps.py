@@ -669,14 +669,7 @@ def round_trip_files(problem: DemProblem, speeds, steps_per_contact: int = STEPS
                     case: dict[str, Any] = {"contact": c.key, "level": lvl, "v": float(v),
                             "predicted": float(level_prediction(f, R, m, v))}
                     if oblique:
-                        point = Oblique(np.array([float(v)]), np.array([float(ang)]), R, m,
-                                        c.mu, np.array([np.nan]), np.array([np.nan]))
-                        b_pred = (_adhesive_oblique_beta(c, point, f.params, [])[0]
-                                  if "cohesion" in f.params else
-                                  oblique_beta(c, point, f.params["A_s"], f.params,
-                                               f.params["k_t"], f.params["x_gamma_t"]))
-                        case.update(angle=float(ang), vt=vt, F=linear.mass_factor(c),
-                                    predicted_beta=float(b_pred[0]))
+                        case.update(angle=float(ang), vt=vt, F=linear.mass_factor(c))
                     if isinstance(b2, Body) and isinstance(second, ParticleType):  # a pair
                         q1, q2 = b2.m / (b1.m + b2.m), b1.m / (b1.m + b2.m)
                         atoms.append((c.first.index, (x - b1.R - gap / 2, 0.0, z_pairs), b1.R,
@@ -689,6 +682,17 @@ def round_trip_files(problem: DemProblem, speeds, steps_per_contact: int = STEPS
                                       c.first.density, (vt, 0.0, -float(v))))
                         case["ids"] = [len(atoms)]
                     cases.append(case)
+            if oblique:  # the report's beta of all this level's impacts in one call
+                mine = [cs for cs in cases if cs["contact"] == c.key and cs["level"] == lvl]
+                nan = np.full(len(mine), np.nan)
+                points = Oblique(np.array([cs["v"] for cs in mine]),
+                                 np.array([cs["angle"] for cs in mine]), R, m, c.mu, nan, nan)
+                b_pred = (_adhesive_oblique_beta(c, points, f.params, [])[0]
+                          if "cohesion" in f.params else
+                          oblique_beta(c, points, f.params["A_s"], f.params,
+                                       f.params["k_t"], f.params["x_gamma_t"]))
+                for cs, b in zip(mine, b_pred):
+                    cs["predicted_beta"] = float(b)
     dt = shortest_contact(problem, fits) / steps_per_contact
     vmin = float(min(speeds))
     t_end = 2e-3 * r_max / vmin + 3.0 * max(

@@ -297,10 +297,7 @@ def round_trip(problem: DemProblem, speeds, steps_per_contact: int = STEPS_PER_C
                 Ys, Gs = shear_ratio(Y, c.first.index - 1, c.second.index - 1)
                 F = linear.mass_factor(c)
                 R_, m_ = c.nominal()
-                case.update(angle=float(ang), vt=vt, F=F, predicted_beta=float(tangential_beta(
-                    f.params["coefficientRestitution"], Ys, Gs, F, c.mu,
-                    np.array([vt / float(v)]), f.params.get("tangential_damping", True),
-                    wall=(R_, m_, np.array([float(v)])))[0]))
+                case.update(angle=float(ang), vt=vt, F=F)
             if isinstance(second, WallType):
                 atoms.append((c.first.index, (x, 0.0, R1 + gap), R1, c.first.density,
                               (vt, 0.0, -float(v))))
@@ -314,6 +311,15 @@ def round_trip(problem: DemProblem, speeds, steps_per_contact: int = STEPS_PER_C
                 case["ids"] = [len(atoms) - 1, len(atoms)]
             cases.append(case)
             top = x
+        if angles_deg is not None:  # the report's beta of all this contact's impacts in one call
+            mine = [cs for cs in cases if cs["contact"] == c.key]
+            v_all = np.array([cs["v"] for cs in mine])
+            beta = tangential_beta(f.params["coefficientRestitution"], Ys, Gs, F, c.mu,
+                                   np.array([cs["vt"] for cs in mine]) / v_all,
+                                   f.params.get("tangential_damping", True),
+                                   wall=(R_, m_, v_all))
+            for cs, b in zip(mine, beta):
+                cs["predicted_beta"] = float(b)
     dt = time_step(fits, steps_per_contact)
     t_end = max(1e-3 * f.contact.first.radius / min(speeds) for f in fits) + 3.0 * max(
         float(laws.hertz_contact_time(f.params["E_star_Pa"], *f.contact.nominal(), min(speeds)))

@@ -328,13 +328,18 @@ def round_trip(problem: DemProblem, speeds, steps_per_contact: int = STEPS_PER_C
                     "wall": second.name if c.is_wall else None, "v": float(v),
                     "R1": c.first.radius, "R2": R2, "predicted": float(f.params["e_yade"])}
                 if ang is not None:
-                    p = f.params
-                    w0 = math.tan(math.radians(ang))
-                    case.update(angle=float(ang), vt=float(v) * w0, predicted_beta=float(
-                        yade_oblique(p["tc"], p["en"], p["et"], mass_ratio(c),
-                                     linear.mass_factor(c), p["mu"], np.array([w0]),
-                                     R=c.first.radius, v=np.array([float(v)]))[0]))
+                    case.update(angle=float(ang), vt=float(v) * math.tan(math.radians(ang)))
                 cases.append(case)
+        if angles_deg is not None:  # the report's beta of all this contact's impacts in one call
+            p = f.params
+            mine = [cs for cs in cases if cs["contact"] == c.key]
+            v_all = np.array([cs["v"] for cs in mine])
+            beta = yade_oblique(p["tc"], p["en"], p["et"], mass_ratio(c), linear.mass_factor(c),
+                                p["mu"], np.array([math.tan(math.radians(cs["angle"]))
+                                                   for cs in mine]),
+                                R=c.first.radius, v=v_all)
+            for cs, b in zip(mine, beta):
+                cs["predicted_beta"] = float(b)
     t_end = max(1e-3 * cs["R1"] / cs["v"] for cs in cases) + 3.0 * max(
         f.params["t_contact"] for f in fits)
     with tempfile.TemporaryDirectory() as tmp:
