@@ -273,8 +273,12 @@ def explain_paths(spec: SweepSpec, first_rows: dict[str, int]) -> dict[str, list
     from vimpact.engine.routing import choose_path
     out = {}
     for name, row in first_rows.items():
-        chunk = row // spec.chunk_size
-        scene = spec.scene(spec.chunk_parameters(chunk), row - chunk * spec.chunk_size)
+        if spec.mode == "grid":  # the row's own axis values (not its whole chunk's)
+            one = dataclasses.replace(spec, chunk_size=1)
+            scene = one.scene(one.chunk_parameters(row), 0)
+        else:  # (a random row's draws depend on its chunk's)
+            chunk = row // spec.chunk_size
+            scene = spec.scene(spec.chunk_parameters(chunk), row - chunk * spec.chunk_size)
         out[name] = list(choose_path(scene, spec.numerics).reasons)
     return out
 
