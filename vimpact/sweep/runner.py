@@ -215,10 +215,15 @@ def _decoded(codes: np.ndarray, names):
 
 
 def _repeated(values: np.ndarray, n: int):
-    """Return a string column as a ``pyarrow`` array; one repeated value without a loop."""
+    """Return a string column as a ``pyarrow`` array; one repeated value without a loop.
+
+    A view of one element (stride 0: :func:`~vimpact.sweep.parameters.engine_columns`'
+    ``model``) is one value without comparing its rows.
+    """
     import pyarrow as pa
 
-    if n and isinstance(values[0], str) and bool(np.all(values == values[0])):
+    if n and isinstance(values[0], str) and (values.strides[0] == 0
+                                             or bool(np.all(values == values[0]))):
         return pa.repeat(pa.scalar(values[0], type=pa.string()), n)
     return pa.array(values, type=pa.string())
 
