@@ -316,15 +316,123 @@ def linear_tangential_beta(en: float, et_like: tuple[float, float]) -> float:
 
 
 def fit_scalar(predict, target: np.ndarray, lo: float, hi: float) -> tuple[float, np.ndarray]:
-    """One constant ``p`` in ``[lo, hi]`` minimizing ``RMS(predict(p) - target)``."""
+    """One constant ``p`` in ``[lo, hi]`` minimizing ``RMS(predict(p) - target)``.
 
-    def cost(p: float) -> float:
-        r = np.asarray(predict(p)) - target
-        return float(np.mean(r * r))
+    The one-search case of :func:`fit_scalar_many`; returns ``p`` and ``predict(p)``.
+    """
+    p = fit_scalar_many(lambda jobs: [predict(x) for _, x in jobs], [target], [lo], [hi])[0]
+    return p, np.asarray(predict(p), dtype=float)
 
-    best = minimize_scalar(cost, bounds=(lo, hi), method="bounded",
-                           options={"xatol": 1e-10, "maxiter": 500})
-    return float(best.x), np.asarray(predict(best.x), dtype=float)
+
+def _bounded_brent(lo: float, hi: float, xatol: float, maxiter: int):
+    """Brent's bounded minimization of one scalar as a generator: yields candidates, is sent costs.
+
+    The steps of :func:`scipy.optimize.minimize_scalar` with ``method="bounded"``
+    (golden-section and parabolic steps on ``[lo, hi]``, stop when the bracket is
+    within ``xatol``, or after ``maxiter`` evaluations), the same arithmetic, so that
+    it picks the same candidates and the same best. Each ``yield`` hands out the next
+    candidate and receives its cost; the generator returns the best candidate.
+    """
+    sqrt_eps = np.sqrt(2.2e-16)
+    golden_mean = 0.5 * (3.0 - np.sqrt(5.0))
+    a, b = lo, hi
+    fulc = a + golden_mean * (b - a)
+    nfc, xf = fulc, fulc
+    rat = e = 0.0
+    x = xf
+    fx = yield x
+    num = 1
+    ffulc = fnfc = fx
+    xm = 0.5 * (a + b)
+    tol1 = sqrt_eps * np.abs(xf) + xatol / 3.0
+    tol2 = 2.0 * tol1
+    while np.abs(xf - xm) > (tol2 - 0.5 * (b - a)):
+        golden = 1
+        if np.abs(e) > tol1:  # a parabolic step through the three best points
+            golden = 0
+            r = (xf - nfc) * (fx - ffulc)
+            q = (xf - fulc) * (fx - fnfc)
+            p = (xf - fulc) * q - (xf - nfc) * r
+            q = 2.0 * (q - r)
+            if q > 0.0:
+                p = -p
+            q = np.abs(q)
+            r = e
+            e = rat
+            if (np.abs(p) < np.abs(0.5 * q * r)) and (p > q * (a - xf)) and (p < q * (b - xf)):
+                rat = (p + 0.0) / q
+                x = xf + rat
+                if ((x - a) < tol2) or ((b - x) < tol2):
+                    rat = tol1 * (np.sign(xm - xf) + ((xm - xf) == 0))
+            else:
+                golden = 1
+        if golden:  # a golden-section step into the larger part of the bracket
+            e = (a - xf) if xf >= xm else (b - xf)
+            rat = golden_mean * e
+        x = xf + (np.sign(rat) + (rat == 0)) * np.maximum(np.abs(rat), tol1)
+        fu = yield x
+        num += 1
+        if fu <= fx:
+            if x >= xf:
+                a = xf
+            else:
+                b = xf
+            fulc, ffulc = nfc, fnfc
+            nfc, fnfc = xf, fx
+            xf, fx = x, fu
+        else:
+            if x < xf:
+                a = x
+            else:
+                b = x
+            if (fu <= fnfc) or (nfc == xf):
+                fulc, ffulc = nfc, fnfc
+                nfc, fnfc = x, fu
+            elif (fu <= ffulc) or (fulc == xf) or (fulc == nfc):
+                fulc, ffulc = x, fu
+        xm = 0.5 * (a + b)
+        tol1 = sqrt_eps * np.abs(xf) + xatol / 3.0
+        tol2 = 2.0 * tol1
+        if num >= maxiter:
+            break
+    return xf
+
+
+def fit_scalar_many(predict, targets, lows, highs, xatol: float = 1e-10,
+                    maxiter: int = 500) -> list[float]:
+    """Run several :func:`fit_scalar` searches in lockstep, every round's candidates in one call.
+
+    Each search is Brent's bounded search of one constant (:func:`_bounded_brent`)
+    minimizing the mean square of its prediction minus its target; its steps depend
+    only on its own costs, so it finds what it would find alone. A search that has
+    stopped drops out of the later rounds.
+
+    Parameters
+    ----------
+    predict : list of ``(search index, candidate)`` of the searches still running ->
+        list of their predictions (arrays like their targets), in the same order
+    targets : one array per search (dimensionless)
+    lows, highs : the bounds of each search's constant (its units)
+    xatol : width of the bracket at which a search stops; maxiter : evaluations at most
+
+    Returns
+    -------
+    the best constant of each search
+    """
+    searches = [_bounded_brent(lo, hi, xatol, maxiter) for lo, hi in zip(lows, highs)]
+    best: list[float] = [math.nan] * len(searches)
+    pending = {s: next(g) for s, g in enumerate(searches)}
+    while pending:
+        jobs = list(pending.items())
+        running = {}
+        for (s, _), pred in zip(jobs, predict(jobs)):
+            r = np.asarray(pred) - targets[s]
+            try:
+                running[s] = searches[s].send(float(np.mean(r * r)))
+            except StopIteration as stop:
+                best[s] = float(stop.value)
+        pending = running
+    return best
 
 
 def grid_search(cost, start, half_width, lower, upper, xatol: float = 5e-4, n: int = 7,
