@@ -316,15 +316,118 @@ def linear_tangential_beta(en: float, et_like: tuple[float, float]) -> float:
 
 
 def fit_scalar(predict, target: np.ndarray, lo: float, hi: float) -> tuple[float, np.ndarray]:
-    """One constant ``p`` in ``[lo, hi]`` minimizing ``RMS(predict(p) - target)``."""
+    """One constant ``p`` in ``[lo, hi]`` minimizing ``RMS(predict(p) - target)``.
 
-    def cost(p: float) -> float:
-        r = np.asarray(predict(p)) - target
-        return float(np.mean(r * r))
+    The one-search case of :func:`fit_scalar_many`; returns ``p`` and ``predict(p)``.
+    """
+    p = fit_scalar_many(lambda jobs: [predict(x) for _, x in jobs], [target], [lo], [hi])[0]
+    return p, np.asarray(predict(p), dtype=float)
 
-    best = minimize_scalar(cost, bounds=(lo, hi), method="bounded",
-                           options={"xatol": 1e-10, "maxiter": 500})
-    return float(best.x), np.asarray(predict(best.x), dtype=float)
+
+def _bounded_brent(lo: float, hi: float, xatol: float, maxiter: int):
+    """Brent's minimization of one scalar on ``[lo, hi]`` as a generator.
+
+    Each ``yield`` hands out the next candidate and receives its cost; the
+    generator returns the best candidate. The method (Brent 1973): ``x`` is the
+    best point so far, ``w`` the second best, ``v`` the one before it; a step is
+    the minimum of the parabola through the three if it falls inside the bracket
+    ``[a, b]`` and is less than half the step before last, else a golden-section
+    step into the larger part of the bracket; no candidate lies closer than
+    ``tol`` to ``x``. It stops when the bracket is within ``xatol`` of ``x`` (plus
+    the relative ``sqrt(eps) |x|``) or after ``maxiter`` evaluations. Its
+    decisions and arithmetic are those of :func:`scipy.optimize.minimize_scalar`
+    with ``method="bounded"`` (``tests/dem/test_fit.py`` checks it ends where that
+    ends), so :func:`fit_scalar` gives what it gave with scipy's search.
+    """
+    sqrt_eps = math.sqrt(2.2e-16)
+    section = 0.5 * (3.0 - math.sqrt(5.0))  # the golden-section fraction
+    a, b = lo, hi
+    x = w = v = a + section * (b - a)
+    step = before_last = 0.0
+    fx = yield x
+    fw = fv = fx
+    evaluations = 1
+    while True:
+        middle = 0.5 * (a + b)
+        tol = sqrt_eps * abs(x) + xatol / 3.0
+        if abs(x - middle) <= 2.0 * tol - 0.5 * (b - a):
+            break
+        parabolic = False
+        if abs(before_last) > tol:
+            r = (x - w) * (fx - fv)
+            q = (x - v) * (fx - fw)
+            p = (x - v) * q - (x - w) * r
+            q = 2.0 * (q - r)
+            if q > 0.0:
+                p = -p
+            q = abs(q)
+            limit, before_last = before_last, step
+            if abs(p) < abs(0.5 * q * limit) and q * (a - x) < p < q * (b - x):
+                parabolic = True
+                step = p / q
+                if (x + step) - a < 2.0 * tol or b - (x + step) < 2.0 * tol:
+                    step = tol if middle >= x else -tol  # not onto the bracket's ends
+        if not parabolic:
+            before_last = (a - x) if x >= middle else (b - x)
+            step = section * before_last
+        u = x + (1.0 if step >= 0.0 else -1.0) * max(abs(step), tol)
+        fu = yield u
+        evaluations += 1
+        if fu <= fx:  # u is the new best; the bracket shrinks to its side of x
+            if u >= x:
+                a = x
+            else:
+                b = x
+            v, fv, w, fw, x, fx = w, fw, x, fx, u, fu
+        else:
+            if u < x:
+                a = u
+            else:
+                b = u
+            if fu <= fw or w == x:
+                v, fv, w, fw = w, fw, u, fu
+            elif fu <= fv or v == x or v == w:
+                v, fv = u, fu
+        if evaluations >= maxiter:
+            break
+    return x
+
+
+def fit_scalar_many(predict, targets, lows, highs, xatol: float = 1e-10,
+                    maxiter: int = 500) -> list[float]:
+    """Run several :func:`fit_scalar` searches in lockstep, every round's candidates in one call.
+
+    Each search is Brent's bounded search of one constant (:func:`_bounded_brent`)
+    minimizing the mean square of its prediction minus its target; its steps depend
+    only on its own costs, so it finds what it would find alone. A search that has
+    stopped drops out of the later rounds.
+
+    Parameters
+    ----------
+    predict : list of ``(search index, candidate)`` of the searches still running ->
+        list of their predictions (arrays like their targets), in the same order
+    targets : one array per search (dimensionless)
+    lows, highs : the bounds of each search's constant (its units)
+    xatol : width of the bracket at which a search stops; maxiter : evaluations at most
+
+    Returns
+    -------
+    the best constant of each search
+    """
+    searches = [_bounded_brent(lo, hi, xatol, maxiter) for lo, hi in zip(lows, highs)]
+    best: list[float] = [math.nan] * len(searches)
+    pending = {s: next(g) for s, g in enumerate(searches)}
+    while pending:
+        jobs = list(pending.items())
+        running = {}
+        for (s, _), pred in zip(jobs, predict(jobs)):
+            r = np.asarray(pred) - targets[s]
+            try:
+                running[s] = searches[s].send(float(np.mean(r * r)))
+            except StopIteration as stop:
+                best[s] = float(stop.value)
+        pending = running
+    return best
 
 
 def grid_search(cost, start, half_width, lower, upper, xatol: float = 5e-4, n: int = 7,

@@ -363,8 +363,8 @@ def liggghts_coulomb(e_in: float, K: float, D: float, F: float, mu: float, w0,
     return _stepped(np.zeros(w0.shape), w0, mu, steps, force, F, lever)
 
 
-def yade_coulomb(zeta: float, w_t: float, zeta_t: float, F: float, mu: float, w0,
-                 steps: int = FRICTION_STEPS, rho=None) -> tuple[np.ndarray, np.ndarray]:
+def yade_coulomb(zeta, w_t, zeta_t, F, mu, w0, steps: int = FRICTION_STEPS,
+                 rho=None) -> tuple[np.ndarray, np.ndarray]:
     """Return the normal and tangential restitution of Yade's viscoelastic law with friction.
 
     Yade's ``Law2_ScGeom_ViscElPhys_Basic`` in an oblique impact with Coulomb
@@ -385,6 +385,10 @@ def yade_coulomb(zeta: float, w_t: float, zeta_t: float, F: float, mu: float, w0
     onto the wall): the contact point moves with ``v_x - (R - delta) omega`` and the
     torque has that arm. ``None``: arm ``R`` (the one-contact law).
 
+    ``zeta``, ``w_t``, ``zeta_t``, ``F``, ``mu`` may also be arrays of the shape of ``w0``
+    (one contact per point, e.g. several contacts' candidates of a fit in one call: each
+    point then gets what it gets alone); ``rho`` ``inf`` at a point is the arm ``R``.
+
     Returns
     -------
     (e, beta) : arrays; ``beta = -w_end / w0``
@@ -392,18 +396,27 @@ def yade_coulomb(zeta: float, w_t: float, zeta_t: float, F: float, mu: float, w0
     w0 = np.asarray(w0, dtype=float)
     lever = None if rho is None else 1.0 / np.broadcast_to(np.asarray(rho, dtype=float),
                                                          w0.shape)
+    per_point = any(np.ndim(a) for a in (zeta, w_t, zeta_t, F))
+    if per_point:  # one contact per point: flat arrays like _stepped's state
+        zeta, w_t, zeta_t, F = (np.broadcast_to(np.asarray(a, dtype=float), w0.shape).ravel()
+                                for a in (zeta, w_t, zeta_t, F))
     k_t = w_t * w_t / F  # tangential stiffness per unit mass (contact-point mass m / F)
     c_t = 2.0 * zeta_t * w_t / F
+    stiff = k_t > 0.0
+    k_safe = np.where(stiff, k_t, 1.0) if per_point else k_t
 
     def force(x, v, s, w, alpha, cap):
         f = np.maximum(x + 2.0 * zeta * v, 0.0)
         el = k_t * s  # the incremental elastic force: the sum of k_t w dt
         over = np.abs(el) > cap * f
         el = np.where(over, np.sign(el) * cap * f, el)
-        if k_t > 0.0:
+        if per_point:
+            s = np.where(over & stiff, el / k_safe, s)
+        elif k_t > 0.0:
             s = np.where(over, el / k_t, s)
         return f, el + np.where(over, 0.0, c_t * w), s
-    return _stepped(np.zeros(w0.shape), w0, mu, steps, force, F, lever, contact_time=math.pi)
+    return _stepped(np.zeros(w0.shape), w0, mu, steps, force,
+                    np.reshape(F, w0.shape) if per_point else F, lever, contact_time=math.pi)
 
 
 def mfix_coulomb(zeta: float, w_t: float, zeta_t, F: float, mu: float, w0,

@@ -34,7 +34,14 @@ from typing import Any
 import numpy as np
 
 from vimpact.dem import laws, linear
-from vimpact.dem.fit import ContactFit, Residual, Targets, fit_constant, fit_scalar
+from vimpact.dem.fit import (
+    ContactFit,
+    Residual,
+    Targets,
+    fit_constant,
+    fit_scalar,
+    fit_scalar_many,
+)
 from vimpact.dem.problem import Contact, DemProblem, WallType
 
 CODE = "yade"
@@ -83,6 +90,30 @@ def yade_law(tc: float, en: float, et: float, q: float, F: float, m: float = 1.0
     return e, beta, t / w0
 
 
+#: time steps per contact of the stepped law in the search of ``et`` (the reported beta: the
+#: law's default, :data:`vimpact.dem.laws.FRICTION_STEPS`)
+FIT_STEPS = 1000
+
+
+def _tangential_law(tc: float, en: float, et: float, q: float, F: float
+                    ) -> tuple[float, float, float, float]:
+    """Yade's law in the units of :func:`vimpact.dem.laws.yade_coulomb`, per unit ``massR / q``.
+
+    Returns ``(zeta, w_t, zeta_t, omega0)``: the normal damping ratio, the tangential
+    oscillator of the contact point (angular frequency over ``omega0``, damping ratio)
+    and ``omega0`` (1/s) for an effective mass of 1 kg; ``tc`` in s, the rest as in
+    :func:`yade_law`.
+    """
+    mR = q
+    kn = mR * (math.pi**2 + linear.ln2(en)) / tc**2
+    cn = -2.0 * mR * math.log(en) / tc
+    ks = 2.0 / 7.0 * mR * (math.pi**2 + linear.ln2(et)) / tc**2
+    cs = -4.0 / 7.0 * mR * math.log(et) / tc
+    w0n = math.sqrt(kn)
+    w_t = math.sqrt(ks * F)
+    return cn / (2.0 * math.sqrt(kn)), w_t / w0n, cs * F / (2.0 * w_t), w0n
+
+
 def yade_oblique(tc: float, en: float, et: float, q: float, F: float, mu: float, w0,
                  steps: int | None = None, R: float | None = None, v=None) -> np.ndarray:
     """Return Yade's ``beta`` in oblique impacts with Coulomb friction ``mu`` at ``w0 = v_c0 / v_z0``.
@@ -93,16 +124,36 @@ def yade_oblique(tc: float, en: float, et: float, q: float, F: float, mu: float,
     like ``w0``): Yade's wall contact, whose contact point is on the wall plane (lever
     ``R - delta``), so that ``beta`` shifts by about ``delta/R`` with the speed.
     """
-    mR = q
-    kn = mR * (math.pi**2 + linear.ln2(en)) / tc**2
-    cn = -2.0 * mR * math.log(en) / tc
-    ks = 2.0 / 7.0 * mR * (math.pi**2 + linear.ln2(et)) / tc**2
-    cs = -4.0 / 7.0 * mR * math.log(et) / tc
-    w0n = math.sqrt(kn)
-    w_t = math.sqrt(ks * F)
+    zeta, w_t, zeta_t, w0n = _tangential_law(tc, en, et, q, F)
     rho = None if R is None else R * w0n / np.asarray(v, dtype=float)
-    return laws.yade_coulomb(cn / (2.0 * math.sqrt(kn)), w_t / w0n, cs * F / (2.0 * w_t), F, mu,
-                             w0, steps or laws.FRICTION_STEPS, rho)[1]
+    return laws.yade_coulomb(zeta, w_t, zeta_t, F, mu, w0, steps or laws.FRICTION_STEPS, rho)[1]
+
+
+def yade_oblique_many(cases: list[dict[str, Any]], steps: int | None = None) -> list[np.ndarray]:
+    """:func:`yade_oblique` of several contacts (or candidates) in one stepped call.
+
+    ``cases``: one dict of :func:`yade_oblique`'s arguments per case (``tc``, ``en``,
+    ``et``, ``q``, ``F``, ``mu``, ``w0``, and ``R``, ``v`` for Yade's wall contact);
+    every point of every case is stepped at once with its own constants (the law is
+    elementwise), so each case gets exactly what :func:`yade_oblique` gives it alone.
+    """
+    cols: dict[str, list[np.ndarray]] = {k: [] for k in ("zeta", "w_t", "zeta_t", "F", "mu",
+                                                          "w0", "rho")}
+    for cs in cases:
+        w0 = np.asarray(cs["w0"], dtype=float).ravel()
+        zeta, w_t, zeta_t, w0n = _tangential_law(cs["tc"], cs["en"], cs["et"], cs["q"], cs["F"])
+        for k, val in (("zeta", zeta), ("w_t", w_t), ("zeta_t", zeta_t), ("F", cs["F"]),
+                       ("mu", cs["mu"])):
+            cols[k].append(np.full(w0.size, float(val)))
+        cols["w0"].append(w0)
+        # an infinite radius (in v0/omega0) is the arm R of the one-contact law
+        cols["rho"].append(np.full(w0.size, math.inf) if cs.get("R") is None else
+                           np.broadcast_to(cs["R"] * w0n / np.asarray(cs["v"], dtype=float),
+                                           w0.shape))
+    flat = {k: np.concatenate(v) for k, v in cols.items()}
+    beta = laws.yade_coulomb(flat["zeta"], flat["w_t"], flat["zeta_t"], flat["F"], flat["mu"],
+                             flat["w0"], steps or laws.FRICTION_STEPS, flat["rho"])[1]
+    return np.split(beta, np.cumsum([np.size(cs["w0"]) for cs in cases])[:-1])
 
 
 def _en_for(target: float, q: float) -> float:
@@ -117,6 +168,8 @@ def _en_for(target: float, q: float) -> float:
         return lo
     for _ in range(80):  # e_of increases with en
         mid = 0.5 * (lo + hi)
+        if mid in (lo, hi):  # lo and hi are neighbouring numbers: no step changes them
+            break
         lo, hi = (mid, hi) if e_of(mid) < target else (lo, mid)
     return 0.5 * (lo + hi)
 
@@ -127,10 +180,13 @@ def fit(problem: DemProblem, targets: dict[str, Targets]) -> list[ContactFit]:
     ``en`` gives the constant closest to vimpact's ``e_z`` (Yade clips the normal
     force at zero), ``tc`` makes the contact last the Hertz contact time, ``et`` is
     fitted to vimpact's ``beta_x`` (oblique impacts with the contact's friction,
-    else full stick).
+    else full stick); the oblique fits of all contacts run in lockstep
+    (:func:`vimpact.dem.fit.fit_scalar_many`), every round's candidates in one stepped
+    call (:func:`yade_oblique_many`).
     """
     fits = []
-    for c in problem.contacts:
+    oblique: dict[int, dict[str, Any]] = {}  # contact index -> its yade_oblique arguments
+    for i, c in enumerate(problem.contacts):
         t = targets[c.key]
         q, F = mass_ratio(c), linear.mass_factor(c)
         e_const, _ = fit_constant(t.e_z, 1e-6, 1.0)
@@ -147,25 +203,13 @@ def fit(problem: DemProblem, targets: dict[str, Targets]) -> list[ContactFit]:
         if abs(F - 3.5) > 1e-9:
             notes.append(f"contact-point mass factor {F:.4g} (not 3.5: not solid spheres); "
                          "et is fitted with it")
-        b = res_b = b_ob = None
+        b = res_b = None
         et = 1.0
         ob = t.oblique
-        if ob is not None:
-            # one et closest to vimpact's oblique impacts with the contact's friction
+        if ob is not None:  # et: below, all contacts' searches in lockstep
             # Yade's wall contact point: on the wall plane, lever R - delta
-            R_arm, v_arm = (ob.R, ob.v) if c.is_wall else (None, None)
-            et, b_ob = fit_scalar(lambda x: yade_oblique(tc, en, x, q, F, c.mu, ob.w0, 1000,
-                                                         R=R_arm, v=v_arm), ob.beta_x, 1e-6, 1.0)
-            b_ob = yade_oblique(tc, en, et, q, F, c.mu, ob.w0, R=R_arm, v=v_arm)
-            res_b = Residual.of(b_ob, ob.beta_x)
-            if t.beta_x is not None:
-                b = np.full_like(t.beta_x, yade_law(tc, en, et, q, F)[1])
-            notes.append(f"et = {et:.4g} fitted to vimpact's oblique impacts with mu = {c.mu:g} "
-                         "over the impact angles" + (
-                             " (at a wall Yade's contact point is on the wall plane, lever "
-                             "R - delta: its beta shifts with the speed by about delta/R; "
-                             "included)" if c.is_wall
-                             else " (Yade's linear law: beta depends on the angle only)"))
+            oblique[i] = dict(tc=tc, en=en, q=q, F=F, mu=c.mu, w0=ob.w0,
+                              R=ob.R if c.is_wall else None, v=ob.v if c.is_wall else None)
         elif t.beta_x is not None:
             def beta(x: float) -> np.ndarray:
                 return np.full_like(t.beta_x, yade_law(tc, en, x, q, F)[1])
@@ -177,8 +221,42 @@ def fit(problem: DemProblem, targets: dict[str, Targets]) -> list[ContactFit]:
         mu = c.mu if math.isfinite(c.mu) else STICK_MU
         fits.append(ContactFit(c, {"tc": tc, "en": en, "et": et, "frictAngle": math.atan(mu),
                                    "mu": c.mu, "e_yade": e_code, "t_contact": t_h},
-                               e, b, Residual.of(e, t.e_z), res_b, notes, b_ob))
+                               e, b, Residual.of(e, t.e_z), res_b, notes))
+    if oblique:
+        _fit_oblique_et(problem, targets, fits, oblique)
     return fits
+
+
+def _fit_oblique_et(problem: DemProblem, targets: dict[str, Targets], fits: list[ContactFit],
+                    oblique: dict[int, dict[str, Any]]) -> None:
+    """Fit ``et`` of the contacts ``oblique`` (index -> :func:`yade_oblique`'s arguments).
+
+    One ``et`` per contact closest to vimpact's oblique impacts with the contact's
+    friction, all contacts' searches in lockstep; completes their fits in place.
+    """
+    keys = list(oblique)
+    obs = [ob for i in keys if (ob := targets[problem.contacts[i].key].oblique) is not None]
+
+    def predict(jobs: list[tuple[int, float]]) -> list[np.ndarray]:
+        return yade_oblique_many([dict(oblique[keys[s]], et=x) for s, x in jobs], FIT_STEPS)
+
+    ets = fit_scalar_many(predict, [ob.beta_x for ob in obs], [1e-6] * len(keys),
+                          [1.0] * len(keys))
+    betas = yade_oblique_many([dict(oblique[i], et=et) for i, et in zip(keys, ets)])
+    for i, ob, et, b_ob in zip(keys, obs, ets, betas):
+        f, a = fits[i], oblique[i]
+        c, t = f.contact, targets[f.contact.key]
+        f.params["et"] = et
+        f.beta_oblique = b_ob
+        f.res_beta_x = Residual.of(b_ob, ob.beta_x)
+        if t.beta_x is not None:
+            f.beta_x = np.full_like(t.beta_x, yade_law(a["tc"], a["en"], et, a["q"], a["F"])[1])
+        f.notes.append(f"et = {et:.4g} fitted to vimpact's oblique impacts with mu = {c.mu:g} "
+                       "over the impact angles" + (
+                           " (at a wall Yade's contact point is on the wall plane, lever "
+                           "R - delta: its beta shifts with the speed by about delta/R; "
+                           "included)" if c.is_wall
+                           else " (Yade's linear law: beta depends on the angle only)"))
 
 
 def time_step(fits: list[ContactFit], steps_per_contact: int = STEPS_PER_CONTACT) -> float:
