@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 from ..machine import figure
-from .config import INTEGRATORS
 
 
 def _cell(c) -> str:
@@ -29,7 +28,7 @@ def _summary(data: dict) -> str:
     for table in ("cheapest", "cheapest_by_time_model", "cheapest_e_z_only"):
         lines.append(f"{table}:")
         for tol, row in d[table].items():
-            cells = [f"{n} {_cell(row[n])}" for n in INTEGRATORS]
+            cells = [f"{n} {_cell(row[n])}" for n in data["integrators"]]
             if "continuum_normal_only" in row:
                 c = row["continuum_normal_only"]
                 cells.append("continuum " + (c if isinstance(c, str) else
