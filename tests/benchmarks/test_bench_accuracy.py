@@ -41,6 +41,13 @@ def test_structure_and_plot(data, integrators, tmp_path):
     assert set(data["presets"]) | set(data["presets_not_on_elements"]) == set(v.PRESETS)
     assert not set(data["presets"]) & set(data["presets_not_on_elements"])
     assert set(data["presets_as_routed"]) == set(v.PRESETS)
+    # the text summary and the headline figures (a failed setting has error None: the
+    # quick run's envelope model check at 4/26 is one)
+    text = accuracy.report(data)
+    assert all(f"{n} front:" in text for n in names)
+    assert all(f"preset {p}: not run on the element path" in text
+               for p in data["presets_not_on_elements"])
+    assert set(accuracy.figures(data)) >= {f"preset_{p}_error" for p in data["presets"]}
     for key in ("cheapest", "cheapest_by_time_model", "cheapest_e_z_only",
                 "euler_over_verlet_time", "orders", "error_models", "suggested_presets"):
         assert key in data["derived"]
