@@ -3,9 +3,9 @@ and its derived numbers are consistent (no time is asserted).
 
 The default run checks the quick configuration as ``vimpact bench accuracy --quick``
 runs it: the Verlet ladder, whose element kernels the rest of the suite compiles
-anyway. The explicit and semi-implicit Euler ladders run oblique scenes on kernels
-nothing else needs (about 25 s of compiling on a fresh clone), so the same checks on
-every integrator are marked slow."""
+anyway. The explicit and semi-implicit Euler ladders run the oblique scenes through
+parallel batch kernels nothing else compiles, so the same checks on every integrator
+are marked slow."""
 
 import json
 import math

@@ -52,9 +52,10 @@ CONFIGS: dict[str, dict[str, Any]] = {
     ),
     "quick": dict(
         # Verlet only and Kelvin-Voigt only: the explicit and semi-implicit Euler ladders
-        # run oblique scenes on element kernels (about 25 s of compiling on a fresh clone)
-        # that nothing but this benchmark needs, a standard solid two more (about 50 s);
-        # run(quick=True, integrators=INTEGRATORS) adds the Euler ladders
+        # run the oblique scenes through parallel batch kernels that nothing else in the
+        # default test run compiles, a standard solid would add two more element kernels
+        # (about 50 s on a fresh clone); run(quick=True, integrators=INTEGRATORS) adds
+        # the Euler ladders
         integrators=("verlet",),
         scenes=[(0.1, 0.5, None), (1.0, 0.0, None), (0.3, 0.25, None)],
         ladders={
