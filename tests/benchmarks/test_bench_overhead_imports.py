@@ -31,7 +31,9 @@ def test_registry_loads_every_benchmark():
 
 def test_overhead_through_the_command(tmp_path, monkeypatch, capsys):
     monkeypatch.setitem(overhead.CONFIGS, "quick", dict(kv_rows=2000, kv_repeats=2,
-                                                        element_rows=40, element_repeats=2))
+                                                        element_rows=40, element_repeats=2,
+                                                        one_impact_calls=20,
+                                                        one_impact_repeats=3))
     assert main(["bench", "overhead", "--quick", "--out", str(tmp_path)]) == 0
     out = capsys.readouterr().out
     assert out.startswith("machine: ") and "continuum_overhead_us_per_row" in out

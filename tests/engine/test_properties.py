@@ -163,10 +163,13 @@ def test_random_scenes_converged(ds):
 
 
 def test_strategy_reaches_the_corners():
-    """The draws cover every rheology, v_c0 = 0 and both ends of nu and theta."""
+    """The draws cover every rheology, v_c0 = 0 and both ends of nu and theta.
+
+    Within 300 draws (each property test above draws 160 to 240 scenes; a corner
+    rarer than that would hardly reach them; all corners appear by 200)."""
     seen = []
 
-    @settings(max_examples=1000, **SETTINGS)
+    @settings(max_examples=300, **SETTINGS)
     @given(draws())
     def collect(d):
         seen.append(d)

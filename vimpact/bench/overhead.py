@@ -64,10 +64,12 @@ TARGET_OVERHEAD_US_PER_ROW = 5.0
 TARGET_KV_ROWS_PER_SECOND = 50_000.0
 THREADS = 2
 
-#: rows and repeats of each measurement
+#: rows and repeats of each measurement; calls per sample and samples of one impact
 CONFIGS = {
-    "full": dict(kv_rows=100_000, kv_repeats=7, element_rows=10_000, element_repeats=5),
-    "quick": dict(kv_rows=100_000, kv_repeats=3, element_rows=1_000, element_repeats=3),
+    "full": dict(kv_rows=100_000, kv_repeats=7, element_rows=10_000, element_repeats=5,
+                 one_impact_calls=1000, one_impact_repeats=7),
+    "quick": dict(kv_rows=100_000, kv_repeats=3, element_rows=1_000, element_repeats=3,
+                  one_impact_calls=200, one_impact_repeats=3),
 }
 
 
@@ -241,7 +243,8 @@ def one_impact(quick: bool = False) -> dict:
     from vimpact.engine.routing import route
     from vimpact.engine.simulate import run_columns
 
-    calls, repeats = (200, 3) if quick else (1000, 7)
+    cfg = CONFIGS["quick" if quick else "full"]
+    calls, repeats = cfg["one_impact_calls"], cfg["one_impact_repeats"]
     # the engine as of BEFORE_COMMIT (current kernels and model), if at hand
     old_engine = package_at_commit(BEFORE_COMMIT, "vimpact.engine")
     before = None if old_engine is None else old_engine.simulate.simulate

@@ -6,7 +6,11 @@ an error model to pick numerics.
 Run: ``vimpact bench accuracy [--quick] [--out DIR]`` (writes ``DIR/accuracy.json``
 and ``accuracy.png``); the full-size run of the repository is
 ``python -m benchmarks.accuracy`` (``benchmarks/results/accuracy.json`` and
-``accuracy_pareto.png``).
+``accuracy_pareto.png``). The full run measures every integrator; the quick one
+the Verlet ladder only (``CONFIGS["quick"]["integrators"]``: the Euler ladders
+compile element kernels of their own), ``run(quick=True, integrators=INTEGRATORS)``
+all three. Presets whose integrator a run leaves out are measured as routed only
+(``presets_not_on_elements`` says which).
 
 - Scenes: oblique impacts (``v_c0 != 0``, so ``e_x`` is computed), Kelvin-Voigt
   at ``nu = 0`` and ``0.5`` and the standard solid at ``Q2 = 0.1`` and ``10``

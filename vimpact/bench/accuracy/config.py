@@ -9,6 +9,7 @@ import math
 from typing import Any
 
 TOLERANCES = (1e-3, 1e-4, 1e-5, 1e-6, 1e-7)
+#: every integrator the benchmark knows (a configuration's ``integrators`` picks from them)
 INTEGRATORS = ("verlet", "symplectic_euler", "euler")
 THESIS_TABLE_4_1 = {500: 1.1254, 1000: 0.5608, 5000: 0.1119, 10000: 0.0559}  # percent
 THREADS = 2
@@ -27,12 +28,13 @@ def _sqrt2(start: int, stop: int) -> list[int]:
     return [int(round(start * 2 ** (k / 2))) for k in range(n + 1)]
 
 
-#: scenes, ladders, continuum tolerances, timing.
+#: integrators, scenes, ladders, continuum tolerances, timing.
 #: A ladder is the base grid ``steps x elements`` (factor 2, products capped)
 #: and optionally a refinement: the factor-sqrt(2) grid in a band of
 #: ``steps / elements`` where the front lies.
 CONFIGS: dict[str, dict[str, Any]] = {
     "full": dict(
+        integrators=INTEGRATORS,
         q1=[1e-3, 1e-2, 1e-1, 1.0, 10.0],
         kv_nu=[0.0, 0.5], sls_q2=[0.1, 10.0], sls_nu=0.5,
         ladders={
@@ -49,9 +51,12 @@ CONFIGS: dict[str, dict[str, Any]] = {
         repeats=3, target_batch_seconds=0.2, max_copies=256,
     ),
     "quick": dict(
-        # Kelvin-Voigt only: a standard solid here would compile two element kernels
-        # (explicit and semi-implicit Euler with arms, about 50 s on a fresh clone) that
-        # nothing else in the default test run needs
+        # Verlet only and Kelvin-Voigt only: the explicit and semi-implicit Euler ladders
+        # run the oblique scenes through parallel batch kernels that nothing else in the
+        # default test run compiles, a standard solid would add two more element kernels
+        # (about 50 s on a fresh clone); run(quick=True, integrators=INTEGRATORS) adds
+        # the Euler ladders
+        integrators=("verlet",),
         scenes=[(0.1, 0.5, None), (1.0, 0.0, None), (0.3, 0.25, None)],
         ladders={
             "verlet": dict(steps=[100, 200], elements=[20, 40], cap=200 * 40,

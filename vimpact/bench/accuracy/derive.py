@@ -33,7 +33,8 @@ def derive(out: dict, floors: dict, cfg: dict, scenes: list, ref: dict, timer: T
     """
     derived: dict[str, Any] = {}
     models: dict[str, dict[str, Any]] = {}
-    for n in INTEGRATORS:
+    names = tuple(out["integrators"])  # this run's integrators (Verlet among them)
+    for n in names:
         rows = out["integrators"][n]["settings"]
         S = [r["steps"] for r in rows]
         E = [r["elements"] for r in rows]
@@ -68,7 +69,7 @@ def derive(out: dict, floors: dict, cfg: dict, scenes: list, ref: dict, timer: T
             derived[table][f"{tol:g}"] = {
                 "verifiable": tol >= floor,
                 **{n: _cheapest(out["integrators"][n]["settings"], tol, key)
-                   for n in INTEGRATORS}}
+                   for n in names}}
     for tol in TOLERANCES:
         cont = [c for c in out["continuum"] if c["e_z_error_max"] is not None
                 and c["e_z_error_max"] <= tol]
@@ -77,10 +78,12 @@ def derive(out: dict, floors: dict, cfg: dict, scenes: list, ref: dict, timer: T
     # the same ranked by the fitted time model (measured errors): robust to timing noise
     derived["cheapest_by_time_model"] = {
         f"{tol:g}": {n: _cheapest(out["integrators"][n]["settings"], tol, "error",
-                                  by="model_seconds_per_impact") for n in INTEGRATORS}
+                                  by="model_seconds_per_impact") for n in names}
         for tol in TOLERANCES}
 
     def _ratio(tol, by, slow="euler", fast="verlet"):
+        if slow not in out["integrators"]:
+            return {"ratio": None, "why": f"{slow} is not among this run's integrators"}
         a = _cheapest(out["integrators"][slow]["settings"], tol, "error", by=by)
         b = _cheapest(out["integrators"][fast]["settings"], tol, "error", by=by)
         if isinstance(b, str):
@@ -95,7 +98,7 @@ def derive(out: dict, floors: dict, cfg: dict, scenes: list, ref: dict, timer: T
         f"{tol:g}": {"measured": _ratio(tol, "seconds_per_impact"),
                      "time_model": _ratio(tol, "model_seconds_per_impact")}
         for tol in (1e-3, 1e-4)}
-    if "default" in out["presets"]:
+    if "default" in out["presets"] and "euler" in out["integrators"]:
         d = out["presets"]["default"]
         e = _cheapest(out["integrators"]["euler"]["settings"], d["error"], "error")
         derived["default_vs_euler_same_error"] = {
@@ -104,9 +107,9 @@ def derive(out: dict, floors: dict, cfg: dict, scenes: list, ref: dict, timer: T
             "euler_over_default_time": (None if isinstance(e, str)
                                         else e["seconds_per_impact"] / d["seconds_per_impact"]),
             "target": "default at <= 1/10 of explicit Euler's time for the same error"}
-    derived["orders"] = {n: _orders(out["integrators"][n]["settings"], floors)
-                         for n in INTEGRATORS}
-    derived["orders"]["elastic_table_4_1"] = {n: out["table_4_1"][n]["order"] for n in INTEGRATORS}
+    derived["orders"] = {n: _orders(out["integrators"][n]["settings"], floors) for n in names}
+    derived["orders"]["elastic_table_4_1"] = {n: out["table_4_1"][n]["order"]
+                                              for n in INTEGRATORS if n in out["table_4_1"]}
     derived["error_models"] = models
 
     # the fitted models' choices for verlet, run and measured
@@ -132,7 +135,7 @@ def derive(out: dict, floors: dict, cfg: dict, scenes: list, ref: dict, timer: T
     derived["model_checks"] = checks
 
     # suggested presets: cheapest measured setting (by the time model) with a 2x margin
-    every = [r for n in INTEGRATORS for r in out["integrators"][n]["settings"]
+    every = [r for n in names for r in out["integrators"][n]["settings"]
              if r["error"] is not None]
     suggest = {}
     for pname, tol in (("fast", 1e-3), ("default", 1e-4), ("precise", 1e-7)):

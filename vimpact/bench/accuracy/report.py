@@ -3,7 +3,11 @@
 from __future__ import annotations
 
 from ..machine import figure
-from .config import INTEGRATORS
+
+
+def _err(x: float | None, spec: str = ".1e") -> str:
+    """Return an error as text, ``failed`` for ``None`` (no finite value: a row failed)."""
+    return "failed" if x is None else format(x, spec)
 
 
 def _cell(c) -> str:
@@ -29,7 +33,7 @@ def _summary(data: dict) -> str:
     for table in ("cheapest", "cheapest_by_time_model", "cheapest_e_z_only"):
         lines.append(f"{table}:")
         for tol, row in d[table].items():
-            cells = [f"{n} {_cell(row[n])}" for n in INTEGRATORS]
+            cells = [f"{n} {_cell(row[n])}" for n in data["integrators"]]
             if "continuum_normal_only" in row:
                 c = row["continuum_normal_only"]
                 cells.append("continuum " + (c if isinstance(c, str) else
@@ -38,21 +42,25 @@ def _summary(data: dict) -> str:
             lines.append(f"  {tol}: " + "; ".join(cells)
                          + ("" if row.get("verifiable", True) else " (below the reference's uncertainty)"))
     for tol, r in d["euler_over_verlet_time"].items():
-        lines.append(f"euler/verlet time at {tol}: measured {r['measured'].get('ratio')}, "
-                     f"time model {r['time_model'].get('ratio')}")
+        m, t = r["measured"], r["time_model"]
+        lines.append(f"euler/verlet time at {tol}: measured {m.get('ratio')}, "
+                     f"time model {t.get('ratio')}" + (f" ({m['why']})" if "why" in m else ""))
     for pname, p in data["presets"].items():
         lines.append(f"preset {pname}: {p['integrator']} {p['steps']}/{p['elements']}: error "
-                     f"{p['error']:.2e} (e_z {p['e_z_error_max']:.1e}, "
-                     f"e_x {p['e_x_error_max']:.1e})"
+                     f"{_err(p['error'], '.2e')} (e_z {_err(p['e_z_error_max'])}, "
+                     f"e_x {_err(p['e_x_error_max'])})"
                      f" @ {p['seconds_per_impact'] * 1e3:.3g} ms")
+    for pname, why in data.get("presets_not_on_elements", {}).items():
+        lines.append(f"preset {pname}: not run on the element path ({why})")
     for pname, p in data.get("presets_as_routed", {}).items():
         paths = ", ".join(f"{k} x{c}" for k, c in p["rows_per_path"].items())
-        lines.append(f"preset {pname} as routed ({paths}): error {p['error']:.2e} "
-                     f"(e_z {p['e_z_error_max']:.1e}, e_x {p['e_x_error_max']:.1e}) @ "
+        lines.append(f"preset {pname} as routed ({paths}): error {_err(p['error'], '.2e')} "
+                     f"(e_z {_err(p['e_z_error_max'])}, e_x {_err(p['e_x_error_max'])}) @ "
                      f"{p['seconds_per_impact'] * 1e3:.3g} ms")
     for r in data.get("for_tolerance", []):
         lines.append(f"for_tolerance({r['tolerance']:g}): {r['steps']}/{r['elements']} error "
-                     f"{r['error']:.1e} (met: {r['met']}) @ {r['seconds_per_impact'] * 1e3:.3g} ms")
+                     f"{_err(r['error'])} (met: {r['met']}) @ "
+                     f"{r['seconds_per_impact'] * 1e3:.3g} ms")
     scan = data.get("for_tolerance_scan")
     if scan:
         lines.append(f"for_tolerance scan ({len(scan['rows'])} tolerances "
@@ -62,7 +70,7 @@ def _summary(data: dict) -> str:
                      f"(scene {scan['worst_scene']})")
     for c in d.get("model_checks", []):
         lines.append(f"model check {c['tolerance']:g} [{c['source']}]: {c['steps']}/{c['elements']}"
-                     f" error {c['error']:.1e} (met: {c['met']}) @ "
+                     f" error {_err(c['error'])} (met: {c['met']}) @ "
                      f"{c['seconds_per_impact'] * 1e3:.3g} ms")
     for pname, p in d["suggested_presets"].items():
         lines.append(f"suggested {pname} (aim {p['aim']:g}, 2x margin reached: "

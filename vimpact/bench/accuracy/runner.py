@@ -26,9 +26,28 @@ from .measure import (
 from .models import _num, pareto
 
 
-def run(quick: bool = False) -> dict:
-    """Measure every setting, preset and path on the scenes; return the JSON-ready record."""
-    cfg = CONFIGS["quick" if quick else "full"]
+def run(quick: bool = False, integrators: tuple[str, ...] | None = None) -> dict:
+    """Measure every setting, preset and path on the scenes; return the JSON-ready record.
+
+    Parameters
+    ----------
+    quick : the small configuration (``CONFIGS["quick"]``) instead of the full one
+    integrators : whose ladders to run (names from :data:`INTEGRATORS`, ``"verlet"``
+        among them: the error models' checks and the Euler / Verlet ratio use it);
+        default: the configuration's ``integrators`` (the quick one: Verlet only)
+
+    Raises
+    ------
+    ValueError
+        if ``integrators`` names an unknown integrator or lacks ``"verlet"``.
+    """
+    cfg = dict(CONFIGS["quick" if quick else "full"])
+    if integrators is not None:
+        unknown = [n for n in integrators if n not in INTEGRATORS]
+        if unknown or "verlet" not in integrators:
+            raise ValueError(f"integrators={tuple(integrators)!r}: allowed are names from "
+                             f"{INTEGRATORS}, 'verlet' among them")
+        cfg["integrators"] = tuple(n for n in INTEGRATORS if n in integrators)
     numba.set_num_threads(min(THREADS, max_threads()))
     load_start = load_average()
     t_start = time.perf_counter()
@@ -51,7 +70,7 @@ def run(quick: bool = False) -> dict:
            "scenes": specs, "theta_ratio": 0.4, "reference": ref["json"],
            "tolerances": list(TOLERANCES), "integrators": {}}
 
-    for name in INTEGRATORS:
+    for name in cfg["integrators"]:
         # compile every kernel the scenes need outside the timing
         v.simulate_batch(scenes, v.Numerics(integrator=name, steps=16, elements=8,
                                             continuum=False))
@@ -71,12 +90,17 @@ def run(quick: bool = False) -> dict:
         }
 
     # presets on the same scenes: on the element path (what numerics.py states for
-    # them), and as routed (most of these full-stick scenes take the continuum path)
-    out["presets"], out["presets_as_routed"] = {}, {}
+    # them; those of this run's integrators), and as routed (most of these full-stick
+    # scenes take the continuum path)
+    out["presets"], out["presets_as_routed"], out["presets_not_on_elements"] = {}, {}, {}
     for pname, num in v.PRESETS.items():
-        elements = num.with_(continuum=False)
-        v.simulate_batch(scenes, elements.with_(steps=16, elements=8))
-        out["presets"][pname] = evaluate(scenes, elements, ref, timer)
+        if num.integrator in cfg["integrators"]:
+            elements = num.with_(continuum=False)
+            v.simulate_batch(scenes, elements.with_(steps=16, elements=8))
+            out["presets"][pname] = evaluate(scenes, elements, ref, timer)
+        else:
+            out["presets_not_on_elements"][pname] = (
+                f"integrator {num.integrator!r} is not among this run's {cfg['integrators']}")
         out["presets_as_routed"][pname] = evaluate(scenes, num, ref, timer)
 
     # Numerics.for_tolerance (if the package has it): measured against its target
