@@ -5,6 +5,7 @@ leaves and a dict of lattice keys, ``np.unique(axis=0)`` over the rows); the new
 must give the same arrays, hence the same lookups bit for bit.
 """
 
+import os
 from pathlib import Path
 
 import numpy as np
@@ -115,3 +116,23 @@ def test_a_leaf_node_without_a_row_is_named():
     with pytest.raises(InputError, match=f"leaf node at lattice \\({4 * _TICKS // 12},\\) "
                                          "has no row"):
         grid._kernel_arrays()
+
+
+def test_a_file_damaged_after_a_verified_open_is_still_refused(tmp_path):
+    from vimpact.tableformat.integrity import verify_table
+
+    path = tmp_path / "kv.parquet"
+    path.write_bytes((TABLES / "kelvin_voigt_table.parquet").read_bytes())
+    first = RestitutionTable.open(path)
+    again = verify_table(path, once=True)
+    assert "verified earlier by this process" in again  # the hash was not recomputed
+    assert RestitutionTable.open(path).data.equals(first.data)
+    stat = path.stat()
+    raw = bytearray(path.read_bytes())
+    raw[len(raw) // 3] ^= 0x40  # one bit in the data pages
+    path.write_bytes(bytes(raw))
+    os.utime(path, ns=(stat.st_atime_ns, stat.st_mtime_ns))  # the old modification time
+    assert path.stat().st_size == stat.st_size
+    with pytest.raises(InputError, match="integrity check"):
+        RestitutionTable.open(path)
+    assert "verified earlier" not in verify_table(TABLES / "kelvin_voigt_table.parquet")
