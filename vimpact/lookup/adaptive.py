@@ -120,6 +120,137 @@ def lattice_coordinates(keys: np.ndarray, bounds) -> np.ndarray:
     return np.exp(lb[:, 0] + u * (lb[:, 1] - lb[:, 0]))
 
 
+def _packed(keys: np.ndarray) -> np.ndarray | None:
+    """One ``uint64`` per row of lattice keys ``(n, k)``, ordered as the rows are.
+
+    ``key_0 (T + 1)**(k-1) + ... + key_(k-1)`` with ``T`` = :data:`_TICKS` (``k <= 2``:
+    below ``2**64``), so sorting the packed keys sorts the rows lexicographically, as
+    ``np.unique(keys, axis=0)`` does. None if a key lies off the lattice (``< 0`` or
+    ``> T``) or ``k > 2``.
+    """
+    keys = np.asarray(keys, dtype=np.int64)
+    k = keys.shape[1]
+    if k > 2 or (keys.size and (keys.min() < 0 or keys.max() > _TICKS)):
+        return None
+    packed = np.zeros(len(keys), dtype=np.uint64)
+    for d in range(k):
+        packed = packed * np.uint64(_TICKS + 1) + keys[:, d].astype(np.uint64)
+    return packed
+
+
+def _unique_keys(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``np.unique(keys, axis=0, return_inverse=True)`` of lattice keys ``(n, k)``.
+
+    The same arrays, sorted as one ``uint64`` per row (:func:`_packed`): 0.03 s for the
+    489,360 rows of the shipped standard-solid table, against 0.5 s for the sort of
+    rows that ``np.unique(axis=0)`` does.
+    """
+    packed = _packed(keys)
+    if packed is None:
+        unique, inverse = np.unique(keys, axis=0, return_inverse=True)
+        return unique, inverse.ravel()
+    _, first, inverse = np.unique(packed, return_index=True, return_inverse=True)
+    return np.asarray(keys, dtype=np.int64)[first], inverse.ravel()
+
+
+def _rows_of(keys: np.ndarray, wanted: np.ndarray) -> np.ndarray:
+    """Return the row of ``keys`` ``(n, k)`` that holds each lattice key of ``wanted`` ``(m, k)``.
+
+    The last such row where a key appears twice. Raises :class:`InputError` naming the
+    first key of ``wanted`` that no row holds.
+    """
+    probe = _packed(wanted)
+    stored = _packed(keys)
+    if stored is None:  # rows off the lattice hold no node: never a match
+        inside = np.all((keys >= 0) & (keys <= _TICKS), axis=1)
+        stored = np.full(len(keys), np.iinfo(np.uint64).max, dtype=np.uint64)
+        stored[inside] = _packed(keys[inside])
+    if probe is None:
+        raise InputError(f"adaptive table: a leaf node at lattice {wanted.tolist()[:1]} lies "
+                         "off the lattice")
+    order = np.argsort(stored, kind="stable")
+    ranked = stored[order]
+    at = np.searchsorted(ranked, probe, side="right") - 1
+    found = (at >= 0) & (ranked[np.maximum(at, 0)] == probe)
+    if not found.all():
+        key = tuple(int(x) for x in wanted[np.flatnonzero(~found)[0]])
+        raise InputError(f"adaptive table: the leaf node at lattice {key} has no row")
+    return order[at].astype(np.int64)
+
+
+def _cell_tree(leaves: np.ndarray, k: int) -> tuple[np.ndarray, np.ndarray]:
+    """Return the cell tree of the kernel: ``child`` ``(n_cells, 2**k)`` and ``leaf_of``.
+
+    Cells are numbered as they are first met going through the leaves in order, each
+    from the root (cell 0) down to itself; ``child[c, b]`` is the child of cell ``c``
+    whose index has bit ``d`` of ``b`` set where it is the upper half along axis ``d``
+    (-1: none), ``leaf_of[c]`` the leaf that cell ``c`` is (-1: a split cell).
+
+    Raises :class:`InputError` for a leaf that overlaps an earlier one (the first such
+    leaf in order: one that lies inside, covers, or repeats an earlier leaf), a level
+    outside ``0 ... LATTICE_LEVEL - 1`` or an index outside its level, and for leaves
+    that do not tile the square (a split cell lacks a child).
+    """
+    n = len(leaves)
+    level = leaves[:, 0].astype(np.int64)
+    index = leaves[:, 1:].astype(np.int64)
+    if n and (level.min() < 0 or level.max() > LATTICE_LEVEL - 1):
+        bad = int(np.flatnonzero((level < 0) | (level > LATTICE_LEVEL - 1))[0])
+        raise InputError(f"adaptive leaves: leaf {bad} at level {int(level[bad])} is not "
+                         f"allowed: levels 0 ... {LATTICE_LEVEL - 1}")
+    outside = np.any((index < 0) | (index >= (np.int64(1) << level)[:, None]), axis=1)
+    if outside.any():
+        bad = int(np.flatnonzero(outside)[0])
+        raise InputError(f"adaptive leaves: leaf {bad} at level {int(level[bad])}, index "
+                         f"{index[bad].tolist()} lies outside the square (0 <= index < "
+                         f"2**level)")
+    if n == 0:
+        raise InputError("adaptive leaves do not cover the table: a split cell lacks a child")
+    # every leaf's path from the root (level 0) down to itself, leaf by leaf
+    steps = level + 1
+    owner = np.repeat(np.arange(n), steps)
+    depth = np.arange(int(steps.sum())) - np.repeat(np.cumsum(steps) - steps, steps)
+    sub = index[owner] >> (level[owner] - depth)[:, None]
+    code = np.zeros(len(owner), dtype=np.int64)  # one integer per cell: level and index
+    for d in range(k):  # sub + 2**depth: its leading bit gives the level (30 bits each)
+        code = (code << 31) | (sub[:, d] + (np.int64(1) << depth))
+    own = np.cumsum(steps) - 1  # the entry of each leaf itself
+    # overlaps: a leaf n that is (or lies inside) an earlier leaf, or covers one
+    leaf_code = code[own]
+    unique_leaf, first_leaf = np.unique(leaf_code, return_index=True)
+    clash = np.full(n, n, dtype=np.int64)
+    twice = np.ones(n, dtype=bool)
+    twice[first_leaf] = False
+    clash[twice] = np.flatnonzero(twice)  # a leaf repeated: the second is the clash
+    at = np.minimum(np.searchsorted(unique_leaf, code), len(unique_leaf) - 1)
+    hit = unique_leaf[at] == code
+    other = first_leaf[at[hit]]  # the leaf whose cell is on this path
+    mine = owner[hit]
+    pair = other != mine
+    if pair.any() or twice.any():
+        worst = np.maximum(other[pair], mine[pair])
+        bad = int(min(worst.min() if worst.size else n, clash.min()))
+        raise InputError(f"adaptive leaves: leaf {bad} at level {int(level[bad])}, index "
+                         f"{index[bad].tolist()} overlaps another leaf")
+    # cells numbered in the order they are first met
+    _, first, inverse = np.unique(code, return_index=True, return_inverse=True)
+    rank = np.empty(len(first), dtype=np.int64)
+    rank[np.argsort(first, kind="stable")] = np.arange(len(first))
+    cell = rank[inverse.ravel()]
+    child = np.full((len(first), 1 << k), -1, dtype=np.int64)
+    below = depth > 0
+    which = np.zeros(len(owner), dtype=np.int64)
+    for d in range(k):
+        which |= (sub[:, d] & 1) << d
+    child[cell[np.flatnonzero(below) - 1], which[below]] = cell[below]
+    leaf = np.full(len(first), -1, dtype=np.int64)
+    leaf[cell[own]] = np.arange(n)
+    if np.any(child[leaf < 0] < 0):  # every split cell has all its children
+        raise InputError("adaptive leaves do not cover the table: a split cell lacks "
+                         "a child")
+    return child, leaf
+
+
 class AdaptiveGrid:
     """An adaptive table's cells, nodes and values, and its lookup.
 
@@ -188,50 +319,13 @@ class AdaptiveGrid:
     # ---- kernel arrays ----------------------------------------------------
     def _kernel_arrays(self) -> tuple:
         if self._kernel is None:
-            k = self.k
-            cells: dict[tuple, int] = {(0,) + (0,) * k: 0}
-            children: list[list[int]] = [[-1] * (1 << k)]
-            leaf_of = [-1]
-            for n, row in enumerate(self.leaves):
-                level, idx = int(row[0]), [int(x) for x in row[1:]]
-                parent = 0
-                for L in range(1, level + 1):
-                    if leaf_of[parent] != -1:
-                        raise InputError(f"adaptive leaves: leaf {n} at level {level}, index "
-                                         f"{idx} overlaps another leaf")
-                    sub = [i >> (level - L) for i in idx]
-                    key = (L, *sub)
-                    cell = cells.get(key)
-                    if cell is None:
-                        cell = len(children)
-                        cells[key] = cell
-                        children.append([-1] * (1 << k))
-                        leaf_of.append(-1)
-                        c = sum((s & 1) << d for d, s in enumerate(sub))
-                        children[parent][c] = cell
-                    parent = cell
-                if leaf_of[parent] != -1 or any(c >= 0 for c in children[parent]):
-                    raise InputError(f"adaptive leaves: leaf {n} at level {level}, index {idx} "
-                                     "overlaps another leaf")
-                leaf_of[parent] = n
-            # every split cell must have all its children (the leaves tile the square)
-            child = np.array(children, dtype=np.int64)
-            leaf = np.array(leaf_of, dtype=np.int64)
-            split = leaf < 0
-            if np.any(child[split] < 0):
-                raise InputError("adaptive leaves do not cover the table: a split cell lacks "
-                                 "a child")
-            index = {tuple(key): i for i, key in enumerate(self.keys.tolist())}
-            nk = _node_keys(self.leaves[:, 0], self.leaves[:, 1:])
-            try:
-                leaf_nodes = np.array([[index[tuple(key)] for key in cell] for cell in
-                                       nk.tolist()], dtype=np.int64).reshape(-1, 4**k)
-            except KeyError as exc:
-                raise InputError(f"adaptive table: the leaf node at lattice {exc.args[0]} has "
-                                 "no row") from None
+            child, leaf = _cell_tree(self.leaves, self.k)
+            nk = _node_keys(self.leaves[:, 0], self.leaves[:, 1:]).reshape(-1, self.k)
+            leaf_nodes = _rows_of(self.keys, nk).reshape(-1, 4**self.k)
             lb = self.log_bounds
-            self._kernel = (k, np.ascontiguousarray(lb[:, 0]), np.ascontiguousarray(lb[:, 1]),
-                            child, leaf, leaf_nodes, np.ascontiguousarray(self.tensor_nodes),
+            self._kernel = (self.k, np.ascontiguousarray(lb[:, 0]),
+                            np.ascontiguousarray(lb[:, 1]), child, leaf, leaf_nodes,
+                            np.ascontiguousarray(self.tensor_nodes),
                             np.ascontiguousarray(self.values))
         return self._kernel
 
@@ -334,8 +428,7 @@ class AdaptiveGrid:
                                  f"tensor nodes {tnodes.tolist()}")
         else:
             ti = np.zeros(len(data), dtype=np.int64)
-        keys, inverse = np.unique(keys_all, axis=0, return_inverse=True)
-        inverse = inverse.ravel()
+        keys, inverse = _unique_keys(keys_all)
         ok = data["status"].astype(str).isin(["ok"]).to_numpy()
         values = {}
         count = np.zeros((len(keys), len(tnodes)), dtype=np.int64)

@@ -143,12 +143,16 @@ class RestitutionTable:
         its rows (:func:`validate_table`: vimpact metadata, known statuses, finite
         outputs within their physical bounds in data rows, axes in their domains, no
         duplicated node). ``validate=False`` skips both (to inspect a damaged file).
+        A file is read once for both; a file this process verified before and unchanged
+        since is read with its page checksums and metadata hash checked but its content
+        hash not recomputed (``verify_table(..., once=True)``).
 
         Raises
         ------
         InputError
             naming the file, the column and the offending value and row
         """
+        import pyarrow as pa
         import pyarrow.parquet as pq
 
         from vimpact.tableformat.integrity import verify_table
@@ -163,10 +167,12 @@ class RestitutionTable:
         elif not p.is_file():
             raise InputError(f"table = {str(path)!r} is not allowed: no such file "
                              "(a Parquet restitution table written by `vimpact sweep`)")
+        groups: list = []  # a file's row groups, read (and checked) once
         if validate:
-            verify_table(p)
+            verify_table(p, keep=None if p.is_dir() else groups, once=True)
         try:
-            arrow = pq.read_table(p)
+            arrow = (pq.read_table(p) if not groups else groups[0] if len(groups) == 1
+                     else pa.concat_tables(groups))
             raw = (pq.read_schema(p / COMMON_METADATA) if p.is_dir() else arrow.schema).metadata
         except Exception as exc:  # pyarrow raises several types for a bad file
             why = (str(exc).splitlines() or [""])[0]

@@ -279,7 +279,7 @@ def open_checked(path: Path):
 
 
 def scan(path: Path, hasher: ContentHash | None = None,
-         keep: list | None = None) -> tuple[dict, str, int]:
+         keep: list | None = None, content: bool = True) -> tuple[dict, str, int]:
     """Read every row group of the Parquet file ``path`` with page checksums checked.
 
     Returns the decoded ``vimpact.*`` metadata, the :class:`ContentHash` of the
@@ -287,7 +287,10 @@ def scan(path: Path, hasher: ContentHash | None = None,
     column put in canonical form once for both). ``keep`` (a list, optional)
     receives the row groups read (``pyarrow`` tables), so that a caller that needs
     the data reads the file once. Raises :class:`Damaged` for a file that cannot be
-    read back or whose stored hash (if any) differs from its data.
+    read back or whose stored hash (if any) differs from its data. ``content=False``
+    (for a file verified before, :func:`verify_table` ``once``) reads and checks the
+    pages and the metadata hash but does not recompute the content hash: the
+    returned hash is then the stored one (``""`` if none).
     """
     pf = open_checked(path)
     try:
@@ -296,6 +299,7 @@ def scan(path: Path, hasher: ContentHash | None = None,
         raise Damaged(f"schema unreadable ({first_line(exc)})") from None
     check_metadata_hash(pf.schema_arrow.metadata)
     own = ContentHash(pf.schema_arrow.names)
+    rows = 0
     for group in range(pf.metadata.num_row_groups):
         try:
             table = pf.read_row_group(group)
@@ -303,9 +307,13 @@ def scan(path: Path, hasher: ContentHash | None = None,
             why = first_line(exc)
             what = "page checksum failed" if "checksum" in why.lower() else "data unreadable"
             raise Damaged(f"{what} in row group {group} ({why})") from None
-        own.update(table, also=hasher)
+        if content:
+            own.update(table, also=hasher)
+        rows += table.num_rows
         if keep is not None:
             keep.append(table)
+    if not content:
+        return meta, str(meta.get(CONTENT_HASH_KEY, "")), rows
     digest = own.hexdigest()
     stored = meta.get(CONTENT_HASH_KEY)
     if stored is not None and stored != digest:
@@ -322,7 +330,24 @@ def rows_in_footer(pf) -> int:
 
 
 
-def verify_table(path) -> str:
+#: Files verified in full by this process with :func:`verify_table` ``once``: the file's
+#: identity (:func:`_identity`) -> its stored content hash.
+_VERIFIED: dict[tuple, str | None] = {}
+
+
+def _identity(path: Path) -> tuple:
+    """Return what identifies one version of the file ``path``.
+
+    Its resolved path, device, inode, size, and modification and status-change times
+    (ns): a write, a rename onto it, a copy over it, even one that sets the
+    modification time back, changes the status-change time.
+    """
+    st = path.stat()
+    return (str(path.resolve()), st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns,
+            st.st_ctime_ns)
+
+
+def verify_table(path, keep: list | None = None, once: bool = False) -> str:
     """Check that the table at ``path`` reads back as it was written.
 
     ``path`` is a Parquet file or a dataset directory; raise
@@ -341,7 +366,14 @@ def verify_table(path) -> str:
 
     A table without a stored content hash (written before vimpact stored one, e.g.
     a shipped table not yet regenerated) is accepted with the hash check skipped;
-    the returned text says so. Memory: one row group (part) at a time.
+    the returned text says so. Memory: one row group (part) at a time, unless ``keep``.
+
+    ``keep`` (a list, a file only): receives the row groups read (``pyarrow``
+    tables), so that a caller that uses the data reads the file once. ``once``
+    (a file only): a file this process verified in full before, unchanged since
+    (the same path, device, inode, size, modification and status-change times, and
+    stored content hash), is read again with its page checksums and metadata hash
+    checked, but its content hash is not recomputed.
 
     Returns
     -------
@@ -352,20 +384,32 @@ def verify_table(path) -> str:
     """
     path = Path(path)
     where = f"table = {str(path)!r} is not allowed"
+    seen = False  # verified before by this process (a file, once)
     if not path.exists():
         raise InputError(f"{where}: no such file or directory")
     try:
         if path.is_dir():
             rows, groups, stored = _verify_dataset(path)
         else:
-            meta, _, rows = scan(path)
+            ident = _identity(path) if once else None  # before reading: a later change shows
+            seen = ident is not None and ident in _VERIFIED
+            meta, _, rows = scan(path, keep=keep, content=not seen)
+            if seen and meta.get(CONTENT_HASH_KEY) != _VERIFIED.get(ident or ()):  # changed
+                seen = False
+                if keep is not None:
+                    keep.clear()
+                meta, _, rows = scan(path, keep=keep)
             if not meta:
                 raise Damaged("not a vimpact table (no vimpact.* metadata)")
+            if ident is not None:
+                _VERIFIED[ident] = meta.get(CONTENT_HASH_KEY)
             groups = open_checked(path).metadata.num_row_groups
             stored = CONTENT_HASH_KEY in meta
     except Damaged as exc:
         raise InputError(f"{where}: it fails the integrity check: {exc}") from None
     text = f"ok: {rows} rows, {groups} row group(s), page checksums checked where stored, "
+    if seen and stored:
+        return text + "content hash verified earlier by this process (the file is unchanged)"
     return text + ("content hash verified" if stored else
                    "no content hash stored (an older table): hash check skipped")
 
