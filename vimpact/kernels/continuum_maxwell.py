@@ -217,17 +217,7 @@ _Z_SERIES = 0.2
 _INV_FACT = np.array([1.0 / math.factorial(k) for k in range(16)])
 
 
-@jit(internal=True)
-def _n_load(n, tang):
-    return 4 + 3 * n + (4 + 3 * n if tang else 0)
-
-
-@jit(internal=True)
-def _n_unload(n, tang):
-    return 5 + 2 * n + (3 + n if tang else 0)
-
-
-@jit(internal=True)
+@jit(internal=True, nrt=False)
 def _rk_mask(phase, n, tang, mask):
     """Write the Runge-Kutta mask of a phase's state into ``mask``; return its count.
 
@@ -255,7 +245,7 @@ def _rk_mask(phase, n, tang, mask):
     return 4 + (2 if tang else 0)
 
 
-@jit(internal=True)
+@jit(internal=True, nrt=False)
 def _filter_weights(z):
     """Weights of the exact filter updates (module docstring) for ``z = Delta/tau``.
 
@@ -294,13 +284,13 @@ def _filter_weights(z):
             24.0 * p3 - 72.0 * p4)
 
 
-@jit(internal=True)
+@jit(internal=True, nrt=False)
 def _arm(x0, ez, w0, wr, wj, dt, p0, pr, j):
     """Return the quadratic-drive filter update ``exp(-z) X_0 + Delta (w_0 P_0 + w_r P_r) + w_J J``."""
     return ez * x0 + dt * (w0 * p0 + wr * pr) + wj * j
 
 
-@jit(internal=True)
+@jit(internal=True, nrt=False)
 def _arm3(x0, ez, c0, c1, cr, cj, dt, p0, dp0, pr, j):
     """Return the cubic-drive filter update of an arm quantity.
 
@@ -309,9 +299,9 @@ def _arm3(x0, ez, c0, c1, cr, cj, dt, p0, dp0, pr, j):
     return ez * x0 + dt * (c0 * p0 + c1 * dt * dp0 + cr * pr) + cj * j
 
 
-@jit(internal=True)
+@jit(internal=True, nrt=False)
 def _rhs(phase, y0, x, K, r, advance, tau0, g, itau, n, kappa, mu_t, tang, rc, hs, nh, ah,
-         e_val, kh):
+         e_val):
     """Right-hand side ``dx/dsigma`` into ``K[r]``; returns ``(F_z, F_x)``.
 
     With ``advance`` the arm quantities of ``x`` are first set by their exact
@@ -319,8 +309,9 @@ def _rhs(phase, y0, x, K, r, advance, tau0, g, itau, n, kappa, mu_t, tang, rc, h
     holds them already. Their entries of ``K[r]`` are 0. Unloading reads the
     loading history (``rc``, ``hs``, ``nh``, ``ah``) at the edge; ``e_val``
     receives the decay factors there and, at ``n``, the force density at the
-    edge (zero up to the integration error); ``e_val[n + 1:]`` (``4 n`` more) keeps
-    each arm's step weights between its strain and strain-rate updates.
+    edge (zero up to the integration error); ``e_val[n + 1:5 n + 1]`` keeps
+    each arm's step weights between its strain and strain-rate updates, and
+    ``e_val[5 n + 1]`` the loading step of the last edge (:func:`_edge`).
     """
     s = x[0]
     v = x[1]
@@ -397,7 +388,7 @@ def _rhs(phase, y0, x, K, r, advance, tau0, g, itau, n, kappa, mu_t, tang, rc, h
     if tang:
         wc = x[o]
         vc = x[o + 1]
-    k, th = _edge(rc, hs, nh, s, kh)
+    k, th = _edge(rc, hs, nh, s, e_val, 5 * n + 1)
     te = _dense(rc, k, th, np.int64(_LT))
     ue = s * s
     # the loading step's dense output at the edge, for the arm quantities there
@@ -493,24 +484,7 @@ def _rhs(phase, y0, x, K, r, advance, tau0, g, itau, n, kappa, mu_t, tang, rc, h
     return Fz, Fx
 
 
-@jit(inline="always")
-def _rhs_once(phase, y0, x, K, r, tau0, g, itau, n, kappa, mu_t, tang, rc, hs, nh, ah, e_val,
-              kh):
-    """Evaluate :func:`_rhs` at a state that holds its arm quantities (no advance).
-
-    For the few evaluations outside the steps. The right-hand side is a called
-    function, compiled once (inlined into :func:`_step` and here it was lowered
-    twice) for an ``advance`` typed bool, not a literal (which would compile it once
-    per value). This wrapper itself is inlined where it is called: compiled as a
-    function of its own it optimized and emitted all of :func:`_rhs` once more in its
-    own module, about 1 s of the 14 s of CPU of a cold ``vimpact simulate`` (measured
-    side by side, fresh cache each).
-    """
-    return _rhs(phase, y0, x, K, r, np.bool_(False), tau0, g, itau, n, kappa, mu_t, tang, rc, hs,
-                nh, ah, e_val, kh)
-
-
-@jit(internal=True)
+@jit(internal=True, nrt=False)
 def _dense(rc, k, th, c):
     """Dense-output value of component ``c`` of stored step ``k`` at ``theta = th``."""
     th1 = 1.0 - th
@@ -518,7 +492,7 @@ def _dense(rc, k, th, c):
                                                                        + th1 * rc[k, 4, c])))
 
 
-@jit(internal=True)
+@jit(internal=True, nrt=False)
 def _dense_d(rc, k, th, c):
     """``d/dtheta`` of :func:`_dense`."""
     r1 = rc[k, 1, c]
@@ -530,16 +504,17 @@ def _dense_d(rc, k, th, c):
             + (2.0 * th - 6.0 * th * th + 4.0 * th * th * th) * r4)
 
 
-@jit(inline="always")
-def _edge(rc, hs, nh, s_t, kh):
+@jit(internal=True, nrt=False)
+def _edge(rc, hs, nh, s_t, hint, ih):
     """Return the loading step ``k`` and ``theta`` with ``s(k, theta) = s_t``.
 
     ``hs`` holds ``s`` at the start of each stored step (increasing) and, at
     ``nh``, at the end of the last one. Below 0 the first step's polynomial is
     extended (``theta < 0``), above the turning point ``theta = 1``. The step
-    is searched from ``kh[0]``, the previous call's (the edge moves little
+    is searched from ``hint[ih]``, the previous call's (the edge moves little
     between calls), and stored there: the same step as a bisection over all
-    steps, the last with ``hs[k] <= s_t``.
+    steps, the last with ``hs[k] <= s_t``. (The step is an integer kept in a
+    float array: the kernel allocates no integer array.)
     """
     if s_t >= hs[nh]:
         return nh - 1, 1.0
@@ -549,12 +524,16 @@ def _edge(rc, hs, nh, s_t, kh):
         hi = 0.0
         th = s_t / (hs[1] - hs[0]) if hs[1] > hs[0] else 0.0
     else:
-        k = min(max(kh[0], 0), nh - 1)
+        k = int(hint[ih])
+        if k < 0:
+            k = 0
+        if nh - 1 < k:
+            k = nh - 1
         while k > 0 and hs[k] > s_t:
             k -= 1
         while k < nh - 1 and hs[k + 1] <= s_t:
             k += 1
-        kh[0] = k
+        hint[ih] = k
         lo = 0.0
         hi = 1.0
         th = (s_t - hs[k]) / (hs[k + 1] - hs[k])
@@ -578,9 +557,9 @@ def _edge(rc, hs, nh, s_t, kh):
     return k, th
 
 
-@jit(internal=True)
+@jit(internal=True, nrt=False)
 def _step(phase, m, y, h, K, y1, tmp, mask, n_rk, tau0, g, itau, n, kappa, mu_t, tang, rc, hs,
-          nh, ah, e_val, atol, rtol, kh):
+          nh, ah, e_val, atol, rtol):
     """Take one Dormand-Prince 5(4) step of length ``h`` (/ T) from ``y``; return its error norm.
 
     ``K[0]`` is the derivative at ``y``; ``y1`` and ``K[1..6]`` receive the new
@@ -612,7 +591,7 @@ def _step(phase, m, y, h, K, y1, tmp, mask, n_rk, tau0, g, itau, n, kappa, mu_t,
                 tmp[c] = y[c] + h * (_B1 * K[0, c] + _B3 * K[2, c] + _B4 * K[3, c]
                                      + _B5 * K[4, c] + _B6 * K[5, c])
         _rhs(phase, y, tmp, K, r, np.bool_(True), tau0, g, itau, n, kappa, mu_t, tang, rc, hs,
-             nh, ah, e_val, kh)
+             nh, ah, e_val)
     for c in range(m):
         y1[c] = tmp[c]
     acc = 0.0
@@ -625,7 +604,7 @@ def _step(phase, m, y, h, K, y1, tmp, mask, n_rk, tau0, g, itau, n, kappa, mu_t,
     return math.sqrt(acc / n_rk)
 
 
-@jit(internal=True)
+@jit(internal=True, nrt=False)
 def _store(rc, hs, ah, nh, y, y1, K, h, m, n, tang):
     """Write the dense output of an accepted loading step into row ``nh``.
 
@@ -675,7 +654,7 @@ def _grown_history(rc, hs, ah, nh):
     return rc2, hs2, ah2
 
 
-@jit(internal=True)
+@jit(internal=True, nrt=False)
 def _surface_catches(u_end, v_end, work, n, g, tau, tau0, tol):
     """Return whether the free centre element catches the sphere after separation.
 
@@ -799,9 +778,9 @@ def maxwell_stick_impact(tau0, g, tau, kappa, mu_t, tangential, rtol, max_steps,
     for i in range(n):
         glassy += ga[i]
     rtol = max(rtol / glassy, RTOL_MIN)
-    m_l = _n_load(n, tang)
-    m_u = _n_unload(n, tang)
-    mm = max(m_l, m_u)
+    m_l = 4 + 3 * n + (4 + 3 * n if tang else 0)  # state sizes: loading, unloading
+    m_u = 5 + 2 * n + (3 + n if tang else 0)
+    mm = m_l if m_l > m_u else m_u
     # absolute tolerances; heavy damping as in continuum_kv
     v_scale = 1.0
     s_scale = 1.0
@@ -819,8 +798,9 @@ def maxwell_stick_impact(tau0, g, tau, kappa, mu_t, tangential, rtol, max_steps,
     tmp = np.zeros(mm)
     mask = np.zeros(mm)
     K = np.zeros((np.int64(7), mm))
-    e_val = np.zeros(5 * n + 1)  # decay factors, edge force density, step weights
-    kh = np.zeros(1, dtype=np.int64)  # the history step of the last edge
+    # decay factors, edge force density, step weights; last: the history step of the
+    # last edge (an integer kept as a float: no second allocation type to compile)
+    e_val = np.zeros(5 * n + 2)
     cap = np.int64(64)
     rc = np.zeros((cap, np.int64(5), m_l))
     hs = np.zeros(cap + 1)
@@ -833,8 +813,8 @@ def maxwell_stick_impact(tau0, g, tau, kappa, mu_t, tangential, rtol, max_steps,
     y[1] = 1.0
     if tang:
         y[3 + 3 * n + 1] = 1.0
-    Fz, Fx = _rhs_once(phase, y, y, K, np.int64(0), tau0, ga, itau, n, kappa, mu_t, tang, rc, hs,
-                       nh, ah, e_val, kh)
+    Fz, Fx = _rhs(phase, y, y, K, np.int64(0), np.bool_(False), tau0, ga, itau, n, kappa, mu_t,
+                  tang, rc, hs, nh, ah, e_val)
     h = 0.05 * min(1.0, s_scale)
     sig = 0.0
     err_old = 1e-4
@@ -849,7 +829,7 @@ def maxwell_stick_impact(tau0, g, tau, kappa, mu_t, tangential, rtol, max_steps,
             status = STATUS_NON_FINITE
             break
         err = _step(phase, m, y, h, K, y1, tmp, mask, n_rk, tau0, ga, itau, n, kappa, mu_t, tang,
-                    rc, hs, nh, ah, e_val, atol, rtol, kh)
+                    rc, hs, nh, ah, e_val, atol, rtol)
         if not (err <= 1.0):
             h *= rejected_step_factor(err)
             rejected = True
@@ -874,7 +854,7 @@ def maxwell_stick_impact(tau0, g, tau, kappa, mu_t, tangential, rtol, max_steps,
                 if not (lo < hp < hi):
                     hp = 0.5 * (lo + hi)
                 _step(phase, m, y, hp, K, y1, tmp, mask, n_rk, tau0, ga, itau, n, kappa, mu_t,
-                      tang, rc, hs, nh, ah, e_val, atol, rtol, kh)
+                      tang, rc, hs, nh, ah, e_val, atol, rtol)
                 last_h = hp
                 gv = y1[comp]
                 if abs(gv) <= abs(best_g):
@@ -900,7 +880,7 @@ def maxwell_stick_impact(tau0, g, tau, kappa, mu_t, tangential, rtol, max_steps,
                 # is the same state; the copy loops (unrolled over the seven stages and
                 # vectorized) were a third of this function's compiled code
                 _step(phase, m, y, h, K, y1, tmp, mask, n_rk, tau0, ga, itau, n, kappa, mu_t,
-                      tang, rc, hs, nh, ah, e_val, atol, rtol, kh)
+                      tang, rc, hs, nh, ah, e_val, atol, rtol)
         if phase == 0:
             if nh + 1 >= rc.shape[0]:  # grow the history (rare: doubling)
                 rc, hs, ah = _grown_history(rc, hs, ah, nh)
@@ -957,7 +937,7 @@ def maxwell_stick_impact(tau0, g, tau, kappa, mu_t, tangential, rtol, max_steps,
             phase = np.int64(1)
             m = m_u
             n_rk = _rk_mask(phase, n, tang, mask)
-            kh[0] = nh - 1
+            e_val[5 * n + 1] = nh - 1
             for c in range(mm):
                 atol[c] = rtol
             atol[0] = rtol * s_scale
@@ -965,8 +945,8 @@ def maxwell_stick_impact(tau0, g, tau, kappa, mu_t, tangential, rtol, max_steps,
             atol[3] = rtol * (s_scale * s_scale)
             if tau0 > 0.0:
                 atol[0] = rtol * min(s_max, (v_scale / (1.25 * tau0)) ** (1.0 / 3.0))
-            Fz, Fx = _rhs_once(phase, y, y, K, np.int64(0), tau0, ga, itau, n, kappa, mu_t,
-                               tang, rc, hs, nh, ah, e_val, kh)
+            Fz, Fx = _rhs(phase, y, y, K, np.int64(0), np.bool_(False), tau0, ga, itau, n, kappa,
+                          mu_t, tang, rc, hs, nh, ah, e_val)
             # restart small: the right-hand side is not smooth in the edge state
             # at the turning point, and there the error estimate of a long step
             # misses most of its error (measured: 10-20x the error otherwise)
@@ -975,8 +955,9 @@ def maxwell_stick_impact(tau0, g, tau, kappa, mu_t, tangential, rtol, max_steps,
         if phase == 0 and y[0] * y[0] > u_max:
             u_max = y[0] * y[0]
         if n_rec > 0 and steps % rec_every == 0:
-            i_rec = _rec_state(rec, i_rec, phase, y, K, tau0, ga, itau, n, kappa, mu_t, tang, rc,
-                               hs, nh, ah, e_val, kh)
+            Fz, Fx = _rhs(phase, y, y, K, np.int64(6), np.bool_(False), tau0, ga, itau, n, kappa,
+                          mu_t, tang, rc, hs, nh, ah, e_val)
+            i_rec = _rec_state(rec, i_rec, phase, y, n, tang, Fz, Fx)
     if status == STATUS_OK and (n > 0 or tau0 > 0.0):
         # the stages K are free now: scratch of the check (no allocation here)
         for i in range(n):
@@ -985,8 +966,10 @@ def maxwell_stick_impact(tau0, g, tau, kappa, mu_t, tangential, rtol, max_steps,
         if _surface_catches(y[3], y[1], K, n, ga, ta, tau0, tol_c):
             status = STATUS_ASSUMPTION
     if n_rec > 0:
-        i_rec = _rec_state(rec, min(i_rec, n_rec - 1), phase, y, K, tau0, ga, itau, n, kappa,
-                           mu_t, tang, rc, hs, nh, ah, e_val, kh)
+        Fz, Fx = _rhs(phase, y, y, K, np.int64(6), np.bool_(False), tau0, ga, itau, n, kappa,
+                      mu_t, tang, rc, hs, nh, ah, e_val)
+        i_rec = _rec_state(rec, n_rec - 1 if n_rec - 1 < i_rec else i_rec, phase, y, n, tang,
+                           Fz, Fx)
         if status == STATUS_OK:
             rec[i_rec - 1, 4] = 0.0
             rec[i_rec - 1, 5] = 0.0
@@ -1005,12 +988,13 @@ def maxwell_stick_impact(tau0, g, tau, kappa, mu_t, tangential, rtol, max_steps,
     return i_rec
 
 
-@jit(internal=True)
-def _rec_state(rec, i_rec, phase, y, K, tau0, g, itau, n, kappa, mu_t, tang, rc, hs, nh, ah,
-               e_val, kh):
-    """Record the current state (forces recomputed at it)."""
-    Fz, Fx = _rhs_once(phase, y, y, K, np.int64(6), tau0, g, itau, n, kappa, mu_t, tang, rc, hs,
-                       nh, ah, e_val, kh)
+@jit(internal=True, nrt=False)
+def _rec_state(rec, i_rec, phase, y, n, tang, Fz, Fx):
+    """Record the current state with its forces ``Fz``, ``Fx`` (:func:`_rhs` at it).
+
+    The caller evaluates the forces: calling :func:`_rhs` from here linked and
+    optimized all of it once more in this function's own module.
+    """
     if phase == 0:
         u = y[0] * y[0]
         vc = y[3 + 3 * n + 1] if tang else 0.0

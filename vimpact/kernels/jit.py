@@ -17,7 +17,7 @@ import numba
 
 
 def jit(parallel: bool = False, inline: Literal["never", "always"] = "never",
-        internal: bool = False):
+        internal: bool = False, nrt: bool = True):
     """Return the decorator that compiles one of the package's numba kernels.
 
     ``internal``: a function only other kernels call, never Python. numba then
@@ -26,5 +26,7 @@ def jit(parallel: bool = False, inline: Literal["never", "always"] = "never",
     """
     # (numba's type stubs do not list the wrapper options)
     wrappers: dict[str, Any] = {"no_cpython_wrapper": internal, "no_cfunc_wrapper": internal}
+    if not nrt:
+        wrappers["_nrt"] = False
     return numba.njit(cache=True, error_model="numpy", parallel=parallel, inline=inline,
                       **wrappers)
