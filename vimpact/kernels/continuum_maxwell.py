@@ -313,6 +313,7 @@ def _rhs(phase, y0, x, K, r, advance, tau0, g, itau, n, kappa, mu_t, tang, rc, h
     each arm's step weights between its strain and strain-rate updates, and
     ``e_val[5 n + 1]`` the loading step of the last edge (:func:`_edge`).
     """
+    Kr = K[r]
     s = x[0]
     v = x[1]
     t = x[2]
@@ -336,49 +337,54 @@ def _rhs(phase, y0, x, K, r, advance, tau0, g, itau, n, kappa, mu_t, tang, rc, h
             vc = x[o + 1]
             accx = wc * s - x[o + 2] + tau0 * vc * s
         for i in range(n):
+            # slots of arm i: D, S, J_S and (tangential) E, U, J_U
+            iD = 3 + i
+            iS = iD + n
+            iJ = iS + n
+            iE = o + iD
+            iU = iE + n
+            iJU = iU + n
             if advance:
                 ez, w0, wr, wj, c0, c1, cr, cj = _filter_weights(dt * itau[i])
-                d = _arm3(y0[3 + i], ez, c0, c1, cr, cj, dt, y0[1], y0[la], v, du)
-                x[3 + i] = d
-                d0 = y0[3 + i]
-                x[3 + n + i] = _arm3(y0[3 + n + i], ez, c0, c1, cr, cj, dt, -d0 * rate0,
-                                     -(y0[1] - d0 * itau[i]) * rate0 - d0 * accel0, -d * rate,
-                                     x[3 + 2 * n + i] - y0[3 + 2 * n + i])
+                d = _arm3(y0[iD], ez, c0, c1, cr, cj, dt, y0[1], y0[la], v, du)
+                x[iD] = d
+                d0 = y0[iD]
+                x[iS] = _arm3(y0[iS], ez, c0, c1, cr, cj, dt, -d0 * rate0,
+                              -(y0[1] - d0 * itau[i]) * rate0 - d0 * accel0, -d * rate,
+                              x[iJ] - y0[iJ])
                 if tang:
-                    ee = _arm3(y0[o + 3 + i], ez, c0, c1, cr, cj, dt, y0[o + 1], y0[la + 1], vc,
+                    ee = _arm3(y0[iE], ez, c0, c1, cr, cj, dt, y0[o + 1], y0[la + 1], vc,
                                wc - y0[o])
-                    x[o + 3 + i] = ee
-                    e0 = y0[o + 3 + i]
-                    x[o + 3 + n + i] = _arm3(y0[o + 3 + n + i], ez, c0, c1, cr, cj, dt,
-                                             -e0 * rate0,
-                                             -(y0[o + 1] - e0 * itau[i]) * rate0 - e0 * accel0,
-                                             -ee * rate,
-                                             x[o + 3 + 2 * n + i] - y0[o + 3 + 2 * n + i])
-            d = x[3 + i]
-            acc += g[i] * (d * s + x[3 + n + i])
-            K[r, 3 + i] = 0.0
-            K[r, 3 + n + i] = 0.0
-            K[r, 3 + 2 * n + i] = -d * v
+                    x[iE] = ee
+                    e0 = y0[iE]
+                    x[iU] = _arm3(y0[iU], ez, c0, c1, cr, cj, dt, -e0 * rate0,
+                                  -(y0[o + 1] - e0 * itau[i]) * rate0 - e0 * accel0, -ee * rate,
+                                  x[iJU] - y0[iJU])
+            d = x[iD]
+            acc += g[i] * (d * s + x[iS])
+            Kr[iD] = 0.0
+            Kr[iS] = 0.0
+            Kr[iJ] = -d * v
             if tang:
-                ee = x[o + 3 + i]
-                accx += g[i] * (ee * s + x[o + 3 + n + i])
-                K[r, o + 3 + i] = 0.0
-                K[r, o + 3 + n + i] = 0.0
-                K[r, o + 3 + 2 * n + i] = -ee * v
+                ee = x[iE]
+                accx += g[i] * (ee * s + x[iU])
+                Kr[iE] = 0.0
+                Kr[iU] = 0.0
+                Kr[iJU] = -ee * v
         Fz = GN * acc
-        K[r, 0] = v
-        K[r, 1] = -2.0 * s * Fz
-        K[r, 2] = 2.0 * s
+        Kr[0] = v
+        Kr[1] = -2.0 * s * Fz
+        Kr[2] = 2.0 * s
         x[la] = -Fz
-        K[r, la] = 0.0
+        Kr[la] = 0.0
         Fx = 0.0
         if tang:
             Fx = GN * kappa * accx
-            K[r, o] = 2.0 * s * vc
-            K[r, o + 1] = -2.0 * s * mu_t * Fx
-            K[r, o + 2] = wc * v
+            Kr[o] = 2.0 * s * vc
+            Kr[o + 1] = -2.0 * s * mu_t * Fx
+            Kr[o + 2] = wc * v
             x[la + 1] = -mu_t * Fx
-            K[r, la + 1] = 0.0
+            Kr[la + 1] = 0.0
         return Fz, Fx
     u = x[3]
     du = u - y0[3]
@@ -392,9 +398,11 @@ def _rhs(phase, y0, x, K, r, advance, tau0, g, itau, n, kappa, mu_t, tang, rc, h
     te = _dense(rc, k, th, np.int64(_LT))
     ue = s * s
     # the loading step's dense output at the edge, for the arm quantities there
-    sk = rc[k, 0, _LS]
-    vk = rc[k, 0, _LV]
-    dte = te - rc[k, 0, _LT]
+    rk = rc[k, 0]  # the state at the start of step k
+    ahk = ah[k]  # its arm quantities
+    sk = rk[_LS]
+    vk = rk[_LV]
+    dte = te - rk[_LT]
     ve = _dense(rc, k, th, np.int64(_LV)) if n > 0 else 0.0
     rate_e = 0.5 * ve / s if s > 0.0 else 0.0
     rate_k = 0.5 * vk / sk if sk > 0.0 else 0.0
@@ -404,7 +412,7 @@ def _rhs(phase, y0, x, K, r, advance, tau0, g, itau, n, kappa, mu_t, tang, rc, h
     la = ol + (3 + 3 * n if tang else 0)
     ou = o + (2 + n if tang else 0)
     if sk > 0.0:
-        accel_k = 0.5 * rc[k, 0, la] / sk - 0.25 * vk * vk / (sk * sk * sk)
+        accel_k = 0.5 * rk[la] / sk - 0.25 * vk * vk / (sk * sk * sk)
     wce = 0.0
     vce = 0.0
     accx = 0.0
@@ -418,6 +426,10 @@ def _rhs(phase, y0, x, K, r, advance, tau0, g, itau, n, kappa, mu_t, tang, rc, h
     ft = 0.0
     fe = u - ue + tau0 * v
     for i in range(n):
+        iD = 4 + i  # slots of arm i: D and (tangential) E
+        iE = o + 2 + i
+        iJ = 3 + 2 * n + i  # J_S and J_U of the loading layout
+        iJU = ol + iJ
         if advance:
             ez, w0, wr, wj, c0, c1, cr, cj = _filter_weights(dt * itau[i])
             w = n + 1 + 4 * i  # the step's weights, kept for the strain rate below
@@ -425,36 +437,34 @@ def _rhs(phase, y0, x, K, r, advance, tau0, g, itau, n, kappa, mu_t, tang, rc, h
             e_val[w + 1] = w0
             e_val[w + 2] = wr
             e_val[w + 3] = wj
-            x[4 + i] = _arm3(y0[4 + i], ez, c0, c1, cr, cj, dt, y0[1], y0[ou + n], v, du)
+            x[iD] = _arm3(y0[iD], ez, c0, c1, cr, cj, dt, y0[1], y0[ou + n], v, du)
             if tang:
-                x[o + 2 + i] = _arm3(y0[o + 2 + i], ez, c0, c1, cr, cj, dt, y0[o + 1],
-                                     y0[ou + n + 1], vc, wc - y0[o])
-        d = x[4 + i]
+                x[iE] = _arm3(y0[iE], ez, c0, c1, cr, cj, dt, y0[o + 1], y0[ou + n + 1], vc,
+                              wc - y0[o])
+        d = x[iD]
         # arm quantities of the edge element at its entry (loading history)
         ez, w0, wr, wj, c0, c1, cr, cj = _filter_weights(dte * itau[i])
-        dk = ah[k, i]
-        de = _arm3(dk, ez, c0, c1, cr, cj, dte, vk, rc[k, 0, la], ve, due)
-        se = _arm3(ah[k, n + i], ez, c0, c1, cr, cj, dte, -dk * rate_k,
+        dk = ahk[i]
+        de = _arm3(dk, ez, c0, c1, cr, cj, dte, vk, rk[la], ve, due)
+        se = _arm3(ahk[n + i], ez, c0, c1, cr, cj, dte, -dk * rate_k,
                    -(vk - dk * itau[i]) * rate_k - dk * accel_k, -de * rate_e,
-                   _dense(rc, k, th, 3 + 2 * n + i) - rc[k, 0, 3 + 2 * n + i])
+                   _dense(rc, k, th, iJ) - rk[iJ])
         e = math.exp(-(t - te) * itau[i])
         e_val[i] = e
         acc += g[i] * (d * s + e * se)
         den += g[i] * e
         fe += g[i] * (d - e * de)
         ft += g[i] * e * de * itau[i]
-        K[r, 4 + i] = 0.0
+        Kr[iD] = 0.0
         if tang:
-            ee = x[o + 2 + i]
-            eee = _arm3(ah[k, 2 * n + i], ez, c0, c1, cr, cj, dte, rc[k, 0, ol + 1],
-                        rc[k, 0, la + 1], vce, wce - rc[k, 0, ol])
-            ek = ah[k, 2 * n + i]
-            ue_i = _arm3(ah[k, 3 * n + i], ez, c0, c1, cr, cj, dte, -ek * rate_k,
-                         -(rc[k, 0, ol + 1] - ek * itau[i]) * rate_k - ek * accel_k,
-                         -eee * rate_e,
-                         _dense(rc, k, th, ol + 3 + 2 * n + i) - rc[k, 0, ol + 3 + 2 * n + i])
+            ee = x[iE]
+            ek = ahk[2 * n + i]
+            eee = _arm3(ek, ez, c0, c1, cr, cj, dte, rk[ol + 1], rk[la + 1], vce, wce - rk[ol])
+            ue_i = _arm3(ahk[3 * n + i], ez, c0, c1, cr, cj, dte, -ek * rate_k,
+                         -(rk[ol + 1] - ek * itau[i]) * rate_k - ek * accel_k, -eee * rate_e,
+                         _dense(rc, k, th, iJU) - rk[iJU])
             accx += g[i] * (ee * s + e * ue_i)
-            K[r, o + 2 + i] = 0.0
+            Kr[iE] = 0.0
     Fz = GN * acc
     e_val[n] = fe
     # the arm strain rates dD_i/dt = v - D_i/tau_i, by their own filter update
@@ -466,21 +476,21 @@ def _rhs(phase, y0, x, K, r, advance, tau0, g, itau, n, kappa, mu_t, tang, rc, h
             x[ou + i] = _arm(y0[ou + i], e_val[w], e_val[w + 1], e_val[w + 2], e_val[w + 3], dt,
                              y0[ou + n], -Fz, v - y0[1])
         ft += g[i] * x[ou + i]
-        K[r, ou + i] = 0.0
+        Kr[ou + i] = 0.0
     x[ou + n] = -Fz
-    K[r, ou + n] = 0.0
+    Kr[ou + n] = 0.0
     ft += v - tau0 * Fz
-    K[r, 0] = ft / den
-    K[r, 1] = -2.0 * s * Fz
-    K[r, 2] = 2.0 * s
-    K[r, 3] = 2.0 * s * v
+    Kr[0] = ft / den
+    Kr[1] = -2.0 * s * Fz
+    Kr[2] = 2.0 * s
+    Kr[3] = 2.0 * s * v
     Fx = 0.0
     if tang:
         Fx = GN * kappa * accx
-        K[r, o] = 2.0 * s * vc
-        K[r, o + 1] = -2.0 * s * mu_t * Fx
+        Kr[o] = 2.0 * s * vc
+        Kr[o + 1] = -2.0 * s * mu_t * Fx
         x[ou + n + 1] = -mu_t * Fx
-        K[r, ou + n + 1] = 0.0
+        Kr[ou + n + 1] = 0.0
     return Fz, Fx
 
 
@@ -568,28 +578,35 @@ def _step(phase, m, y, h, K, y1, tmp, mask, n_rk, tau0, g, itau, n, kappa, mu_t,
     ``advance``). The error norm (dimensionless, 1 at the tolerance) is taken over
     the ``n_rk`` Runge-Kutta components.
     """
+    K0 = K[0]
+    K1 = K[1]
+    K2 = K[2]
+    K3 = K[3]
+    K4 = K[4]
+    K5 = K[5]
+    K6 = K[6]
     for r in range(1, 7):
         if r == 1:
             for c in range(m):
-                tmp[c] = y[c] + h * _A21 * K[0, c]
+                tmp[c] = y[c] + h * _A21 * K0[c]
         elif r == 2:
             for c in range(m):
-                tmp[c] = y[c] + h * (_A31 * K[0, c] + _A32 * K[1, c])
+                tmp[c] = y[c] + h * (_A31 * K0[c] + _A32 * K1[c])
         elif r == 3:
             for c in range(m):
-                tmp[c] = y[c] + h * (_A41 * K[0, c] + _A42 * K[1, c] + _A43 * K[2, c])
+                tmp[c] = y[c] + h * (_A41 * K0[c] + _A42 * K1[c] + _A43 * K2[c])
         elif r == 4:
             for c in range(m):
-                tmp[c] = y[c] + h * (_A51 * K[0, c] + _A52 * K[1, c] + _A53 * K[2, c]
-                                     + _A54 * K[3, c])
+                tmp[c] = y[c] + h * (_A51 * K0[c] + _A52 * K1[c] + _A53 * K2[c]
+                                     + _A54 * K3[c])
         elif r == 5:
             for c in range(m):
-                tmp[c] = y[c] + h * (_A61 * K[0, c] + _A62 * K[1, c] + _A63 * K[2, c]
-                                     + _A64 * K[3, c] + _A65 * K[4, c])
+                tmp[c] = y[c] + h * (_A61 * K0[c] + _A62 * K1[c] + _A63 * K2[c]
+                                     + _A64 * K3[c] + _A65 * K4[c])
         else:
             for c in range(m):
-                tmp[c] = y[c] + h * (_B1 * K[0, c] + _B3 * K[2, c] + _B4 * K[3, c]
-                                     + _B5 * K[4, c] + _B6 * K[5, c])
+                tmp[c] = y[c] + h * (_B1 * K0[c] + _B3 * K2[c] + _B4 * K3[c]
+                                     + _B5 * K4[c] + _B6 * K5[c])
         _rhs(phase, y, tmp, K, r, np.bool_(True), tau0, g, itau, n, kappa, mu_t, tang, rc, hs,
              nh, ah, e_val)
     for c in range(m):
@@ -597,8 +614,8 @@ def _step(phase, m, y, h, K, y1, tmp, mask, n_rk, tau0, g, itau, n, kappa, mu_t,
     acc = 0.0
     for c in range(m):
         if mask[c] > 0.0:
-            e = h * (_E1 * K[0, c] + _E3 * K[2, c] + _E4 * K[3, c] + _E5 * K[4, c]
-                     + _E6 * K[5, c] + _E7 * K[6, c])
+            e = h * (_E1 * K0[c] + _E3 * K2[c] + _E4 * K3[c] + _E5 * K4[c]
+                     + _E6 * K5[c] + _E7 * K6[c])
             sc = atol[c] + rtol * max(abs(y[c]), abs(y1[c]))
             acc += (e / sc) ** 2
     return math.sqrt(acc / n_rk)
@@ -611,15 +628,26 @@ def _store(rc, hs, ah, nh, y, y1, K, h, m, n, tang):
     Hairer, Norsett & Wanner's ``contd5`` coefficients, the step's end ``s`` and
     the arm quantities at its start.
     """
+    R0 = rc[nh, 0]
+    R1 = rc[nh, 1]
+    R2 = rc[nh, 2]
+    R3 = rc[nh, 3]
+    R4 = rc[nh, 4]
+    K0 = K[0]
+    K2 = K[2]
+    K3 = K[3]
+    K4 = K[4]
+    K5 = K[5]
+    K6 = K[6]
     for c in range(m):
         dif = y1[c] - y[c]
-        bspl = h * K[0, c] - dif
-        rc[nh, 0, c] = y[c]
-        rc[nh, 1, c] = dif
-        rc[nh, 2, c] = bspl
-        rc[nh, 3, c] = dif - h * K[6, c] - bspl
-        rc[nh, 4, c] = h * (_D1 * K[0, c] + _D3 * K[2, c] + _D4 * K[3, c] + _D5 * K[4, c]
-                            + _D6 * K[5, c] + _D7 * K[6, c])
+        bspl = h * K0[c] - dif
+        R0[c] = y[c]
+        R1[c] = dif
+        R2[c] = bspl
+        R3[c] = dif - h * K6[c] - bspl
+        R4[c] = h * (_D1 * K0[c] + _D3 * K2[c] + _D4 * K3[c] + _D5 * K4[c] + _D6 * K5[c]
+                     + _D7 * K6[c])
     hs[nh + 1] = y1[0]
     for i in range(2 * n):
         ah[nh, i] = y[3 + i]
