@@ -411,7 +411,7 @@ def test_edge_search_finds_the_step_from_any_hint():
         want = int(np.searchsorted(hs, s_t, side="right")) - 1
         for hint in (0, nh - 1, int(rng.integers(0, nh)), -5, nh + 5):
             slots = np.array([np.nan, hint, np.nan])
-            k, th = edge(rc, hs, nh, s_t, slots)
+            k, th = edge(rc.reshape(5 * nh, 1), hs, nh, s_t, slots)  # the kernel's 2-D rows
             assert k == want and slots[1] == want
             assert 0.0 <= th <= 1.0
             assert abs(rc[k, 0, 0] + th * rc[k, 1, 0] - s_t) < 1e-14  # s on the step

@@ -398,7 +398,7 @@ def _rhs(phase, y0, x, K, r, advance, tau0, g, itau, n, kappa, mu_t, tang, rc, h
     te = _dense(rc, k, th, np.int64(_LT))
     ue = s * s
     # the loading step's dense output at the edge, for the arm quantities there
-    rk = rc[k, 0]  # the state at the start of step k
+    rk = rc[5 * k]  # the state at the start of step k
     ahk = ah[k]  # its arm quantities
     sk = rk[_LS]
     vk = rk[_LV]
@@ -496,19 +496,25 @@ def _rhs(phase, y0, x, K, r, advance, tau0, g, itau, n, kappa, mu_t, tang, rc, h
 
 @jit(internal=True, nrt=False)
 def _dense(rc, k, th, c):
-    """Dense-output value of component ``c`` of stored step ``k`` at ``theta = th``."""
+    """Dense-output value of component ``c`` of stored step ``k`` at ``theta = th``.
+
+    ``rc`` holds the five coefficient rows of step ``k`` at rows ``5 k .. 5 k + 4``
+    (:func:`_store`; 2-D, so that the kernel allocates no 3-D array).
+    """
     th1 = 1.0 - th
-    return rc[k, 0, c] + th * (rc[k, 1, c] + th1 * (rc[k, 2, c] + th * (rc[k, 3, c]
-                                                                       + th1 * rc[k, 4, c])))
+    b = 5 * k
+    return rc[b, c] + th * (rc[b + 1, c] + th1 * (rc[b + 2, c] + th * (rc[b + 3, c]
+                                                                      + th1 * rc[b + 4, c])))
 
 
 @jit(internal=True, nrt=False)
 def _dense_d(rc, k, th, c):
     """``d/dtheta`` of :func:`_dense`."""
-    r1 = rc[k, 1, c]
-    r2 = rc[k, 2, c]
-    r3 = rc[k, 3, c]
-    r4 = rc[k, 4, c]
+    b = 5 * k
+    r1 = rc[b + 1, c]
+    r2 = rc[b + 2, c]
+    r3 = rc[b + 3, c]
+    r4 = rc[b + 4, c]
     # p = r0 + th r1 + th (1-th) r2 + th^2 (1-th) r3 + th^2 (1-th)^2 r4
     return (r1 + (1.0 - 2.0 * th) * r2 + (2.0 * th - 3.0 * th * th) * r3
             + (2.0 * th - 6.0 * th * th + 4.0 * th * th * th) * r4)
@@ -623,16 +629,18 @@ def _step(phase, m, y, h, K, y1, tmp, mask, n_rk, tau0, g, itau, n, kappa, mu_t,
 
 @jit(internal=True, nrt=False)
 def _store(rc, hs, ah, nh, y, y1, K, h, m, n, tang):
-    """Write the dense output of an accepted loading step into row ``nh``.
+    """Write the dense output of an accepted loading step ``nh``.
 
-    Hairer, Norsett & Wanner's ``contd5`` coefficients, the step's end ``s`` and
-    the arm quantities at its start.
+    Hairer, Norsett & Wanner's ``contd5`` coefficients into rows ``5 nh .. 5 nh + 4``
+    of ``rc``, the step's end ``s`` into ``hs[nh + 1]`` and the arm quantities at
+    its start into row ``nh`` of ``ah``.
     """
-    R0 = rc[nh, 0]
-    R1 = rc[nh, 1]
-    R2 = rc[nh, 2]
-    R3 = rc[nh, 3]
-    R4 = rc[nh, 4]
+    b = 5 * nh
+    R0 = rc[b]
+    R1 = rc[b + 1]
+    R2 = rc[b + 2]
+    R3 = rc[b + 3]
+    R4 = rc[b + 4]
     K0 = K[0]
     K2 = K[2]
     K3 = K[3]
@@ -665,13 +673,13 @@ def _grown_history(rc, hs, ah, nh):
     assignment compiles numba's shape-mismatch error message, about 25 string
     helpers; one flat loop per array instead of one per component compiles less).
     """
-    cap = rc.shape[0]
-    rc2 = np.zeros((2 * cap, rc.shape[1], rc.shape[2]))
+    cap = hs.shape[0] - 1
+    rc2 = np.zeros((2 * rc.shape[0], rc.shape[1]))
     hs2 = np.zeros(2 * cap + 1)
     ah2 = np.zeros((2 * cap, ah.shape[1]))
     src = rc.reshape(-1)
     dst = rc2.reshape(-1)
-    for j in range(nh * rc.shape[1] * rc.shape[2]):
+    for j in range(5 * nh * rc.shape[1]):
         dst[j] = src[j]
     src = ah.reshape(-1)
     dst = ah2.reshape(-1)
@@ -830,7 +838,7 @@ def maxwell_stick_impact(tau0, g, tau, kappa, mu_t, tangential, rtol, max_steps,
     # last edge (an integer kept as a float: no second allocation type to compile)
     e_val = np.zeros(5 * n + 2)
     cap = np.int64(64)
-    rc = np.zeros((cap, np.int64(5), m_l))
+    rc = np.zeros((5 * cap, m_l))  # five dense-output rows per step (_store)
     hs = np.zeros(cap + 1)
     ah = np.zeros((cap, 4 * n))
     nh = np.int64(0)
@@ -910,7 +918,7 @@ def maxwell_stick_impact(tau0, g, tau, kappa, mu_t, tangential, rtol, max_steps,
                 _step(phase, m, y, h, K, y1, tmp, mask, n_rk, tau0, ga, itau, n, kappa, mu_t,
                       tang, rc, hs, nh, ah, e_val, atol, rtol)
         if phase == 0:
-            if nh + 1 >= rc.shape[0]:  # grow the history (rare: doubling)
+            if nh + 1 >= hs.shape[0] - 1:  # grow the history (rare: doubling)
                 rc, hs, ah = _grown_history(rc, hs, ah, nh)
             _store(rc, hs, ah, nh, y, y1, K, h, m, n, tang)
             nh += 1
