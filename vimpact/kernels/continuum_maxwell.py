@@ -860,140 +860,152 @@ def maxwell_stick_impact(tau0, g, tau, kappa, mu_t, tangential, rtol, max_steps,
     u_max = 0.0
     s_max = 0.0
     t_turn = 0.0
-    while steps < max_steps:
-        if h <= 4.0 * _EPS * abs(sig) or not (h > 0.0):
-            status = STATUS_NON_FINITE
-            break
-        err = _step(phase, m, y, h, K, y1, tmp, mask, n_rk, tau0, ga, itau, n, kappa, mu_t, tang,
-                    rc, hs, nh, ah, e_val, atol, rtol)
-        if not (err <= 1.0):
-            h *= rejected_step_factor(err)
-            rejected = True
-            continue
-        steps += 1
-        h_next = h * accepted_step_factor(err, err_old, rejected)
-        err_old = max(err, 1e-4)
-        rejected = False
-        comp = 1 if phase == 0 else 0
-        event = y1[comp] <= 0.0
-        if event and y1[comp] < 0.0:
-            # re-take the step so that component comp is zero at its end
-            lo = 0.0
-            hi = h
-            g0 = y[comp]
-            best_h = h
-            best_g = y1[comp]
-            last_h = h  # the step whose state y1 and stages K[1:] hold
-            hp = h * g0 / (g0 - y1[comp])
-            tiny = 4.0 * _EPS * (abs(sig) + h)
-            for _ in range(40):
-                if not (lo < hp < hi):
-                    hp = 0.5 * (lo + hi)
-                _step(phase, m, y, hp, K, y1, tmp, mask, n_rk, tau0, ga, itau, n, kappa, mu_t,
-                      tang, rc, hs, nh, ah, e_val, atol, rtol)
-                last_h = hp
-                gv = y1[comp]
-                if abs(gv) <= abs(best_g):
-                    best_h = hp
-                    best_g = gv
-                if gv == 0.0:
-                    break
-                if gv > 0.0:
-                    lo = hp
-                else:
-                    hi = hp
-                dg = K[6, comp]
-                hn = hp - gv / dg if dg != 0.0 else 0.5 * (lo + hi)
-                if not (lo < hn < hi):
-                    hn = 0.5 * (lo + hi)
-                if abs(hn - hp) <= tiny or hi - lo <= tiny:
-                    break
-                hp = hn
-            h = best_h
-            if last_h != best_h:
-                # take the best step again rather than keep copies of every candidate's
-                # state and stages: a step is a function of (y, K[0], h) alone, so this
-                # is the same state; the copy loops (unrolled over the seven stages and
-                # vectorized) were a third of this function's compiled code
-                _step(phase, m, y, h, K, y1, tmp, mask, n_rk, tau0, ga, itau, n, kappa, mu_t,
-                      tang, rc, hs, nh, ah, e_val, atol, rtol)
-        if phase == 0:
-            if nh + 1 >= hs.shape[0] - 1:  # grow the history (rare: doubling)
-                rc, hs, ah = _grown_history(rc, hs, ah, nh)
-            _store(rc, hs, ah, nh, y, y1, K, h, m, n, tang)
-            nh += 1
-        elif y1[0] > y[0] + 100.0 * rtol * s_max:  # edge moving outward: re-entry
-            status = STATUS_ASSUMPTION
+    # the history grows (rare: doubling) outside the loop of steps, so that the
+    # arrays are not reassigned in it: numba versions a variable reassigned in a
+    # loop at every branch (SSA), and each copy of an array carries reference
+    # counting (measured: a ninth of this function's lowered code)
+    grow = False
+    while True:
+        if grow:
+            rc, hs, ah = _grown_history(rc, hs, ah, nh)
+            grow = False
+        while steps < max_steps:
+            if phase == 0 and nh + 1 >= hs.shape[0] - 1:
+                grow = True
+                break
+            if h <= 4.0 * _EPS * abs(sig) or not (h > 0.0):
+                status = STATUS_NON_FINITE
+                break
+            err = _step(phase, m, y, h, K, y1, tmp, mask, n_rk, tau0, ga, itau, n, kappa, mu_t, tang,
+                        rc, hs, nh, ah, e_val, atol, rtol)
+            if not (err <= 1.0):
+                h *= rejected_step_factor(err)
+                rejected = True
+                continue
+            steps += 1
+            h_next = h * accepted_step_factor(err, err_old, rejected)
+            err_old = max(err, 1e-4)
+            rejected = False
+            comp = 1 if phase == 0 else 0
+            event = y1[comp] <= 0.0
+            if event and y1[comp] < 0.0:
+                # re-take the step so that component comp is zero at its end
+                lo = 0.0
+                hi = h
+                g0 = y[comp]
+                best_h = h
+                best_g = y1[comp]
+                last_h = h  # the step whose state y1 and stages K[1:] hold
+                hp = h * g0 / (g0 - y1[comp])
+                tiny = 4.0 * _EPS * (abs(sig) + h)
+                for _ in range(40):
+                    if not (lo < hp < hi):
+                        hp = 0.5 * (lo + hi)
+                    _step(phase, m, y, hp, K, y1, tmp, mask, n_rk, tau0, ga, itau, n, kappa, mu_t,
+                          tang, rc, hs, nh, ah, e_val, atol, rtol)
+                    last_h = hp
+                    gv = y1[comp]
+                    if abs(gv) <= abs(best_g):
+                        best_h = hp
+                        best_g = gv
+                    if gv == 0.0:
+                        break
+                    if gv > 0.0:
+                        lo = hp
+                    else:
+                        hi = hp
+                    dg = K[6, comp]
+                    hn = hp - gv / dg if dg != 0.0 else 0.5 * (lo + hi)
+                    if not (lo < hn < hi):
+                        hn = 0.5 * (lo + hi)
+                    if abs(hn - hp) <= tiny or hi - lo <= tiny:
+                        break
+                    hp = hn
+                h = best_h
+                if last_h != best_h:
+                    # take the best step again rather than keep copies of every candidate's
+                    # state and stages: a step is a function of (y, K[0], h) alone, so this
+                    # is the same state; the copy loops (unrolled over the seven stages and
+                    # vectorized) were a third of this function's compiled code
+                    _step(phase, m, y, h, K, y1, tmp, mask, n_rk, tau0, ga, itau, n, kappa, mu_t,
+                          tang, rc, hs, nh, ah, e_val, atol, rtol)
+            if phase == 0:
+                _store(rc, hs, ah, nh, y, y1, K, h, m, n, tang)
+                nh += 1
+            elif y1[0] > y[0] + 100.0 * rtol * s_max:  # edge moving outward: re-entry
+                status = STATUS_ASSUMPTION
+                for c in range(m):
+                    y[c] = y1[c]
+                break
+            sig += h
             for c in range(m):
                 y[c] = y1[c]
-            break
-        sig += h
-        for c in range(m):
-            y[c] = y1[c]
-            K[0, c] = K[6, c]
-        h = h_next
-        finite = True
-        for c in range(m):
-            if not math.isfinite(y[c]):
-                finite = False
-        if not finite:
-            status = STATUS_NON_FINITE
-            break
-        if event and phase == 1:
-            y[0] = 0.0
-            status = STATUS_OK
-            break
-        if event:  # turning point: switch to the unloading state
-            y[1] = 0.0
-            s_max = y[0]
-            u_max = s_max * s_max
-            t_turn = y[2]
-            hs[nh] = s_max
-            # the unloading state is built in y1 (free between steps), then copied
-            z = y1
-            for c in range(mm):
-                z[c] = 0.0
-            z[0] = s_max
-            z[1] = 0.0
-            z[2] = t_turn
-            z[3] = u_max
-            for i in range(n):
-                z[4 + i] = y[3 + i]
-            if tang:
-                o = 3 + 3 * n
-                z[4 + n] = y[o]
-                z[4 + n + 1] = y[o + 1]
+                K[0, c] = K[6, c]
+            h = h_next
+            finite = True
+            for c in range(m):
+                if not math.isfinite(y[c]):
+                    finite = False
+            if not finite:
+                status = STATUS_NON_FINITE
+                break
+            if event and phase == 1:
+                y[0] = 0.0
+                status = STATUS_OK
+                break
+            if event:  # turning point: switch to the unloading state
+                y[1] = 0.0
+                s_max = y[0]
+                u_max = s_max * s_max
+                t_turn = y[2]
+                hs[nh] = s_max
+                # the unloading state is built in y1 (free between steps), then copied
+                z = y1
+                for c in range(mm):
+                    z[c] = 0.0
+                z[0] = s_max
+                z[1] = 0.0
+                z[2] = t_turn
+                z[3] = u_max
                 for i in range(n):
-                    z[4 + n + 2 + i] = y[o + 3 + i]
-            ou = 4 + n + (2 + n if tang else 0)
-            for i in range(n):
-                z[ou + i] = -z[4 + i] * itau[i]  # dD/dt = v - D/tau at v = 0
-            for c in range(mm):
-                y[c] = z[c]
-            phase = np.int64(1)
-            m = m_u
-            n_rk = _rk_mask(phase, n, tang, mask)
-            e_val[5 * n + 1] = nh - 1
-            for c in range(mm):
-                atol[c] = rtol
-            atol[0] = rtol * s_scale
-            atol[1] = rtol * v_scale
-            atol[3] = rtol * (s_scale * s_scale)
-            if tau0 > 0.0:
-                atol[0] = rtol * min(s_max, (v_scale / (1.25 * tau0)) ** (1.0 / 3.0))
-            Fz, Fx = _rhs(phase, y, y, K, np.int64(0), np.bool_(False), tau0, ga, itau, n, kappa,
-                          mu_t, tang, rc, hs, nh, ah, e_val)
-            # restart small: the right-hand side is not smooth in the edge state
-            # at the turning point, and there the error estimate of a long step
-            # misses most of its error (measured: 10-20x the error otherwise)
-            h = h_next * UNLOAD_FIRST_STEP
-            err_old = 1e-4
-        if phase == 0 and y[0] * y[0] > u_max:
-            u_max = y[0] * y[0]
-        if n_rec > 0 and steps % rec_every == 0:
-            Fz, Fx = _rhs(phase, y, y, K, np.int64(6), np.bool_(False), tau0, ga, itau, n, kappa,
-                          mu_t, tang, rc, hs, nh, ah, e_val)
-            i_rec = _rec_state(rec, i_rec, phase, y, n, tang, Fz, Fx)
+                    z[4 + i] = y[3 + i]
+                if tang:
+                    o = 3 + 3 * n
+                    z[4 + n] = y[o]
+                    z[4 + n + 1] = y[o + 1]
+                    for i in range(n):
+                        z[4 + n + 2 + i] = y[o + 3 + i]
+                ou = 4 + n + (2 + n if tang else 0)
+                for i in range(n):
+                    z[ou + i] = -z[4 + i] * itau[i]  # dD/dt = v - D/tau at v = 0
+                for c in range(mm):
+                    y[c] = z[c]
+                phase = np.int64(1)
+                m = m_u
+                n_rk = _rk_mask(phase, n, tang, mask)
+                e_val[5 * n + 1] = nh - 1
+                for c in range(mm):
+                    atol[c] = rtol
+                atol[0] = rtol * s_scale
+                atol[1] = rtol * v_scale
+                atol[3] = rtol * (s_scale * s_scale)
+                if tau0 > 0.0:
+                    atol[0] = rtol * min(s_max, (v_scale / (1.25 * tau0)) ** (1.0 / 3.0))
+                Fz, Fx = _rhs(phase, y, y, K, np.int64(0), np.bool_(False), tau0, ga, itau, n, kappa,
+                              mu_t, tang, rc, hs, nh, ah, e_val)
+                # restart small: the right-hand side is not smooth in the edge state
+                # at the turning point, and there the error estimate of a long step
+                # misses most of its error (measured: 10-20x the error otherwise)
+                h = h_next * UNLOAD_FIRST_STEP
+                err_old = 1e-4
+            if phase == 0 and y[0] * y[0] > u_max:
+                u_max = y[0] * y[0]
+            if n_rec > 0 and steps % rec_every == 0:
+                Fz, Fx = _rhs(phase, y, y, K, np.int64(6), np.bool_(False), tau0, ga, itau, n, kappa,
+                              mu_t, tang, rc, hs, nh, ah, e_val)
+                i_rec = _rec_state(rec, i_rec, phase, y, n, tang, Fz, Fx)
+        if not grow:
+            break
     if status == STATUS_OK and (n > 0 or tau0 > 0.0):
         # the stages K are free now: scratch of the check (no allocation here)
         for i in range(n):
