@@ -124,6 +124,20 @@ invalid input: ``tau0 < 0``, ``g_i < 0``, ``tau_i < 0``, NaN, ``kappa`` or
 ``mu_t`` not positive; NaN outputs); ``STATUS_ASSUMPTION`` (above).
 ``OUT_STEPS`` counts accepted steps (loading and unloading), ``OUT_N_REC``
 the trajectory rows.
+
+Compile time
+------------
+A fresh clone compiles this kernel on its first impact, so it is written to
+compile little: the helpers are called functions (numba's IR inlining costs
+more than a call), every call passes typed values (``np.int64``, ``np.bool_``:
+a literal argument compiles the callee once more), the helpers that allocate
+nothing compile without reference counting (``jit(nrt=False)``), the kernel
+allocates arrays of two types only (1-D and 2-D float: numba compiles each
+allocation type), and no array is reassigned inside the loop of steps (numba
+versions it at every branch there, each copy with its reference counting).
+numba links each callee's module into its caller's and optimizes it again
+there, so the right-hand side is called from the step and the kernel only (the
+trajectory recording takes the forces as arguments).
 """
 
 from __future__ import annotations

@@ -23,6 +23,12 @@ def jit(parallel: bool = False, inline: Literal["never", "always"] = "never",
     ``internal``: a function only other kernels call, never Python. numba then
     compiles no Python entry point for it (no argument unboxing, no C-callable
     wrapper), which every caller's module would otherwise carry along.
+
+    ``nrt=False``: compiled without numba's reference counting, for a function
+    that allocates nothing and returns no array (it only reads and writes arrays
+    its caller holds): no increment and decrement around every array argument and
+    view, less code to lower and optimize, and none of their atomic operations
+    at run time. A function that allocates must keep it on.
     """
     # (numba's type stubs do not list the wrapper options)
     wrappers: dict[str, Any] = {"no_cpython_wrapper": internal, "no_cfunc_wrapper": internal}
