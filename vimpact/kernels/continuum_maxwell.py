@@ -683,22 +683,20 @@ def _store(rc, hs, ah, nh, y, y1, K, h, m, n, tang):
 def _grown_history(rc, hs, ah, nh):
     """Return the loading history with twice the rows, the first ``nh`` steps copied.
 
-    Copied element by element over each array's contiguous prefix (an array slice
-    assignment compiles numba's shape-mismatch error message, about 25 string
-    helpers; one flat loop per array instead of one per component compiles less).
+    Copied element by element (an array slice assignment compiles numba's
+    shape-mismatch error message, about 25 string helpers; a flat view through
+    ``reshape`` compiles numba's shape normalization).
     """
     cap = hs.shape[0] - 1
     rc2 = np.zeros((2 * rc.shape[0], rc.shape[1]))
     hs2 = np.zeros(2 * cap + 1)
     ah2 = np.zeros((2 * cap, ah.shape[1]))
-    src = rc.reshape(-1)
-    dst = rc2.reshape(-1)
-    for j in range(5 * nh * rc.shape[1]):
-        dst[j] = src[j]
-    src = ah.reshape(-1)
-    dst = ah2.reshape(-1)
-    for j in range(nh * ah.shape[1]):
-        dst[j] = src[j]
+    for j in range(5 * nh):
+        for c in range(rc.shape[1]):
+            rc2[j, c] = rc[j, c]
+    for j in range(nh):
+        for c in range(ah.shape[1]):
+            ah2[j, c] = ah[j, c]
     for j in range(nh + 1):
         hs2[j] = hs[j]
     return rc2, hs2, ah2
