@@ -131,7 +131,8 @@ A fresh clone compiles this kernel on its first impact, so it is written to
 compile little: the helpers are called functions (numba's IR inlining costs
 more than a call), every call passes typed values (``np.int64``, ``np.bool_``:
 a literal argument compiles the callee once more), the helpers that allocate
-nothing compile without reference counting (``jit(nrt=False)``), the kernel
+nothing compile without reference counting (``jit(nrt=False)``), all of it
+without numba's rewrite passes (scalar code: ``jit(rewrites=False)``), the kernel
 allocates arrays of two types only (1-D and 2-D float: numba compiles each
 allocation type), and no array is reassigned inside the loop of steps (numba
 versions it at every branch there, each copy with its reference counting).
@@ -231,7 +232,7 @@ _Z_SERIES = 0.2
 _INV_FACT = np.array([1.0 / math.factorial(k) for k in range(16)])
 
 
-@jit(internal=True, nrt=False)
+@jit(internal=True, nrt=False, rewrites=False)
 def _rk_mask(phase, n, tang, mask):
     """Write the Runge-Kutta mask of a phase's state into ``mask``; return its count.
 
@@ -259,7 +260,7 @@ def _rk_mask(phase, n, tang, mask):
     return 4 + (2 if tang else 0)
 
 
-@jit(internal=True, nrt=False)
+@jit(internal=True, nrt=False, rewrites=False)
 def _filter_weights(z):
     """Weights of the exact filter updates (module docstring) for ``z = Delta/tau``.
 
@@ -298,13 +299,13 @@ def _filter_weights(z):
             24.0 * p3 - 72.0 * p4)
 
 
-@jit(internal=True, nrt=False)
+@jit(internal=True, nrt=False, rewrites=False)
 def _arm(x0, ez, w0, wr, wj, dt, p0, pr, j):
     """Return the quadratic-drive filter update ``exp(-z) X_0 + Delta (w_0 P_0 + w_r P_r) + w_J J``."""
     return ez * x0 + dt * (w0 * p0 + wr * pr) + wj * j
 
 
-@jit(internal=True, nrt=False)
+@jit(internal=True, nrt=False, rewrites=False)
 def _arm3(x0, ez, c0, c1, cr, cj, dt, p0, dp0, pr, j):
     """Return the cubic-drive filter update of an arm quantity.
 
@@ -313,7 +314,7 @@ def _arm3(x0, ez, c0, c1, cr, cj, dt, p0, dp0, pr, j):
     return ez * x0 + dt * (c0 * p0 + c1 * dt * dp0 + cr * pr) + cj * j
 
 
-@jit(internal=True, nrt=False)
+@jit(internal=True, nrt=False, rewrites=False)
 def _rhs(phase, y0, x, K, r, advance, tau0, g, itau, n, kappa, mu_t, tang, rc, hs, nh, ah,
          e_val):
     """Right-hand side ``dx/dsigma`` into ``K[r]``; returns ``(F_z, F_x)``.
@@ -508,7 +509,7 @@ def _rhs(phase, y0, x, K, r, advance, tau0, g, itau, n, kappa, mu_t, tang, rc, h
     return Fz, Fx
 
 
-@jit(internal=True, nrt=False)
+@jit(internal=True, nrt=False, rewrites=False)
 def _dense(rc, k, th, c):
     """Dense-output value of component ``c`` of stored step ``k`` at ``theta = th``.
 
@@ -521,7 +522,7 @@ def _dense(rc, k, th, c):
                                                                       + th1 * rc[b + 4, c])))
 
 
-@jit(internal=True, nrt=False)
+@jit(internal=True, nrt=False, rewrites=False)
 def _dense_d(rc, k, th, c):
     """``d/dtheta`` of :func:`_dense`."""
     b = 5 * k
@@ -534,7 +535,7 @@ def _dense_d(rc, k, th, c):
             + (2.0 * th - 6.0 * th * th + 4.0 * th * th * th) * r4)
 
 
-@jit(internal=True, nrt=False)
+@jit(internal=True, nrt=False, rewrites=False)
 def _edge(rc, hs, nh, s_t, hint, ih):
     """Return the loading step ``k`` and ``theta`` with ``s(k, theta) = s_t``.
 
@@ -587,7 +588,7 @@ def _edge(rc, hs, nh, s_t, hint, ih):
     return k, th
 
 
-@jit(internal=True, nrt=False)
+@jit(internal=True, nrt=False, rewrites=False)
 def _step(phase, m, y, h, K, y1, tmp, mask, n_rk, tau0, g, itau, n, kappa, mu_t, tang, rc, hs,
           nh, ah, e_val, atol, rtol):
     """Take one Dormand-Prince 5(4) step of length ``h`` (/ T) from ``y``; return its error norm.
@@ -641,7 +642,7 @@ def _step(phase, m, y, h, K, y1, tmp, mask, n_rk, tau0, g, itau, n, kappa, mu_t,
     return math.sqrt(acc / n_rk)
 
 
-@jit(internal=True, nrt=False)
+@jit(internal=True, nrt=False, rewrites=False)
 def _store(rc, hs, ah, nh, y, y1, K, h, m, n, tang):
     """Write the dense output of an accepted loading step ``nh``.
 
@@ -679,7 +680,7 @@ def _store(rc, hs, ah, nh, y, y1, K, h, m, n, tang):
             ah[nh, 2 * n + i] = y[o + 3 + i]
 
 
-@jit(internal=True)
+@jit(internal=True, rewrites=False)
 def _grown_history(rc, hs, ah, nh):
     """Return the loading history with twice the rows, the first ``nh`` steps copied.
 
@@ -702,7 +703,7 @@ def _grown_history(rc, hs, ah, nh):
     return rc2, hs2, ah2
 
 
-@jit(internal=True, nrt=False)
+@jit(internal=True, nrt=False, rewrites=False)
 def _surface_catches(u_end, v_end, work, n, g, tau, tau0, tol):
     """Return whether the free centre element catches the sphere after separation.
 
@@ -749,7 +750,7 @@ def _surface_catches(u_end, v_end, work, n, g, tau, tau0, tol):
     return False
 
 
-@jit()
+@jit(rewrites=False)
 def maxwell_stick_impact(tau0, g, tau, kappa, mu_t, tangential, rtol, max_steps, rec, rec_every,
                          out):
     """One full-stick impact in the continuum limit; results into ``out``.
@@ -1048,7 +1049,7 @@ def maxwell_stick_impact(tau0, g, tau, kappa, mu_t, tangential, rtol, max_steps,
     return i_rec
 
 
-@jit(internal=True, nrt=False)
+@jit(internal=True, nrt=False, rewrites=False)
 def _rec_state(rec, i_rec, phase, y, n, tang, Fz, Fx):
     """Record the current state with its forces ``Fz``, ``Fx`` (:func:`_rhs` at it).
 
