@@ -392,15 +392,15 @@ def test_step_limit():
 
 def test_edge_search_finds_the_step_from_any_hint():
     """The unloading edge's history step is searched from the previous call's
-    (``kh``): whatever the hint, it is the last loading step that starts at or
-    below the edge (what a bisection over all steps gives), and ``theta`` puts
-    the step's dense output on the edge."""
+    (kept in a float slot of the kernel's scratch): whatever the hint, it is the
+    last loading step that starts at or below the edge (what a bisection over all
+    steps gives), and ``theta`` puts the step's dense output on the edge."""
     from numba import njit
 
     from vimpact.kernels.continuum_maxwell import _edge
 
     # the kernels' internal functions have no Python entry point: call through one
-    edge = njit(lambda rc, hs, nh, s_t, kh: _edge(rc, hs, nh, s_t, kh))
+    edge = njit(lambda rc, hs, nh, s_t, hint: _edge(rc, hs, nh, s_t, hint, 1))
     rng = np.random.default_rng(3)
     nh = 40
     hs = np.concatenate([[0.0], np.cumsum(rng.uniform(0.01, 0.1, nh))])
@@ -410,9 +410,9 @@ def test_edge_search_finds_the_step_from_any_hint():
     for s_t in rng.uniform(0.0, hs[-1], 30):
         want = int(np.searchsorted(hs, s_t, side="right")) - 1
         for hint in (0, nh - 1, int(rng.integers(0, nh)), -5, nh + 5):
-            kh = np.array([hint], dtype=np.int64)
-            k, th = edge(rc, hs, nh, s_t, kh)
-            assert k == want and kh[0] == want
+            slots = np.array([np.nan, hint, np.nan])
+            k, th = edge(rc.reshape(5 * nh, 1), hs, nh, s_t, slots)  # the kernel's 2-D rows
+            assert k == want and slots[1] == want
             assert 0.0 <= th <= 1.0
             assert abs(rc[k, 0, 0] + th * rc[k, 1, 0] - s_t) < 1e-14  # s on the step
 

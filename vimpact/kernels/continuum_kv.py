@@ -302,7 +302,7 @@ def _force(s, v, tau0, unloading):
     return 1.25 * s * s * s + 1.875 * tau0 * s * v
 
 
-@jit(inline="always")
+@jit(internal=True)
 def rejected_step_factor(err):
     """Factor (< 1) for the step after a rejected one with error norm ``err`` (NaN: the smallest)."""
     if math.isfinite(err):
@@ -310,7 +310,7 @@ def rejected_step_factor(err):
     return _FAC_MIN
 
 
-@jit(inline="always")
+@jit(internal=True)
 def accepted_step_factor(err, err_old, rejected):
     """Return the PI step-size factor after an accepted step (Hairer, Norsett & Wanner).
 

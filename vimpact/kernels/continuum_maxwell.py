@@ -124,6 +124,21 @@ invalid input: ``tau0 < 0``, ``g_i < 0``, ``tau_i < 0``, NaN, ``kappa`` or
 ``mu_t`` not positive; NaN outputs); ``STATUS_ASSUMPTION`` (above).
 ``OUT_STEPS`` counts accepted steps (loading and unloading), ``OUT_N_REC``
 the trajectory rows.
+
+Compile time
+------------
+A fresh clone compiles this kernel on its first impact, so it is written to
+compile little: the helpers are called functions (numba's IR inlining costs
+more than a call), every call passes typed values (``np.int64``, ``np.bool_``:
+a literal argument compiles the callee once more), the helpers that allocate
+nothing compile without reference counting (``jit(nrt=False)``), all of it
+without numba's rewrite passes (scalar code: ``jit(rewrites=False)``), the kernel
+allocates arrays of two types only (1-D and 2-D float: numba compiles each
+allocation type), and no array is reassigned inside the loop of steps (numba
+versions it at every branch there, each copy with its reference counting).
+numba links each callee's module into its caller's and optimizes it again
+there, so the right-hand side is called from the step and the kernel only (the
+trajectory recording takes the forces as arguments).
 """
 
 from __future__ import annotations
@@ -217,17 +232,7 @@ _Z_SERIES = 0.2
 _INV_FACT = np.array([1.0 / math.factorial(k) for k in range(16)])
 
 
-@jit(internal=True)
-def _n_load(n, tang):
-    return 4 + 3 * n + (4 + 3 * n if tang else 0)
-
-
-@jit(internal=True)
-def _n_unload(n, tang):
-    return 5 + 2 * n + (3 + n if tang else 0)
-
-
-@jit(internal=True)
+@jit(internal=True, nrt=False, rewrites=False)
 def _rk_mask(phase, n, tang, mask):
     """Write the Runge-Kutta mask of a phase's state into ``mask``; return its count.
 
@@ -255,7 +260,7 @@ def _rk_mask(phase, n, tang, mask):
     return 4 + (2 if tang else 0)
 
 
-@jit(internal=True)
+@jit(internal=True, nrt=False, rewrites=False)
 def _filter_weights(z):
     """Weights of the exact filter updates (module docstring) for ``z = Delta/tau``.
 
@@ -294,13 +299,13 @@ def _filter_weights(z):
             24.0 * p3 - 72.0 * p4)
 
 
-@jit(internal=True)
+@jit(internal=True, nrt=False, rewrites=False)
 def _arm(x0, ez, w0, wr, wj, dt, p0, pr, j):
     """Return the quadratic-drive filter update ``exp(-z) X_0 + Delta (w_0 P_0 + w_r P_r) + w_J J``."""
     return ez * x0 + dt * (w0 * p0 + wr * pr) + wj * j
 
 
-@jit(internal=True)
+@jit(internal=True, nrt=False, rewrites=False)
 def _arm3(x0, ez, c0, c1, cr, cj, dt, p0, dp0, pr, j):
     """Return the cubic-drive filter update of an arm quantity.
 
@@ -309,9 +314,9 @@ def _arm3(x0, ez, c0, c1, cr, cj, dt, p0, dp0, pr, j):
     return ez * x0 + dt * (c0 * p0 + c1 * dt * dp0 + cr * pr) + cj * j
 
 
-@jit(internal=True)
+@jit(internal=True, nrt=False, rewrites=False)
 def _rhs(phase, y0, x, K, r, advance, tau0, g, itau, n, kappa, mu_t, tang, rc, hs, nh, ah,
-         e_val, kh):
+         e_val):
     """Right-hand side ``dx/dsigma`` into ``K[r]``; returns ``(F_z, F_x)``.
 
     With ``advance`` the arm quantities of ``x`` are first set by their exact
@@ -319,9 +324,11 @@ def _rhs(phase, y0, x, K, r, advance, tau0, g, itau, n, kappa, mu_t, tang, rc, h
     holds them already. Their entries of ``K[r]`` are 0. Unloading reads the
     loading history (``rc``, ``hs``, ``nh``, ``ah``) at the edge; ``e_val``
     receives the decay factors there and, at ``n``, the force density at the
-    edge (zero up to the integration error); ``e_val[n + 1:]`` (``4 n`` more) keeps
-    each arm's step weights between its strain and strain-rate updates.
+    edge (zero up to the integration error); ``e_val[n + 1:5 n + 1]`` keeps
+    each arm's step weights between its strain and strain-rate updates, and
+    ``e_val[5 n + 1]`` the loading step of the last edge (:func:`_edge`).
     """
+    Kr = K[r]
     s = x[0]
     v = x[1]
     t = x[2]
@@ -345,49 +352,54 @@ def _rhs(phase, y0, x, K, r, advance, tau0, g, itau, n, kappa, mu_t, tang, rc, h
             vc = x[o + 1]
             accx = wc * s - x[o + 2] + tau0 * vc * s
         for i in range(n):
+            # slots of arm i: D, S, J_S and (tangential) E, U, J_U
+            iD = 3 + i
+            iS = iD + n
+            iJ = iS + n
+            iE = o + iD
+            iU = iE + n
+            iJU = iU + n
             if advance:
                 ez, w0, wr, wj, c0, c1, cr, cj = _filter_weights(dt * itau[i])
-                d = _arm3(y0[3 + i], ez, c0, c1, cr, cj, dt, y0[1], y0[la], v, du)
-                x[3 + i] = d
-                d0 = y0[3 + i]
-                x[3 + n + i] = _arm3(y0[3 + n + i], ez, c0, c1, cr, cj, dt, -d0 * rate0,
-                                     -(y0[1] - d0 * itau[i]) * rate0 - d0 * accel0, -d * rate,
-                                     x[3 + 2 * n + i] - y0[3 + 2 * n + i])
+                d = _arm3(y0[iD], ez, c0, c1, cr, cj, dt, y0[1], y0[la], v, du)
+                x[iD] = d
+                d0 = y0[iD]
+                x[iS] = _arm3(y0[iS], ez, c0, c1, cr, cj, dt, -d0 * rate0,
+                              -(y0[1] - d0 * itau[i]) * rate0 - d0 * accel0, -d * rate,
+                              x[iJ] - y0[iJ])
                 if tang:
-                    ee = _arm3(y0[o + 3 + i], ez, c0, c1, cr, cj, dt, y0[o + 1], y0[la + 1], vc,
+                    ee = _arm3(y0[iE], ez, c0, c1, cr, cj, dt, y0[o + 1], y0[la + 1], vc,
                                wc - y0[o])
-                    x[o + 3 + i] = ee
-                    e0 = y0[o + 3 + i]
-                    x[o + 3 + n + i] = _arm3(y0[o + 3 + n + i], ez, c0, c1, cr, cj, dt,
-                                             -e0 * rate0,
-                                             -(y0[o + 1] - e0 * itau[i]) * rate0 - e0 * accel0,
-                                             -ee * rate,
-                                             x[o + 3 + 2 * n + i] - y0[o + 3 + 2 * n + i])
-            d = x[3 + i]
-            acc += g[i] * (d * s + x[3 + n + i])
-            K[r, 3 + i] = 0.0
-            K[r, 3 + n + i] = 0.0
-            K[r, 3 + 2 * n + i] = -d * v
+                    x[iE] = ee
+                    e0 = y0[iE]
+                    x[iU] = _arm3(y0[iU], ez, c0, c1, cr, cj, dt, -e0 * rate0,
+                                  -(y0[o + 1] - e0 * itau[i]) * rate0 - e0 * accel0, -ee * rate,
+                                  x[iJU] - y0[iJU])
+            d = x[iD]
+            acc += g[i] * (d * s + x[iS])
+            Kr[iD] = 0.0
+            Kr[iS] = 0.0
+            Kr[iJ] = -d * v
             if tang:
-                ee = x[o + 3 + i]
-                accx += g[i] * (ee * s + x[o + 3 + n + i])
-                K[r, o + 3 + i] = 0.0
-                K[r, o + 3 + n + i] = 0.0
-                K[r, o + 3 + 2 * n + i] = -ee * v
+                ee = x[iE]
+                accx += g[i] * (ee * s + x[iU])
+                Kr[iE] = 0.0
+                Kr[iU] = 0.0
+                Kr[iJU] = -ee * v
         Fz = GN * acc
-        K[r, 0] = v
-        K[r, 1] = -2.0 * s * Fz
-        K[r, 2] = 2.0 * s
+        Kr[0] = v
+        Kr[1] = -2.0 * s * Fz
+        Kr[2] = 2.0 * s
         x[la] = -Fz
-        K[r, la] = 0.0
+        Kr[la] = 0.0
         Fx = 0.0
         if tang:
             Fx = GN * kappa * accx
-            K[r, o] = 2.0 * s * vc
-            K[r, o + 1] = -2.0 * s * mu_t * Fx
-            K[r, o + 2] = wc * v
+            Kr[o] = 2.0 * s * vc
+            Kr[o + 1] = -2.0 * s * mu_t * Fx
+            Kr[o + 2] = wc * v
             x[la + 1] = -mu_t * Fx
-            K[r, la + 1] = 0.0
+            Kr[la + 1] = 0.0
         return Fz, Fx
     u = x[3]
     du = u - y0[3]
@@ -397,13 +409,15 @@ def _rhs(phase, y0, x, K, r, advance, tau0, g, itau, n, kappa, mu_t, tang, rc, h
     if tang:
         wc = x[o]
         vc = x[o + 1]
-    k, th = _edge(rc, hs, nh, s, kh)
+    k, th = _edge(rc, hs, nh, s, e_val, 5 * n + 1)
     te = _dense(rc, k, th, np.int64(_LT))
     ue = s * s
     # the loading step's dense output at the edge, for the arm quantities there
-    sk = rc[k, 0, _LS]
-    vk = rc[k, 0, _LV]
-    dte = te - rc[k, 0, _LT]
+    rk = rc[5 * k]  # the state at the start of step k
+    ahk = ah[k]  # its arm quantities
+    sk = rk[_LS]
+    vk = rk[_LV]
+    dte = te - rk[_LT]
     ve = _dense(rc, k, th, np.int64(_LV)) if n > 0 else 0.0
     rate_e = 0.5 * ve / s if s > 0.0 else 0.0
     rate_k = 0.5 * vk / sk if sk > 0.0 else 0.0
@@ -413,7 +427,7 @@ def _rhs(phase, y0, x, K, r, advance, tau0, g, itau, n, kappa, mu_t, tang, rc, h
     la = ol + (3 + 3 * n if tang else 0)
     ou = o + (2 + n if tang else 0)
     if sk > 0.0:
-        accel_k = 0.5 * rc[k, 0, la] / sk - 0.25 * vk * vk / (sk * sk * sk)
+        accel_k = 0.5 * rk[la] / sk - 0.25 * vk * vk / (sk * sk * sk)
     wce = 0.0
     vce = 0.0
     accx = 0.0
@@ -427,6 +441,10 @@ def _rhs(phase, y0, x, K, r, advance, tau0, g, itau, n, kappa, mu_t, tang, rc, h
     ft = 0.0
     fe = u - ue + tau0 * v
     for i in range(n):
+        iD = 4 + i  # slots of arm i: D and (tangential) E
+        iE = o + 2 + i
+        iJ = 3 + 2 * n + i  # J_S and J_U of the loading layout
+        iJU = ol + iJ
         if advance:
             ez, w0, wr, wj, c0, c1, cr, cj = _filter_weights(dt * itau[i])
             w = n + 1 + 4 * i  # the step's weights, kept for the strain rate below
@@ -434,36 +452,34 @@ def _rhs(phase, y0, x, K, r, advance, tau0, g, itau, n, kappa, mu_t, tang, rc, h
             e_val[w + 1] = w0
             e_val[w + 2] = wr
             e_val[w + 3] = wj
-            x[4 + i] = _arm3(y0[4 + i], ez, c0, c1, cr, cj, dt, y0[1], y0[ou + n], v, du)
+            x[iD] = _arm3(y0[iD], ez, c0, c1, cr, cj, dt, y0[1], y0[ou + n], v, du)
             if tang:
-                x[o + 2 + i] = _arm3(y0[o + 2 + i], ez, c0, c1, cr, cj, dt, y0[o + 1],
-                                     y0[ou + n + 1], vc, wc - y0[o])
-        d = x[4 + i]
+                x[iE] = _arm3(y0[iE], ez, c0, c1, cr, cj, dt, y0[o + 1], y0[ou + n + 1], vc,
+                              wc - y0[o])
+        d = x[iD]
         # arm quantities of the edge element at its entry (loading history)
         ez, w0, wr, wj, c0, c1, cr, cj = _filter_weights(dte * itau[i])
-        dk = ah[k, i]
-        de = _arm3(dk, ez, c0, c1, cr, cj, dte, vk, rc[k, 0, la], ve, due)
-        se = _arm3(ah[k, n + i], ez, c0, c1, cr, cj, dte, -dk * rate_k,
+        dk = ahk[i]
+        de = _arm3(dk, ez, c0, c1, cr, cj, dte, vk, rk[la], ve, due)
+        se = _arm3(ahk[n + i], ez, c0, c1, cr, cj, dte, -dk * rate_k,
                    -(vk - dk * itau[i]) * rate_k - dk * accel_k, -de * rate_e,
-                   _dense(rc, k, th, 3 + 2 * n + i) - rc[k, 0, 3 + 2 * n + i])
+                   _dense(rc, k, th, iJ) - rk[iJ])
         e = math.exp(-(t - te) * itau[i])
         e_val[i] = e
         acc += g[i] * (d * s + e * se)
         den += g[i] * e
         fe += g[i] * (d - e * de)
         ft += g[i] * e * de * itau[i]
-        K[r, 4 + i] = 0.0
+        Kr[iD] = 0.0
         if tang:
-            ee = x[o + 2 + i]
-            eee = _arm3(ah[k, 2 * n + i], ez, c0, c1, cr, cj, dte, rc[k, 0, ol + 1],
-                        rc[k, 0, la + 1], vce, wce - rc[k, 0, ol])
-            ek = ah[k, 2 * n + i]
-            ue_i = _arm3(ah[k, 3 * n + i], ez, c0, c1, cr, cj, dte, -ek * rate_k,
-                         -(rc[k, 0, ol + 1] - ek * itau[i]) * rate_k - ek * accel_k,
-                         -eee * rate_e,
-                         _dense(rc, k, th, ol + 3 + 2 * n + i) - rc[k, 0, ol + 3 + 2 * n + i])
+            ee = x[iE]
+            ek = ahk[2 * n + i]
+            eee = _arm3(ek, ez, c0, c1, cr, cj, dte, rk[ol + 1], rk[la + 1], vce, wce - rk[ol])
+            ue_i = _arm3(ahk[3 * n + i], ez, c0, c1, cr, cj, dte, -ek * rate_k,
+                         -(rk[ol + 1] - ek * itau[i]) * rate_k - ek * accel_k, -eee * rate_e,
+                         _dense(rc, k, th, iJU) - rk[iJU])
             accx += g[i] * (ee * s + e * ue_i)
-            K[r, o + 2 + i] = 0.0
+            Kr[iE] = 0.0
     Fz = GN * acc
     e_val[n] = fe
     # the arm strain rates dD_i/dt = v - D_i/tau_i, by their own filter update
@@ -475,71 +491,61 @@ def _rhs(phase, y0, x, K, r, advance, tau0, g, itau, n, kappa, mu_t, tang, rc, h
             x[ou + i] = _arm(y0[ou + i], e_val[w], e_val[w + 1], e_val[w + 2], e_val[w + 3], dt,
                              y0[ou + n], -Fz, v - y0[1])
         ft += g[i] * x[ou + i]
-        K[r, ou + i] = 0.0
+        Kr[ou + i] = 0.0
     x[ou + n] = -Fz
-    K[r, ou + n] = 0.0
+    Kr[ou + n] = 0.0
     ft += v - tau0 * Fz
-    K[r, 0] = ft / den
-    K[r, 1] = -2.0 * s * Fz
-    K[r, 2] = 2.0 * s
-    K[r, 3] = 2.0 * s * v
+    Kr[0] = ft / den
+    Kr[1] = -2.0 * s * Fz
+    Kr[2] = 2.0 * s
+    Kr[3] = 2.0 * s * v
     Fx = 0.0
     if tang:
         Fx = GN * kappa * accx
-        K[r, o] = 2.0 * s * vc
-        K[r, o + 1] = -2.0 * s * mu_t * Fx
+        Kr[o] = 2.0 * s * vc
+        Kr[o + 1] = -2.0 * s * mu_t * Fx
         x[ou + n + 1] = -mu_t * Fx
-        K[r, ou + n + 1] = 0.0
+        Kr[ou + n + 1] = 0.0
     return Fz, Fx
 
 
-@jit(inline="always")
-def _rhs_once(phase, y0, x, K, r, tau0, g, itau, n, kappa, mu_t, tang, rc, hs, nh, ah, e_val,
-              kh):
-    """Evaluate :func:`_rhs` at a state that holds its arm quantities (no advance).
-
-    For the few evaluations outside the steps. The right-hand side is a called
-    function, compiled once (inlined into :func:`_step` and here it was lowered
-    twice) for an ``advance`` typed bool, not a literal (which would compile it once
-    per value). This wrapper itself is inlined where it is called: compiled as a
-    function of its own it optimized and emitted all of :func:`_rhs` once more in its
-    own module, about 1 s of the 14 s of CPU of a cold ``vimpact simulate`` (measured
-    side by side, fresh cache each).
-    """
-    return _rhs(phase, y0, x, K, r, np.bool_(False), tau0, g, itau, n, kappa, mu_t, tang, rc, hs,
-                nh, ah, e_val, kh)
-
-
-@jit(internal=True)
+@jit(internal=True, nrt=False, rewrites=False)
 def _dense(rc, k, th, c):
-    """Dense-output value of component ``c`` of stored step ``k`` at ``theta = th``."""
+    """Dense-output value of component ``c`` of stored step ``k`` at ``theta = th``.
+
+    ``rc`` holds the five coefficient rows of step ``k`` at rows ``5 k .. 5 k + 4``
+    (:func:`_store`; 2-D, so that the kernel allocates no 3-D array).
+    """
     th1 = 1.0 - th
-    return rc[k, 0, c] + th * (rc[k, 1, c] + th1 * (rc[k, 2, c] + th * (rc[k, 3, c]
-                                                                       + th1 * rc[k, 4, c])))
+    b = 5 * k
+    return rc[b, c] + th * (rc[b + 1, c] + th1 * (rc[b + 2, c] + th * (rc[b + 3, c]
+                                                                      + th1 * rc[b + 4, c])))
 
 
-@jit(internal=True)
+@jit(internal=True, nrt=False, rewrites=False)
 def _dense_d(rc, k, th, c):
     """``d/dtheta`` of :func:`_dense`."""
-    r1 = rc[k, 1, c]
-    r2 = rc[k, 2, c]
-    r3 = rc[k, 3, c]
-    r4 = rc[k, 4, c]
+    b = 5 * k
+    r1 = rc[b + 1, c]
+    r2 = rc[b + 2, c]
+    r3 = rc[b + 3, c]
+    r4 = rc[b + 4, c]
     # p = r0 + th r1 + th (1-th) r2 + th^2 (1-th) r3 + th^2 (1-th)^2 r4
     return (r1 + (1.0 - 2.0 * th) * r2 + (2.0 * th - 3.0 * th * th) * r3
             + (2.0 * th - 6.0 * th * th + 4.0 * th * th * th) * r4)
 
 
-@jit(inline="always")
-def _edge(rc, hs, nh, s_t, kh):
+@jit(internal=True, nrt=False, rewrites=False)
+def _edge(rc, hs, nh, s_t, hint, ih):
     """Return the loading step ``k`` and ``theta`` with ``s(k, theta) = s_t``.
 
     ``hs`` holds ``s`` at the start of each stored step (increasing) and, at
     ``nh``, at the end of the last one. Below 0 the first step's polynomial is
     extended (``theta < 0``), above the turning point ``theta = 1``. The step
-    is searched from ``kh[0]``, the previous call's (the edge moves little
+    is searched from ``hint[ih]``, the previous call's (the edge moves little
     between calls), and stored there: the same step as a bisection over all
-    steps, the last with ``hs[k] <= s_t``.
+    steps, the last with ``hs[k] <= s_t``. (The step is an integer kept in a
+    float array: the kernel allocates no integer array.)
     """
     if s_t >= hs[nh]:
         return nh - 1, 1.0
@@ -549,12 +555,16 @@ def _edge(rc, hs, nh, s_t, kh):
         hi = 0.0
         th = s_t / (hs[1] - hs[0]) if hs[1] > hs[0] else 0.0
     else:
-        k = min(max(kh[0], 0), nh - 1)
+        k = int(hint[ih])
+        if k < 0:
+            k = 0
+        if nh - 1 < k:
+            k = nh - 1
         while k > 0 and hs[k] > s_t:
             k -= 1
         while k < nh - 1 and hs[k + 1] <= s_t:
             k += 1
-        kh[0] = k
+        hint[ih] = k
         lo = 0.0
         hi = 1.0
         th = (s_t - hs[k]) / (hs[k + 1] - hs[k])
@@ -578,9 +588,9 @@ def _edge(rc, hs, nh, s_t, kh):
     return k, th
 
 
-@jit(internal=True)
+@jit(internal=True, nrt=False, rewrites=False)
 def _step(phase, m, y, h, K, y1, tmp, mask, n_rk, tau0, g, itau, n, kappa, mu_t, tang, rc, hs,
-          nh, ah, e_val, atol, rtol, kh):
+          nh, ah, e_val, atol, rtol):
     """Take one Dormand-Prince 5(4) step of length ``h`` (/ T) from ``y``; return its error norm.
 
     ``K[0]`` is the derivative at ``y``; ``y1`` and ``K[1..6]`` receive the new
@@ -589,58 +599,78 @@ def _step(phase, m, y, h, K, y1, tmp, mask, n_rk, tau0, g, itau, n, kappa, mu_t,
     ``advance``). The error norm (dimensionless, 1 at the tolerance) is taken over
     the ``n_rk`` Runge-Kutta components.
     """
+    K0 = K[0]
+    K1 = K[1]
+    K2 = K[2]
+    K3 = K[3]
+    K4 = K[4]
+    K5 = K[5]
+    K6 = K[6]
     for r in range(1, 7):
         if r == 1:
             for c in range(m):
-                tmp[c] = y[c] + h * _A21 * K[0, c]
+                tmp[c] = y[c] + h * _A21 * K0[c]
         elif r == 2:
             for c in range(m):
-                tmp[c] = y[c] + h * (_A31 * K[0, c] + _A32 * K[1, c])
+                tmp[c] = y[c] + h * (_A31 * K0[c] + _A32 * K1[c])
         elif r == 3:
             for c in range(m):
-                tmp[c] = y[c] + h * (_A41 * K[0, c] + _A42 * K[1, c] + _A43 * K[2, c])
+                tmp[c] = y[c] + h * (_A41 * K0[c] + _A42 * K1[c] + _A43 * K2[c])
         elif r == 4:
             for c in range(m):
-                tmp[c] = y[c] + h * (_A51 * K[0, c] + _A52 * K[1, c] + _A53 * K[2, c]
-                                     + _A54 * K[3, c])
+                tmp[c] = y[c] + h * (_A51 * K0[c] + _A52 * K1[c] + _A53 * K2[c]
+                                     + _A54 * K3[c])
         elif r == 5:
             for c in range(m):
-                tmp[c] = y[c] + h * (_A61 * K[0, c] + _A62 * K[1, c] + _A63 * K[2, c]
-                                     + _A64 * K[3, c] + _A65 * K[4, c])
+                tmp[c] = y[c] + h * (_A61 * K0[c] + _A62 * K1[c] + _A63 * K2[c]
+                                     + _A64 * K3[c] + _A65 * K4[c])
         else:
             for c in range(m):
-                tmp[c] = y[c] + h * (_B1 * K[0, c] + _B3 * K[2, c] + _B4 * K[3, c]
-                                     + _B5 * K[4, c] + _B6 * K[5, c])
+                tmp[c] = y[c] + h * (_B1 * K0[c] + _B3 * K2[c] + _B4 * K3[c]
+                                     + _B5 * K4[c] + _B6 * K5[c])
         _rhs(phase, y, tmp, K, r, np.bool_(True), tau0, g, itau, n, kappa, mu_t, tang, rc, hs,
-             nh, ah, e_val, kh)
+             nh, ah, e_val)
     for c in range(m):
         y1[c] = tmp[c]
     acc = 0.0
     for c in range(m):
         if mask[c] > 0.0:
-            e = h * (_E1 * K[0, c] + _E3 * K[2, c] + _E4 * K[3, c] + _E5 * K[4, c]
-                     + _E6 * K[5, c] + _E7 * K[6, c])
+            e = h * (_E1 * K0[c] + _E3 * K2[c] + _E4 * K3[c] + _E5 * K4[c]
+                     + _E6 * K5[c] + _E7 * K6[c])
             sc = atol[c] + rtol * max(abs(y[c]), abs(y1[c]))
             acc += (e / sc) ** 2
     return math.sqrt(acc / n_rk)
 
 
-@jit(internal=True)
+@jit(internal=True, nrt=False, rewrites=False)
 def _store(rc, hs, ah, nh, y, y1, K, h, m, n, tang):
-    """Write the dense output of an accepted loading step into row ``nh``.
+    """Write the dense output of an accepted loading step ``nh``.
 
-    Hairer, Norsett & Wanner's ``contd5`` coefficients, the step's end ``s`` and
-    the arm quantities at its start.
+    Hairer, Norsett & Wanner's ``contd5`` coefficients into rows ``5 nh .. 5 nh + 4``
+    of ``rc``, the step's end ``s`` into ``hs[nh + 1]`` and the arm quantities at
+    its start into row ``nh`` of ``ah``.
     """
+    b = 5 * nh
+    R0 = rc[b]
+    R1 = rc[b + 1]
+    R2 = rc[b + 2]
+    R3 = rc[b + 3]
+    R4 = rc[b + 4]
+    K0 = K[0]
+    K2 = K[2]
+    K3 = K[3]
+    K4 = K[4]
+    K5 = K[5]
+    K6 = K[6]
     for c in range(m):
         dif = y1[c] - y[c]
-        bspl = h * K[0, c] - dif
-        rc[nh, 0, c] = y[c]
-        rc[nh, 1, c] = dif
-        rc[nh, 2, c] = bspl
-        rc[nh, 3, c] = dif - h * K[6, c] - bspl
-        rc[nh, 4, c] = h * (_D1 * K[0, c] + _D3 * K[2, c] + _D4 * K[3, c] + _D5 * K[4, c]
-                            + _D6 * K[5, c] + _D7 * K[6, c])
+        bspl = h * K0[c] - dif
+        R0[c] = y[c]
+        R1[c] = dif
+        R2[c] = bspl
+        R3[c] = dif - h * K6[c] - bspl
+        R4[c] = h * (_D1 * K0[c] + _D3 * K2[c] + _D4 * K3[c] + _D5 * K4[c] + _D6 * K5[c]
+                     + _D7 * K6[c])
     hs[nh + 1] = y1[0]
     for i in range(2 * n):
         ah[nh, i] = y[3 + i]
@@ -650,32 +680,30 @@ def _store(rc, hs, ah, nh, y, y1, K, h, m, n, tang):
             ah[nh, 2 * n + i] = y[o + 3 + i]
 
 
-@jit(internal=True)
+@jit(internal=True, rewrites=False)
 def _grown_history(rc, hs, ah, nh):
     """Return the loading history with twice the rows, the first ``nh`` steps copied.
 
-    Copied element by element over each array's contiguous prefix (an array slice
-    assignment compiles numba's shape-mismatch error message, about 25 string
-    helpers; one flat loop per array instead of one per component compiles less).
+    Copied element by element (an array slice assignment compiles numba's
+    shape-mismatch error message, about 25 string helpers; a flat view through
+    ``reshape`` compiles numba's shape normalization).
     """
-    cap = rc.shape[0]
-    rc2 = np.zeros((2 * cap, rc.shape[1], rc.shape[2]))
+    cap = hs.shape[0] - 1
+    rc2 = np.zeros((2 * rc.shape[0], rc.shape[1]))
     hs2 = np.zeros(2 * cap + 1)
     ah2 = np.zeros((2 * cap, ah.shape[1]))
-    src = rc.reshape(-1)
-    dst = rc2.reshape(-1)
-    for j in range(nh * rc.shape[1] * rc.shape[2]):
-        dst[j] = src[j]
-    src = ah.reshape(-1)
-    dst = ah2.reshape(-1)
-    for j in range(nh * ah.shape[1]):
-        dst[j] = src[j]
+    for j in range(5 * nh):
+        for c in range(rc.shape[1]):
+            rc2[j, c] = rc[j, c]
+    for j in range(nh):
+        for c in range(ah.shape[1]):
+            ah2[j, c] = ah[j, c]
     for j in range(nh + 1):
         hs2[j] = hs[j]
     return rc2, hs2, ah2
 
 
-@jit(internal=True)
+@jit(internal=True, nrt=False, rewrites=False)
 def _surface_catches(u_end, v_end, work, n, g, tau, tau0, tol):
     """Return whether the free centre element catches the sphere after separation.
 
@@ -722,7 +750,7 @@ def _surface_catches(u_end, v_end, work, n, g, tau, tau0, tol):
     return False
 
 
-@jit()
+@jit(rewrites=False)
 def maxwell_stick_impact(tau0, g, tau, kappa, mu_t, tangential, rtol, max_steps, rec, rec_every,
                          out):
     """One full-stick impact in the continuum limit; results into ``out``.
@@ -799,9 +827,9 @@ def maxwell_stick_impact(tau0, g, tau, kappa, mu_t, tangential, rtol, max_steps,
     for i in range(n):
         glassy += ga[i]
     rtol = max(rtol / glassy, RTOL_MIN)
-    m_l = _n_load(n, tang)
-    m_u = _n_unload(n, tang)
-    mm = max(m_l, m_u)
+    m_l = 4 + 3 * n + (4 + 3 * n if tang else 0)  # state sizes: loading, unloading
+    m_u = 5 + 2 * n + (3 + n if tang else 0)
+    mm = m_l if m_l > m_u else m_u
     # absolute tolerances; heavy damping as in continuum_kv
     v_scale = 1.0
     s_scale = 1.0
@@ -819,10 +847,11 @@ def maxwell_stick_impact(tau0, g, tau, kappa, mu_t, tangential, rtol, max_steps,
     tmp = np.zeros(mm)
     mask = np.zeros(mm)
     K = np.zeros((np.int64(7), mm))
-    e_val = np.zeros(5 * n + 1)  # decay factors, edge force density, step weights
-    kh = np.zeros(1, dtype=np.int64)  # the history step of the last edge
+    # decay factors, edge force density, step weights; last: the history step of the
+    # last edge (an integer kept as a float: no second allocation type to compile)
+    e_val = np.zeros(5 * n + 2)
     cap = np.int64(64)
-    rc = np.zeros((cap, np.int64(5), m_l))
+    rc = np.zeros((5 * cap, m_l))  # five dense-output rows per step (_store)
     hs = np.zeros(cap + 1)
     ah = np.zeros((cap, 4 * n))
     nh = np.int64(0)
@@ -833,8 +862,8 @@ def maxwell_stick_impact(tau0, g, tau, kappa, mu_t, tangential, rtol, max_steps,
     y[1] = 1.0
     if tang:
         y[3 + 3 * n + 1] = 1.0
-    Fz, Fx = _rhs_once(phase, y, y, K, np.int64(0), tau0, ga, itau, n, kappa, mu_t, tang, rc, hs,
-                       nh, ah, e_val, kh)
+    Fz, Fx = _rhs(phase, y, y, K, np.int64(0), np.bool_(False), tau0, ga, itau, n, kappa, mu_t,
+                  tang, rc, hs, nh, ah, e_val)
     h = 0.05 * min(1.0, s_scale)
     sig = 0.0
     err_old = 1e-4
@@ -844,139 +873,152 @@ def maxwell_stick_impact(tau0, g, tau, kappa, mu_t, tangential, rtol, max_steps,
     u_max = 0.0
     s_max = 0.0
     t_turn = 0.0
-    while steps < max_steps:
-        if h <= 4.0 * _EPS * abs(sig) or not (h > 0.0):
-            status = STATUS_NON_FINITE
-            break
-        err = _step(phase, m, y, h, K, y1, tmp, mask, n_rk, tau0, ga, itau, n, kappa, mu_t, tang,
-                    rc, hs, nh, ah, e_val, atol, rtol, kh)
-        if not (err <= 1.0):
-            h *= rejected_step_factor(err)
-            rejected = True
-            continue
-        steps += 1
-        h_next = h * accepted_step_factor(err, err_old, rejected)
-        err_old = max(err, 1e-4)
-        rejected = False
-        comp = 1 if phase == 0 else 0
-        event = y1[comp] <= 0.0
-        if event and y1[comp] < 0.0:
-            # re-take the step so that component comp is zero at its end
-            lo = 0.0
-            hi = h
-            g0 = y[comp]
-            best_h = h
-            best_g = y1[comp]
-            last_h = h  # the step whose state y1 and stages K[1:] hold
-            hp = h * g0 / (g0 - y1[comp])
-            tiny = 4.0 * _EPS * (abs(sig) + h)
-            for _ in range(40):
-                if not (lo < hp < hi):
-                    hp = 0.5 * (lo + hi)
-                _step(phase, m, y, hp, K, y1, tmp, mask, n_rk, tau0, ga, itau, n, kappa, mu_t,
-                      tang, rc, hs, nh, ah, e_val, atol, rtol, kh)
-                last_h = hp
-                gv = y1[comp]
-                if abs(gv) <= abs(best_g):
-                    best_h = hp
-                    best_g = gv
-                if gv == 0.0:
-                    break
-                if gv > 0.0:
-                    lo = hp
-                else:
-                    hi = hp
-                dg = K[6, comp]
-                hn = hp - gv / dg if dg != 0.0 else 0.5 * (lo + hi)
-                if not (lo < hn < hi):
-                    hn = 0.5 * (lo + hi)
-                if abs(hn - hp) <= tiny or hi - lo <= tiny:
-                    break
-                hp = hn
-            h = best_h
-            if last_h != best_h:
-                # take the best step again rather than keep copies of every candidate's
-                # state and stages: a step is a function of (y, K[0], h) alone, so this
-                # is the same state; the copy loops (unrolled over the seven stages and
-                # vectorized) were a third of this function's compiled code
-                _step(phase, m, y, h, K, y1, tmp, mask, n_rk, tau0, ga, itau, n, kappa, mu_t,
-                      tang, rc, hs, nh, ah, e_val, atol, rtol, kh)
-        if phase == 0:
-            if nh + 1 >= rc.shape[0]:  # grow the history (rare: doubling)
-                rc, hs, ah = _grown_history(rc, hs, ah, nh)
-            _store(rc, hs, ah, nh, y, y1, K, h, m, n, tang)
-            nh += 1
-        elif y1[0] > y[0] + 100.0 * rtol * s_max:  # edge moving outward: re-entry
-            status = STATUS_ASSUMPTION
+    # the history grows (rare: doubling) outside the loop of steps, so that the
+    # arrays are not reassigned in it: numba versions a variable reassigned in a
+    # loop at every branch (SSA), and each copy of an array carries reference
+    # counting (measured: a ninth of this function's lowered code)
+    grow = False
+    while True:
+        if grow:
+            rc, hs, ah = _grown_history(rc, hs, ah, nh)
+            grow = False
+        while steps < max_steps:
+            if phase == 0 and nh + 1 >= hs.shape[0] - 1:
+                grow = True
+                break
+            if h <= 4.0 * _EPS * abs(sig) or not (h > 0.0):
+                status = STATUS_NON_FINITE
+                break
+            err = _step(phase, m, y, h, K, y1, tmp, mask, n_rk, tau0, ga, itau, n, kappa, mu_t, tang,
+                        rc, hs, nh, ah, e_val, atol, rtol)
+            if not (err <= 1.0):
+                h *= rejected_step_factor(err)
+                rejected = True
+                continue
+            steps += 1
+            h_next = h * accepted_step_factor(err, err_old, rejected)
+            err_old = max(err, 1e-4)
+            rejected = False
+            comp = 1 if phase == 0 else 0
+            event = y1[comp] <= 0.0
+            if event and y1[comp] < 0.0:
+                # re-take the step so that component comp is zero at its end
+                lo = 0.0
+                hi = h
+                g0 = y[comp]
+                best_h = h
+                best_g = y1[comp]
+                last_h = h  # the step whose state y1 and stages K[1:] hold
+                hp = h * g0 / (g0 - y1[comp])
+                tiny = 4.0 * _EPS * (abs(sig) + h)
+                for _ in range(40):
+                    if not (lo < hp < hi):
+                        hp = 0.5 * (lo + hi)
+                    _step(phase, m, y, hp, K, y1, tmp, mask, n_rk, tau0, ga, itau, n, kappa, mu_t,
+                          tang, rc, hs, nh, ah, e_val, atol, rtol)
+                    last_h = hp
+                    gv = y1[comp]
+                    if abs(gv) <= abs(best_g):
+                        best_h = hp
+                        best_g = gv
+                    if gv == 0.0:
+                        break
+                    if gv > 0.0:
+                        lo = hp
+                    else:
+                        hi = hp
+                    dg = K[6, comp]
+                    hn = hp - gv / dg if dg != 0.0 else 0.5 * (lo + hi)
+                    if not (lo < hn < hi):
+                        hn = 0.5 * (lo + hi)
+                    if abs(hn - hp) <= tiny or hi - lo <= tiny:
+                        break
+                    hp = hn
+                h = best_h
+                if last_h != best_h:
+                    # take the best step again rather than keep copies of every candidate's
+                    # state and stages: a step is a function of (y, K[0], h) alone, so this
+                    # is the same state; the copy loops (unrolled over the seven stages and
+                    # vectorized) were a third of this function's compiled code
+                    _step(phase, m, y, h, K, y1, tmp, mask, n_rk, tau0, ga, itau, n, kappa, mu_t,
+                          tang, rc, hs, nh, ah, e_val, atol, rtol)
+            if phase == 0:
+                _store(rc, hs, ah, nh, y, y1, K, h, m, n, tang)
+                nh += 1
+            elif y1[0] > y[0] + 100.0 * rtol * s_max:  # edge moving outward: re-entry
+                status = STATUS_ASSUMPTION
+                for c in range(m):
+                    y[c] = y1[c]
+                break
+            sig += h
             for c in range(m):
                 y[c] = y1[c]
-            break
-        sig += h
-        for c in range(m):
-            y[c] = y1[c]
-            K[0, c] = K[6, c]
-        h = h_next
-        finite = True
-        for c in range(m):
-            if not math.isfinite(y[c]):
-                finite = False
-        if not finite:
-            status = STATUS_NON_FINITE
-            break
-        if event and phase == 1:
-            y[0] = 0.0
-            status = STATUS_OK
-            break
-        if event:  # turning point: switch to the unloading state
-            y[1] = 0.0
-            s_max = y[0]
-            u_max = s_max * s_max
-            t_turn = y[2]
-            hs[nh] = s_max
-            # the unloading state is built in y1 (free between steps), then copied
-            z = y1
-            for c in range(mm):
-                z[c] = 0.0
-            z[0] = s_max
-            z[1] = 0.0
-            z[2] = t_turn
-            z[3] = u_max
-            for i in range(n):
-                z[4 + i] = y[3 + i]
-            if tang:
-                o = 3 + 3 * n
-                z[4 + n] = y[o]
-                z[4 + n + 1] = y[o + 1]
+                K[0, c] = K[6, c]
+            h = h_next
+            finite = True
+            for c in range(m):
+                if not math.isfinite(y[c]):
+                    finite = False
+            if not finite:
+                status = STATUS_NON_FINITE
+                break
+            if event and phase == 1:
+                y[0] = 0.0
+                status = STATUS_OK
+                break
+            if event:  # turning point: switch to the unloading state
+                y[1] = 0.0
+                s_max = y[0]
+                u_max = s_max * s_max
+                t_turn = y[2]
+                hs[nh] = s_max
+                # the unloading state is built in y1 (free between steps), then copied
+                z = y1
+                for c in range(mm):
+                    z[c] = 0.0
+                z[0] = s_max
+                z[1] = 0.0
+                z[2] = t_turn
+                z[3] = u_max
                 for i in range(n):
-                    z[4 + n + 2 + i] = y[o + 3 + i]
-            ou = 4 + n + (2 + n if tang else 0)
-            for i in range(n):
-                z[ou + i] = -z[4 + i] * itau[i]  # dD/dt = v - D/tau at v = 0
-            for c in range(mm):
-                y[c] = z[c]
-            phase = np.int64(1)
-            m = m_u
-            n_rk = _rk_mask(phase, n, tang, mask)
-            kh[0] = nh - 1
-            for c in range(mm):
-                atol[c] = rtol
-            atol[0] = rtol * s_scale
-            atol[1] = rtol * v_scale
-            atol[3] = rtol * (s_scale * s_scale)
-            if tau0 > 0.0:
-                atol[0] = rtol * min(s_max, (v_scale / (1.25 * tau0)) ** (1.0 / 3.0))
-            Fz, Fx = _rhs_once(phase, y, y, K, np.int64(0), tau0, ga, itau, n, kappa, mu_t,
-                               tang, rc, hs, nh, ah, e_val, kh)
-            # restart small: the right-hand side is not smooth in the edge state
-            # at the turning point, and there the error estimate of a long step
-            # misses most of its error (measured: 10-20x the error otherwise)
-            h = h_next * UNLOAD_FIRST_STEP
-            err_old = 1e-4
-        if phase == 0 and y[0] * y[0] > u_max:
-            u_max = y[0] * y[0]
-        if n_rec > 0 and steps % rec_every == 0:
-            i_rec = _rec_state(rec, i_rec, phase, y, K, tau0, ga, itau, n, kappa, mu_t, tang, rc,
-                               hs, nh, ah, e_val, kh)
+                    z[4 + i] = y[3 + i]
+                if tang:
+                    o = 3 + 3 * n
+                    z[4 + n] = y[o]
+                    z[4 + n + 1] = y[o + 1]
+                    for i in range(n):
+                        z[4 + n + 2 + i] = y[o + 3 + i]
+                ou = 4 + n + (2 + n if tang else 0)
+                for i in range(n):
+                    z[ou + i] = -z[4 + i] * itau[i]  # dD/dt = v - D/tau at v = 0
+                for c in range(mm):
+                    y[c] = z[c]
+                phase = np.int64(1)
+                m = m_u
+                n_rk = _rk_mask(phase, n, tang, mask)
+                e_val[5 * n + 1] = nh - 1
+                for c in range(mm):
+                    atol[c] = rtol
+                atol[0] = rtol * s_scale
+                atol[1] = rtol * v_scale
+                atol[3] = rtol * (s_scale * s_scale)
+                if tau0 > 0.0:
+                    atol[0] = rtol * min(s_max, (v_scale / (1.25 * tau0)) ** (1.0 / 3.0))
+                Fz, Fx = _rhs(phase, y, y, K, np.int64(0), np.bool_(False), tau0, ga, itau, n, kappa,
+                              mu_t, tang, rc, hs, nh, ah, e_val)
+                # restart small: the right-hand side is not smooth in the edge state
+                # at the turning point, and there the error estimate of a long step
+                # misses most of its error (measured: 10-20x the error otherwise)
+                h = h_next * UNLOAD_FIRST_STEP
+                err_old = 1e-4
+            if phase == 0 and y[0] * y[0] > u_max:
+                u_max = y[0] * y[0]
+            if n_rec > 0 and steps % rec_every == 0:
+                Fz, Fx = _rhs(phase, y, y, K, np.int64(6), np.bool_(False), tau0, ga, itau, n, kappa,
+                              mu_t, tang, rc, hs, nh, ah, e_val)
+                i_rec = _rec_state(rec, i_rec, phase, y, n, tang, Fz, Fx)
+        if not grow:
+            break
     if status == STATUS_OK and (n > 0 or tau0 > 0.0):
         # the stages K are free now: scratch of the check (no allocation here)
         for i in range(n):
@@ -985,8 +1027,10 @@ def maxwell_stick_impact(tau0, g, tau, kappa, mu_t, tangential, rtol, max_steps,
         if _surface_catches(y[3], y[1], K, n, ga, ta, tau0, tol_c):
             status = STATUS_ASSUMPTION
     if n_rec > 0:
-        i_rec = _rec_state(rec, min(i_rec, n_rec - 1), phase, y, K, tau0, ga, itau, n, kappa,
-                           mu_t, tang, rc, hs, nh, ah, e_val, kh)
+        Fz, Fx = _rhs(phase, y, y, K, np.int64(6), np.bool_(False), tau0, ga, itau, n, kappa,
+                      mu_t, tang, rc, hs, nh, ah, e_val)
+        i_rec = _rec_state(rec, n_rec - 1 if n_rec - 1 < i_rec else i_rec, phase, y, n, tang,
+                           Fz, Fx)
         if status == STATUS_OK:
             rec[i_rec - 1, 4] = 0.0
             rec[i_rec - 1, 5] = 0.0
@@ -1005,12 +1049,13 @@ def maxwell_stick_impact(tau0, g, tau, kappa, mu_t, tangential, rtol, max_steps,
     return i_rec
 
 
-@jit(internal=True)
-def _rec_state(rec, i_rec, phase, y, K, tau0, g, itau, n, kappa, mu_t, tang, rc, hs, nh, ah,
-               e_val, kh):
-    """Record the current state (forces recomputed at it)."""
-    Fz, Fx = _rhs_once(phase, y, y, K, np.int64(6), tau0, g, itau, n, kappa, mu_t, tang, rc, hs,
-                       nh, ah, e_val, kh)
+@jit(internal=True, nrt=False, rewrites=False)
+def _rec_state(rec, i_rec, phase, y, n, tang, Fz, Fx):
+    """Record the current state with its forces ``Fz``, ``Fx`` (:func:`_rhs` at it).
+
+    The caller evaluates the forces: calling :func:`_rhs` from here linked and
+    optimized all of it once more in this function's own module.
+    """
     if phase == 0:
         u = y[0] * y[0]
         vc = y[3 + 3 * n + 1] if tang else 0.0
