@@ -20,6 +20,10 @@ form, so that its restitution is a function of one or two numbers:
   in units of ``1/omega0`` with the damping ratio ``zeta``; with a tangential
   spring-dashpot at the contact point, in stick, of the same contact duration.
 
+The friction laws stepped as the codes step them (LAMMPS, MercuryDPM, LIGGGHTS,
+Yade) run in the numba kernel :mod:`vimpact.kernels.stepped`, one point after
+another, in the same arithmetic as the codes' updates written here before.
+
 All functions return plain floats / arrays; none imports vimpact's engine.
 """
 
@@ -32,6 +36,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.interpolate import CubicSpline
 
+from vimpact.kernels.stepped import LAW_LAMMPS, LAW_LIGGGHTS, LAW_MERCURY, LAW_YADE, stepped_impacts
 from vimpact.model.hertz import HERTZ_TIME_FACTOR
 
 #: integrator tolerances of every law (relative, absolute)
@@ -259,25 +264,7 @@ def hertz_mindlin_coulomb(alpha, kappa, x_gamma, F, mu, w0,
     """
     alpha, w0, kappa, x_gamma = np.broadcast_arrays(
         *(np.asarray(a, dtype=float) for a in (alpha, w0, kappa, x_gamma)))
-    return _stepped(alpha, w0, mu if np.ndim(mu) else float(mu), steps,
-                    _mindlin_force(kappa.ravel(), x_gamma.ravel()),
-                    F if np.ndim(F) else float(F))
-
-
-def _mindlin_force(kappa: np.ndarray, x_gamma: np.ndarray):
-    def force(x, v, s, w, alpha, cap):
-        r = np.sqrt(np.maximum(x, 0.0))
-        f = np.maximum(x * r + 1.5 * alpha * r * v, 0.0)
-        ft = 1.5 * kappa * r * s + 1.5 * alpha * x_gamma * r * w
-        over = np.abs(ft) > cap * f
-        if np.any(over):
-            lim = np.sign(ft) * cap * f
-            k = 1.5 * kappa * r
-            s = np.where(over & (s != 0.0) & (k > 0.0),
-                         (lim - 1.5 * alpha * x_gamma * r * w) / np.where(k > 0.0, k, 1.0), s)
-            ft = np.where(over, np.where(s != 0.0, lim, 0.0), ft)
-        return 1.25 * f, 1.25 * ft, s
-    return force
+    return _stepped(LAW_LAMMPS, alpha, w0, mu, steps, (kappa, x_gamma), F)
 
 
 def mercury_mindlin_coulomb(alpha, K, D, F, mu, w0,
@@ -305,21 +292,8 @@ def mercury_mindlin_coulomb(alpha, K, D, F, mu, w0,
     -------
     (e, beta) : arrays of the broadcast shape; ``beta = -w_end / w0``
     """
-    alpha, D, w0, Kb = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in (alpha, D, w0, K)))
-    Dflat = D.ravel()
-    K = Kb.ravel()
-
-    def force(x, v, s, w, a, cap):
-        r = np.sqrt(np.maximum(x, 0.0))
-        f = np.maximum(x * r + 1.5 * a * r * v, 0.0)
-        el = K * r * s
-        over = np.abs(el) > cap * f
-        lim = np.sign(el) * cap * f
-        k = K * r
-        s = np.where(over, np.where(k > 0.0, lim / np.where(k > 0.0, k, 1.0), 0.0), s)
-        ft = np.where(over, lim, el + Dflat * np.sqrt(r) * w)
-        return 1.25 * f, 1.25 * ft, s
-    return _stepped(alpha, w0, mu, steps, force, F)
+    alpha, D, w0, K = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in (alpha, D, w0, K)))
+    return _stepped(LAW_MERCURY, alpha, w0, mu, steps, (K, D), F)
 
 
 def liggghts_coulomb(e_in: float, K: float, D: float, F: float, mu: float, w0,
@@ -347,20 +321,7 @@ def liggghts_coulomb(e_in: float, K: float, D: float, F: float, mu: float, w0,
     """
     b = abs(liggghts_beta(e_in))
     w0 = np.asarray(w0, dtype=float)
-
-    def force(x, v, s, w, _a, cap):
-        xp = np.maximum(x, 0.0)
-        r = np.sqrt(xp)
-        q = np.sqrt(r)
-        f = xp * r + 2.0 * b * q * v
-        el = K * r * s
-        over = np.abs(el) > cap * np.abs(f)
-        lim = np.sign(el) * cap * np.abs(f)
-        k = K * r
-        s = np.where(over, np.where(k > 0.0, lim / np.where(k > 0.0, k, 1.0), 0.0), s)
-        ft = np.where(over, lim, el + D * q * w)
-        return 1.25 * f, 1.25 * ft, s
-    return _stepped(np.zeros(w0.shape), w0, mu, steps, force, F, lever)
+    return _stepped(LAW_LIGGGHTS, np.zeros(w0.shape), w0, mu, steps, (b, K, D), F, lever)
 
 
 def yade_coulomb(zeta, w_t, zeta_t, F, mu, w0, steps: int = FRICTION_STEPS,
@@ -396,27 +357,11 @@ def yade_coulomb(zeta, w_t, zeta_t, F, mu, w0, steps: int = FRICTION_STEPS,
     w0 = np.asarray(w0, dtype=float)
     lever = None if rho is None else 1.0 / np.broadcast_to(np.asarray(rho, dtype=float),
                                                          w0.shape)
-    per_point = any(np.ndim(a) for a in (zeta, w_t, zeta_t, F))
-    if per_point:  # one contact per point: flat arrays like _stepped's state
-        zeta, w_t, zeta_t, F = (np.broadcast_to(np.asarray(a, dtype=float), w0.shape).ravel()
-                                for a in (zeta, w_t, zeta_t, F))
+    w_t, zeta_t, F = (np.asarray(a, dtype=float) for a in (w_t, zeta_t, F))
     k_t = w_t * w_t / F  # tangential stiffness per unit mass (contact-point mass m / F)
     c_t = 2.0 * zeta_t * w_t / F
-    stiff = k_t > 0.0
-    k_safe = np.where(stiff, k_t, 1.0) if per_point else k_t
-
-    def force(x, v, s, w, alpha, cap):
-        f = np.maximum(x + 2.0 * zeta * v, 0.0)
-        el = k_t * s  # the incremental elastic force: the sum of k_t w dt
-        over = np.abs(el) > cap * f
-        el = np.where(over, np.sign(el) * cap * f, el)
-        if per_point:
-            s = np.where(over & stiff, el / k_safe, s)
-        elif k_t > 0.0:
-            s = np.where(over, el / k_t, s)
-        return f, el + np.where(over, 0.0, c_t * w), s
-    return _stepped(np.zeros(w0.shape), w0, mu, steps, force,
-                    np.reshape(F, w0.shape) if per_point else F, lever, contact_time=math.pi)
+    return _stepped(LAW_YADE, np.zeros(w0.shape), w0, mu, steps, (zeta, k_t, c_t), F, lever,
+                    contact_time=math.pi)
 
 
 def mfix_coulomb(zeta: float, w_t: float, zeta_t, F: float, mu: float, w0,
@@ -499,56 +444,37 @@ def _stepped_result(live: np.ndarray, e: np.ndarray, wend: np.ndarray, w0: np.nd
     return e.reshape(shape), (-wend / w0).reshape(shape)
 
 
-def _stepped(alpha: np.ndarray, w0: np.ndarray, mu, steps: int, force, F,
+def _stepped(law: int, alpha: np.ndarray, w0: np.ndarray, mu, steps: int, constants, F,
              lever=None, contact_time: float = HERTZ_TIME_FACTOR) -> tuple[np.ndarray, np.ndarray]:
     """Step many oblique impacts with velocity Verlet until each contact ends; return ``(e, beta)``.
 
     ``steps`` per ``contact_time`` (the elastic Hertz contact time in the time unit ``T
     = d_H / v0`` by default, ``pi`` for a linear law in ``1/omega0``), until the overlap
-    is back to zero. ``force(x, v, s, w, alpha, mu) -> (a_n, a_t, s)`` gives the normal
-    acceleration and the tangential force per unit mass (positive decelerates) and the
-    history after the friction cap. The centre moves by ``-a_t``, the spin (``R omega``)
-    by ``arm (F - 1) a_t`` with the lever ``arm = 1 - lever x`` (``lever`` per point, or
-    0), and the contact point with ``w = u_x - arm R omega``. ``mu`` and ``F``: numbers, or
-    arrays that broadcast with ``alpha`` (per point; the force then gets ``mu`` per point).
+    is back to zero, under the law ``law`` (``LAW_*`` of :mod:`vimpact.kernels.stepped`,
+    which steps them) with its ``constants``. The centre moves by ``-a_t``, the spin (``R
+    omega``) by ``arm (F - 1) a_t`` with the lever ``arm = 1 - lever x`` (``lever`` per
+    point, or 0), and the contact point with ``w = u_x - arm R omega``. ``mu``, ``F`` and
+    each constant: numbers, or arrays that broadcast with ``alpha`` (per point).
     """
     alpha, w0 = np.broadcast_arrays(alpha, w0)
     shape = alpha.shape
-    alpha, w0 = alpha.ravel().copy(), w0.ravel().copy()
-    lev = (np.zeros_like(w0) if lever is None
-           else np.broadcast_to(np.asarray(lever, dtype=float), shape).ravel())
-    spin = (np.broadcast_to(np.asarray(F, dtype=float), shape).ravel() - 1.0 if np.ndim(F)
-            else F - 1.0)
-    h = contact_time / steps
+
+    def column(a) -> np.ndarray:
+        return np.ascontiguousarray(np.broadcast_to(np.asarray(a, dtype=float), shape).ravel())
+
+    n = alpha.size
+    p = np.zeros((n, 3))
+    for k, c in enumerate(constants):
+        p[:, k] = column(c)
+    e, wend = np.empty(n), np.empty(n)
     # stick: the tangential force still ends with the normal one
-    cap = (np.minimum(np.broadcast_to(np.asarray(mu, dtype=float), shape).ravel(), 1e300)
-           if np.ndim(mu) else min(float(mu), 1e300))
-    x = np.zeros_like(alpha)
-    v = np.ones_like(alpha)
-    s = np.zeros_like(alpha)
-    ux = w0.copy()
-    om = np.zeros_like(alpha)
-    an = np.zeros_like(alpha)
-    at = np.zeros_like(alpha)
-    live = np.ones(alpha.shape, dtype=bool)
-    e = np.full_like(alpha, np.nan)
-    wend = np.full_like(alpha, np.nan)
-    for _ in range(50 * steps):
-        arm = 1.0 - lev * x
-        v_half = v - 0.5 * h * an
-        ux_half = ux - 0.5 * h * at
-        om_half = om + 0.5 * h * arm * spin * at
-        x = x + h * v_half
-        arm = 1.0 - lev * x
-        w_half = ux_half - arm * om_half
-        s = s + h * w_half  # the tangential displacement (history) in stick
-        an, at, s = force(x, v_half, s, w_half, alpha, cap)
-        v = v_half - 0.5 * h * an
-        ux = ux_half - 0.5 * h * at
-        om = om_half + 0.5 * h * arm * spin * at
-        if _record_ended(live, x, v, ux, om, e, wend):
-            break
-    return _stepped_result(live, e, wend, w0, shape)
+    unfinished = stepped_impacts(
+        np.int64(law), column(alpha), column(w0),
+        np.zeros(n) if lever is None else column(lever), column(F) - 1.0,
+        np.minimum(column(mu), 1e300), p, contact_time / steps, np.int64(50 * steps), e, wend)
+    if unfinished:
+        raise RuntimeError("stepped contact law did not end its contact")
+    return e.reshape(shape), (-wend / column(w0)).reshape(shape)
 
 
 # ---- Tsuji-type Hertz (LIGGGHTS) ----------------------------------------
