@@ -17,34 +17,7 @@ from vimpact.model.hertz import HERTZ_TIME_FACTOR
 
 def hertz_mindlin_coulomb(alpha, kappa, x_gamma, F, mu, w0,
                           steps: int = FRICTION_STEPS) -> tuple[np.ndarray, np.ndarray]:
-    """Return the normal and tangential restitution of LAMMPS' Hertz-Mindlin law with friction.
-
-    LAMMPS' ``hertz ... damping viscoelastic tangential mindlin k_t x_gamma_t mu
-    limit_damping`` in an oblique impact, with Coulomb friction, stepped as LAMMPS
-    steps it.
-
-    Units and the stick law are those of :func:`viscoelastic_hertz_mindlin`; the
-    contact point arrives sliding at ``w0 = v_c0 / v_z0`` (``tan`` of the impact angle
-    for a sphere without spin). Each step is LAMMPS' velocity Verlet (``fix
-    nve/sphere``): half-step velocities, the history ``s`` incremented by ``w dt``, the
-    force ``ft = 1.5 kappa sqrt(x) s + 1.5 alpha x_gamma sqrt(x) w`` and, when ``|ft|``
-    exceeds ``mu f`` (``f`` the normal force clipped at zero, LAMMPS' ``Fncrit``), the
-    force set to ``mu f`` and the history to the elastic part of it
-    (``GranSubModTangentialMindlin::calculate_forces``). Many points at once.
-
-    Parameters
-    ----------
-    alpha, w0 : arrays (or numbers) of the same shape: ``A v0 / d_H`` and ``v_c0 / v_z0``
-    kappa, x_gamma : as in :func:`viscoelastic_hertz_mindlin`; numbers, or arrays that
-        broadcast with ``alpha`` (one candidate per point: a fit runs many at once)
-    F : as in :func:`viscoelastic_hertz_mindlin`; mu : Coulomb coefficient (``inf``: stick);
-        numbers, or arrays that broadcast with ``alpha`` (points of several contacts at once)
-    steps : steps per elastic Hertz contact time (``2.943 T``)
-
-    Returns
-    -------
-    (e, beta) : arrays of the broadcast shape; ``beta = -w_end / w0``
-    """
+    """As ``vimpact.dem.laws.hertz_mindlin_coulomb`` was: the NumPy loop over all points."""
     alpha, w0, kappa, x_gamma = np.broadcast_arrays(
         *(np.asarray(a, dtype=float) for a in (alpha, w0, kappa, x_gamma)))
     return _stepped(alpha, w0, mu if np.ndim(mu) else float(mu), steps,
@@ -70,29 +43,7 @@ def _mindlin_force(kappa: np.ndarray, x_gamma: np.ndarray):
 
 def mercury_mindlin_coulomb(alpha, K, D, F, mu, w0,
                             steps: int = FRICTION_STEPS) -> tuple[np.ndarray, np.ndarray]:
-    """Return the normal and tangential restitution of MercuryDPM's Hertz-Mindlin species.
-
-    MercuryDPM's ``HertzianBSHPViscoelasticMindlinSpecies`` in an oblique impact with
-    Coulomb friction, stepped with velocity Verlet.
-
-    Normal: the clipped viscoelastic Hertz law of :func:`viscoelastic_hertz_e` (units
-    ``d_H``, ``T = d_H / v0``). Tangential (``MindlinInteraction::computeFrictionForce``):
-    the spring ``-(2/3) K_t0 xi`` with ``K_t0 = 8 G a`` and, while that elastic force is
-    below ``mu`` times the normal force, the dashpot ``-c sqrt(m_eff K_t0) v_t``; above it
-    the force is ``mu`` times the normal force and the spring is reset to it. In units of
-    ``k_n d_H^1.5``: elastic ``K sqrt(x) s`` with ``K = 4 G / E*``, viscous
-    ``D x^(1/4) w`` (``D`` per point: it carries the mass and the speed).
-
-    Parameters
-    ----------
-    alpha, D, w0 : arrays (or numbers) that broadcast; K : number or array like them (one
-        candidate per point: a fit runs many at once); F, mu : numbers, or arrays that
-        broadcast with ``alpha`` (points of several contacts at once)
-
-    Returns
-    -------
-    (e, beta) : arrays of the broadcast shape; ``beta = -w_end / w0``
-    """
+    """As ``vimpact.dem.laws.mercury_mindlin_coulomb`` was: the NumPy loop over all points."""
     alpha, D, w0, Kb = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in (alpha, D, w0, K)))
     Dflat = D.ravel()
     K = Kb.ravel()
@@ -112,27 +63,7 @@ def mercury_mindlin_coulomb(alpha, K, D, F, mu, w0,
 
 def liggghts_coulomb(e_in: float, K: float, D: float, F: float, mu: float, w0,
                      steps: int = FRICTION_STEPS, lever=None) -> tuple[np.ndarray, np.ndarray]:
-    """Return the normal and tangential restitution of LIGGGHTS' Hertz law with friction.
-
-    LIGGGHTS' ``model hertz tangential history`` in an oblique impact with Coulomb
-    friction, stepped with velocity Verlet.
-
-    In the units of :func:`viscoelastic_hertz_e` (``d_H`` of LIGGGHTS' ``Y*``): normal
-    force ``x^1.5 + 2 |beta| x^(1/4) x'`` (not clipped, :func:`tsuji_hertz_e`);
-    tangential (``tangential_model_history.h``): the spring ``K sqrt(x) s`` with
-    ``K = 6 G*/Y*`` (``k_t = 8 G* sqrt(R delta)``) capped at ``mu |F_n|`` (the spring
-    reset to the cap), and below the cap the dashpot ``D x^(1/4) w`` with
-    ``D = 2 |beta| sqrt(4 G*/Y*)`` (``tangential_damping on``) or 0 (``off``);
-    ``beta`` from the input restitution ``e_in`` (:func:`liggghts_beta`). The law does
-    not depend on the speed: ``beta`` depends on the angle only, unless ``lever``
-    (``d_H / (2 R)`` per point, like ``w0``) is given: LIGGGHTS' contact point is at
-    ``R - delta/2`` from the centre (``cri``), the lever of the spin in the contact-point
-    velocity and of the torque, which shifts ``beta`` by about ``delta/R``.
-
-    Returns
-    -------
-    (e, beta) : arrays; ``beta = -w_end / w0``
-    """
+    """As ``vimpact.dem.laws.liggghts_coulomb`` was: the NumPy loop over all points."""
     b = abs(liggghts_beta(e_in))
     w0 = np.asarray(w0, dtype=float)
 
@@ -153,34 +84,7 @@ def liggghts_coulomb(e_in: float, K: float, D: float, F: float, mu: float, w0,
 
 def yade_coulomb(zeta, w_t, zeta_t, F, mu, w0, steps: int = FRICTION_STEPS,
                  rho=None) -> tuple[np.ndarray, np.ndarray]:
-    """Return the normal and tangential restitution of Yade's viscoelastic law with friction.
-
-    Yade's ``Law2_ScGeom_ViscElPhys_Basic`` in an oblique impact with Coulomb
-    friction, stepped as Yade steps it.
-
-    In the units of :func:`linear_spring_dashpot` (time ``1/omega0``, lengths
-    ``v0/omega0``): normal force ``u + 2 zeta u'`` clipped at zero; tangential, the
-    elastic force is incremental (``fs -= ks w dt``) and capped at ``mu`` times the
-    normal force, the viscous one ``cs w`` is added only while the elastic one is below
-    the cap (``ViscoelasticPM.cpp``). ``(w_t, zeta_t)`` are the tangential oscillator of
-    the contact point (angular frequency over ``omega0``, damping ratio; contact-point
-    mass ``m / F``), ``w0 = v_c0 / v_z0`` (array). Leapfrog steps as Yade's
-    ``NewtonIntegrator``.
-
-    ``rho`` (array like ``w0``, or ``None``): the sphere radius in units of ``v0/omega0``.
-    Given, the lever arm of the contact point is ``R - delta`` (Yade's
-    ``Ig2_Wall_Sphere_ScGeom`` puts the contact point where the sphere's centre projects
-    onto the wall): the contact point moves with ``v_x - (R - delta) omega`` and the
-    torque has that arm. ``None``: arm ``R`` (the one-contact law).
-
-    ``zeta``, ``w_t``, ``zeta_t``, ``F``, ``mu`` may also be arrays of the shape of ``w0``
-    (one contact per point, e.g. several contacts' candidates of a fit in one call: each
-    point then gets what it gets alone); ``rho`` ``inf`` at a point is the arm ``R``.
-
-    Returns
-    -------
-    (e, beta) : arrays; ``beta = -w_end / w0``
-    """
+    """As ``vimpact.dem.laws.yade_coulomb`` was: the NumPy loop over all points."""
     w0 = np.asarray(w0, dtype=float)
     lever = None if rho is None else 1.0 / np.broadcast_to(np.asarray(rho, dtype=float),
                                                          w0.shape)
@@ -209,11 +113,7 @@ def yade_coulomb(zeta, w_t, zeta_t, F, mu, w0, steps: int = FRICTION_STEPS,
 
 def _record_ended(live: np.ndarray, x: np.ndarray, v: np.ndarray, ux: np.ndarray,
                   om: np.ndarray, e: np.ndarray, wend: np.ndarray) -> bool:
-    """Record the contacts whose overlap ``x`` is back to zero; return True when none is live.
-
-    Their normal restitution ``e = -v`` and contact-point velocity ``ux - om`` are
-    written into ``e`` and ``wend``, and they leave ``live`` (all updated in place).
-    """
+    """As ``vimpact.dem.laws._record_ended`` was: the NumPy loop over all points."""
     ended = live & (x <= 0.0)
     e[ended] = -v[ended]
     wend[ended] = (ux - om)[ended]
@@ -223,7 +123,7 @@ def _record_ended(live: np.ndarray, x: np.ndarray, v: np.ndarray, ux: np.ndarray
 
 def _stepped_result(live: np.ndarray, e: np.ndarray, wend: np.ndarray, w0: np.ndarray,
                     shape: tuple) -> tuple[np.ndarray, np.ndarray]:
-    """Return ``(e, beta = -w_end / w0)`` in ``shape``; refuse a contact that never ended."""
+    """As ``vimpact.dem.laws._stepped_result`` was: the NumPy loop over all points."""
     if live.any():
         raise RuntimeError("stepped contact law did not end its contact")
     return e.reshape(shape), (-wend / w0).reshape(shape)
@@ -231,17 +131,7 @@ def _stepped_result(live: np.ndarray, e: np.ndarray, wend: np.ndarray, w0: np.nd
 
 def _stepped(alpha: np.ndarray, w0: np.ndarray, mu, steps: int, force, F,
              lever=None, contact_time: float = HERTZ_TIME_FACTOR) -> tuple[np.ndarray, np.ndarray]:
-    """Step many oblique impacts with velocity Verlet until each contact ends; return ``(e, beta)``.
-
-    ``steps`` per ``contact_time`` (the elastic Hertz contact time in the time unit ``T
-    = d_H / v0`` by default, ``pi`` for a linear law in ``1/omega0``), until the overlap
-    is back to zero. ``force(x, v, s, w, alpha, mu) -> (a_n, a_t, s)`` gives the normal
-    acceleration and the tangential force per unit mass (positive decelerates) and the
-    history after the friction cap. The centre moves by ``-a_t``, the spin (``R omega``)
-    by ``arm (F - 1) a_t`` with the lever ``arm = 1 - lever x`` (``lever`` per point, or
-    0), and the contact point with ``w = u_x - arm R omega``. ``mu`` and ``F``: numbers, or
-    arrays that broadcast with ``alpha`` (per point; the force then gets ``mu`` per point).
-    """
+    """As ``vimpact.dem.laws._stepped`` was: the NumPy loop over all points."""
     alpha, w0 = np.broadcast_arrays(alpha, w0)
     shape = alpha.shape
     alpha, w0 = alpha.ravel().copy(), w0.ravel().copy()
