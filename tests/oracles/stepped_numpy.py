@@ -11,7 +11,7 @@ import math
 
 import numpy as np
 
-from vimpact.dem.laws import FRICTION_STEPS, liggghts_beta
+from vimpact.dem.laws import FRICTION_STEPS, _record_ended, _stepped_result, liggghts_beta
 from vimpact.model.hertz import HERTZ_TIME_FACTOR
 
 
@@ -109,24 +109,6 @@ def yade_coulomb(zeta, w_t, zeta_t, F, mu, w0, steps: int = FRICTION_STEPS,
         return f, el + np.where(over, 0.0, c_t * w), s
     return _stepped(np.zeros(w0.shape), w0, mu, steps, force,
                     np.reshape(F, w0.shape) if per_point else F, lever, contact_time=math.pi)
-
-
-def _record_ended(live: np.ndarray, x: np.ndarray, v: np.ndarray, ux: np.ndarray,
-                  om: np.ndarray, e: np.ndarray, wend: np.ndarray) -> bool:
-    """As ``vimpact.dem.laws._record_ended`` was: the NumPy loop over all points."""
-    ended = live & (x <= 0.0)
-    e[ended] = -v[ended]
-    wend[ended] = (ux - om)[ended]
-    live &= ~ended
-    return not live.any()
-
-
-def _stepped_result(live: np.ndarray, e: np.ndarray, wend: np.ndarray, w0: np.ndarray,
-                    shape: tuple) -> tuple[np.ndarray, np.ndarray]:
-    """As ``vimpact.dem.laws._stepped_result`` was: the NumPy loop over all points."""
-    if live.any():
-        raise RuntimeError("stepped contact law did not end its contact")
-    return e.reshape(shape), (-wend / w0).reshape(shape)
 
 
 def _stepped(alpha: np.ndarray, w0: np.ndarray, mu, steps: int, force, F,
