@@ -467,14 +467,15 @@ def _stepped(law: int, alpha: np.ndarray, w0: np.ndarray, mu, steps: int, consta
     for k, c in enumerate(constants):
         p[:, k] = column(c)
     e, wend = np.empty(n), np.empty(n)
+    w0 = column(w0)
     # stick: the tangential force still ends with the normal one
     unfinished = stepped_impacts(
-        np.int64(law), column(alpha), column(w0),
+        np.int64(law), column(alpha), w0,
         np.zeros(n) if lever is None else column(lever), column(F) - 1.0,
         np.minimum(column(mu), 1e300), p, contact_time / steps, np.int64(50 * steps), e, wend)
     if unfinished:
         raise RuntimeError("stepped contact law did not end its contact")
-    return e.reshape(shape), (-wend / column(w0)).reshape(shape)
+    return e.reshape(shape), (-wend / w0).reshape(shape)
 
 
 # ---- Tsuji-type Hertz (LIGGGHTS) ----------------------------------------

@@ -124,18 +124,17 @@ def yade_oblique(tc: float, en: float, et: float, q: float, F: float, mu: float,
     like ``w0``): Yade's wall contact, whose contact point is on the wall plane (lever
     ``R - delta``), so that ``beta`` shifts by about ``delta/R`` with the speed.
     """
-    zeta, w_t, zeta_t, w0n = _tangential_law(tc, en, et, q, F)
-    rho = None if R is None else R * w0n / np.asarray(v, dtype=float)
-    return laws.yade_coulomb(zeta, w_t, zeta_t, F, mu, w0, steps or laws.FRICTION_STEPS, rho)[1]
+    case = dict(tc=tc, en=en, et=et, q=q, F=F, mu=mu, w0=w0, R=R, v=v)
+    return yade_oblique_many([case], steps)[0].reshape(np.shape(w0))
 
 
 def yade_oblique_many(cases: list[dict[str, Any]], steps: int | None = None) -> list[np.ndarray]:
     """:func:`yade_oblique` of several contacts (or candidates) in one stepped call.
 
-    ``cases``: one dict of :func:`yade_oblique`'s arguments per case (``tc``, ``en``,
-    ``et``, ``q``, ``F``, ``mu``, ``w0``, and ``R``, ``v`` for Yade's wall contact);
-    every point of every case is stepped at once with its own constants (the law is
-    elementwise), so each case gets exactly what :func:`yade_oblique` gives it alone.
+    One case is :func:`yade_oblique` itself. ``cases``: one dict of :func:`yade_oblique`'s
+    arguments per case (``tc``, ``en``, ``et``, ``q``, ``F``, ``mu``, ``w0``, and ``R``,
+    ``v`` for Yade's wall contact); every point of every case is stepped at once with its
+    own constants (the law is elementwise), so each case gets exactly what it gets alone.
     """
     cols: dict[str, list[np.ndarray]] = {k: [] for k in ("zeta", "w_t", "zeta_t", "F", "mu",
                                                           "w0", "rho")}

@@ -171,8 +171,7 @@ class RestitutionTable:
         if validate:
             verify_table(p, keep=None if p.is_dir() else groups, once=True)
         try:
-            arrow = (pq.read_table(p) if not groups else groups[0] if len(groups) == 1
-                     else pa.concat_tables(groups))
+            arrow = pa.concat_tables(groups) if groups else pq.read_table(p)
             raw = (pq.read_schema(p / COMMON_METADATA) if p.is_dir() else arrow.schema).metadata
         except Exception as exc:  # pyarrow raises several types for a bad file
             why = (str(exc).splitlines() or [""])[0]
