@@ -13,6 +13,7 @@
 
 from __future__ import annotations
 
+import functools
 import importlib.util
 import re
 import subprocess
@@ -86,15 +87,21 @@ def slug(heading: str) -> str:
     return text.replace(" ", "-")
 
 
-def anchors(path: Path) -> set[str]:
+def anchors(path: Path) -> frozenset[str]:
     """Heading slugs and explicit ``(label)=`` targets of a Markdown page."""
+    stat = path.stat()  # a page is read once per version (it is cited some 200 times)
+    return _anchors(path.resolve(), stat.st_mtime_ns, stat.st_size)
+
+
+@functools.cache
+def _anchors(path: Path, mtime_ns: int, size: int) -> frozenset[str]:
     out = set()
     for _, line in _prose_lines(path):
         if m := _LABEL.match(line):
             out.add(m.group(1))
         elif m := _HEADING.match(line):
             out.add(slug(m.group(1)))
-    return out
+    return frozenset(out)
 
 
 def _problem(path: Path, target: str) -> str | None:
