@@ -8,7 +8,9 @@ flag read as stuck (e_z = 0, not NaN) by the API and by `vimpact table lookup`.
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
+import io
 import json
 import math
 from pathlib import Path
@@ -23,7 +25,6 @@ from vimpact.engine.adhesion import adhesion_for_number, simulate_adhesive
 from vimpact.lookup.adhesion import AdhesionTable, is_adhesion_table
 from vimpact.model.numerics import Numerics
 from vimpact.tablebuild.adhesion import (
-    build_adhesion_table,
     sticking_numbers,
     verify_adhesion_table,
 )
@@ -41,10 +42,24 @@ tolerance = 2e-2
 
 
 @pytest.fixture(scope="module")
-def tiny(tmp_path_factory) -> Path:
+def tiny_build(tmp_path_factory) -> tuple[int, Path, str]:
+    """`vimpact table build` of the tiny spec: (exit code, table, stderr).
+
+    Built once through the command line, which calls :func:`build_adhesion_table`
+    with the spec, ``n_verify`` and ``seed`` (``--n``, ``--seed``) and the progress
+    lines on stderr."""
     spec = tmp_path_factory.mktemp("adh") / "tiny.toml"
     spec.write_text(TINY)
-    _, path = build_adhesion_table(spec, n_verify=15, seed=3)
+    err = io.StringIO()
+    with contextlib.redirect_stderr(err):
+        code = main(["table", "build", str(spec), "--n", "15", "--seed", "3"])
+    return code, spec.parent / "tiny.parquet", err.getvalue()
+
+
+@pytest.fixture(scope="module")
+def tiny(tiny_build) -> Path:
+    code, path, err = tiny_build
+    assert code == 0, err
     return path
 
 
@@ -128,13 +143,11 @@ def test_cli_verify_bad_input_exits_2(tiny, capsys, args, text):
     assert text in err and len(err.strip().splitlines()) == 1
 
 
-def test_cli_build(tmp_path, capsys):
+def test_cli_build(tiny_build):
     """`vimpact table build` on a spec with a lam axis writes an adhesive table."""
-    spec = tmp_path / "tiny.toml"
-    spec.write_text(TINY)
-    assert main(["table", "build", str(spec), "--n", "3"]) == 0
-    assert is_adhesion_table(tmp_path / "tiny.parquet")
-    assert "stuck misread" in capsys.readouterr().err
+    code, path, err = tiny_build
+    assert code == 0 and is_adhesion_table(path)
+    assert "stuck misread" in err
 
 
 def test_sweep_refuses_an_adhesive_table_spec(tmp_path, capsys):

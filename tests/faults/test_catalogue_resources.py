@@ -244,8 +244,11 @@ def test_table_export_refuses_a_symlinked_out(tmp_path, capsys):
 
 # ---- item 6: shards take a lock that a plain run respects -----------------------------
 
-def test_plain_run_is_refused_while_shards_run_and_the_other_way(tmp_path, capsys):
+def test_plain_run_is_refused_while_shards_run_and_the_other_way(tmp_path, capsys, monkeypatch):
     from vimpact.tableformat import files
+    # a shard waits this long for a lock held exclusively before it is refused (the
+    # refusal is the same after any wait; 2 s by default)
+    monkeypatch.setattr(files.OutputLock, "SHARED_WAIT_S", 0.1)
     spec, out = str(sweep_spec(tmp_path)), tmp_path / "out.parquet"
     with files.OutputLock(out, shared=True), files.OutputLock(out, shared=True):  # 2 shards
         code, _, err = run(["sweep", spec, "--out", str(out)], capsys)
