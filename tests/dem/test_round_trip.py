@@ -49,29 +49,49 @@ _NO_LAMMPS = lammps.lammps_available()
 
 
 @pytest.fixture(scope="module")
-def lammps_export(problem):
-    return export(problem, "lammps")
+def lammps_export(round_trip_lammps):
+    """The LAMMPS export of :data:`TOML` that ``vimpact dem --for lammps`` made (the CLI
+    test's run)."""
+    assert round_trip_lammps.status == 0
+    return round_trip_lammps.export
+
+
+#: the contacts, speeds (m/s) and steps per contact of the head-on LAMMPS collisions against
+#: the report's law
+COLLISIONS = [(key, v, steps) for key in ("a-floor", "a-b") for v in (0.1, 1.0)
+              for steps in (1000, 4000)]
+
+
+@pytest.fixture(scope="module")
+def lammps_collisions(lammps_export):
+    """LAMMPS' e of each of :data:`COLLISIONS` (one LAMMPS run each, in one process)."""
+    need(_NO_LAMMPS, "LAMMPS")
+    fits = {f.contact.key: f for f in lammps_export.fits}
+    runs = []
+    for key, v, steps in COLLISIONS:
+        f = fits[key]
+        R, m = f.contact.nominal()
+        runs.append((f, v, float(hertz_contact_time(f.params["E_star_Pa"], R, m, v)), steps))
+    return dict(zip(COLLISIONS, lammps.lammps_restitutions(runs)))
 
 
 @pytest.mark.parametrize("key", ["a-floor", "a-b"])
-def test_lammps_restitutes_what_the_report_predicts(lammps_export, key):
-    need(_NO_LAMMPS, "LAMMPS")
+def test_lammps_restitutes_what_the_report_predicts(lammps_export, lammps_collisions, key):
     fits = {f.contact.key: f for f in lammps_export.fits}
     f = fits[key]
-    R, m = f.contact.nominal()
     for v in (0.1, 1.0):
-        t_c = float(hertz_contact_time(f.params["E_star_Pa"], R, m, v))
         predicted = float(lammps.predicted_restitution(f, v))
-        coarse = lammps.lammps_restitution(f, v, t_c, steps_per_contact=1000)
-        fine = lammps.lammps_restitution(f, v, t_c, steps_per_contact=4000)
+        coarse = lammps_collisions[key, v, 1000]
+        fine = lammps_collisions[key, v, 4000]
         # LAMMPS' velocity-Verlet error shrinks with the time step towards the prediction
         assert abs(fine - predicted) < abs(coarse - predicted) or abs(fine - predicted) < 1e-6
         assert fine == pytest.approx(predicted, abs=5e-5)
 
 
-def test_rebound_round_trip_with_the_exported_callback(problem, tmp_path):
+def test_rebound_round_trip_with_the_exported_callback(round_trip_targets, tmp_path):
     rebound = pytest.importorskip("rebound", reason="REBOUND round trip: pip install rebound")
-    ex = export(problem, "rebound", tmp_path)
+    problem, targets = round_trip_targets
+    ex = export(problem, "rebound", tmp_path, targets=targets, figure=False)
     spec = importlib.util.spec_from_file_location("vimpact_restitution_rt",
                                                   tmp_path / "vimpact_restitution.py")
     cor = importlib.util.module_from_spec(spec)
