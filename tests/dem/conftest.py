@@ -50,48 +50,30 @@ def dem_run(folder: Path, toml: str, argv: list[str]) -> Run:
     return Run(status, out, err, folder / "out", made[-1] if made else None)
 
 
+#: the codes the round trips run for real: their ``vimpact dem`` run is on the round trips'
+#: set-up (tests/dem/test_round_trip.py), and the round trips run what that run wrote
+ROUND_TRIP_CODES = ("lammps", "yade", "liggghts", "rebound")
+
+
 @pytest.fixture(scope="session")
-def wiring_run(tmp_path_factory):
-    """``vimpact dem --no-figure`` on ``WIRING`` (tests/dem/test_cli_dem.py) for a code, run
-    once per code and session: ``wiring_run(code) -> Run``.
-    tests/dem/test_cli_dem.py checks the run and its files;
-    tests/dem/test_exported_files.py reads the same files and fits."""
+def code_run(tmp_path_factory):
+    """``vimpact dem --for CODE``, run once per code and session: ``code_run(code) -> Run``.
+
+    The codes of :data:`ROUND_TRIP_CODES` on the round trips' set-up (friction, the
+    default impact angles), LAMMPS with ``--json`` and the report's figure; the others on
+    ``WIRING`` (tests/dem/test_cli_dem.py: one impact angle, a cheap tangential search).
+    Every run but LAMMPS' with ``--no-figure``. tests/dem/test_cli_dem.py checks the runs
+    and their files; tests/dem/test_exported_files.py and the round trips read the same
+    files and fits (the exports are the slow part)."""
     runs: dict[str, Run] = {}
 
     def run(code: str) -> Run:
         if code not in runs:
-            runs[code] = dem_run(tmp_path_factory.mktemp(f"wiring_{code}"), wiring(),
-                                 ["--for", code, "--no-figure"])
+            from tests.dem.test_cli_dem import WIRING
+            from tests.dem.test_round_trip import TOML
+
+            toml = TOML if code in ROUND_TRIP_CODES else WIRING
+            argv = ["--for", code] + (["--json"] if code == "lammps" else ["--no-figure"])
+            runs[code] = dem_run(tmp_path_factory.mktemp(f"dem_{code}"), toml, argv)
         return runs[code]
     return run
-
-
-@pytest.fixture(scope="session")
-def round_trip_lammps(tmp_path_factory):
-    """``vimpact dem --for lammps --json`` on the round trips' set-up (tests/dem/test_round_trip.py:
-    friction, the default impact angles), with the report's figure: the LAMMPS file and
-    figure checks, the JSON checks and the LAMMPS round trips all read this one run (the
-    LAMMPS fit is the slowest of the codes)."""
-    from tests.dem.test_round_trip import TOML
-
-    return dem_run(tmp_path_factory.mktemp("round_trip_lammps"), TOML,
-                   ["--for", "lammps", "--json"])
-
-
-@pytest.fixture(scope="session")
-def round_trip_targets():
-    """The round trips' set-up and vimpact's curves of its contacts (normal, tangential and
-    oblique), computed once for the Yade, LIGGGHTS and REBOUND exports."""
-    from tests.dem.test_round_trip import TOML
-    from vimpact.dem.fit import compute_targets
-    from vimpact.dem.problem import problem_from_toml
-
-    problem = problem_from_toml(TOML, "round-trip")
-    return problem, {c.key: compute_targets(problem, c, tangential=True) for c in problem.contacts}
-
-
-def wiring() -> str:
-    """The set-up of the wiring runs (imported late: the test module imports :func:`cli`)."""
-    from tests.dem.test_cli_dem import WIRING
-
-    return WIRING

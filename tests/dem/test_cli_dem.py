@@ -34,7 +34,8 @@ default = 0.5
 """
 
 #: the same set-up with one impact angle: for tests of the wiring (files, names, lines), not of
-#: the fits' quality, so that the tangential searches have 4 oblique targets, not 24
+#: the fits' quality, so that the tangential searches have 4 oblique targets, not 24 (the
+#: codes the round trips run are run on the round trips' set-up: tests/dem/conftest.py)
 WIRING = TOML.replace("n = 4\n", "n = 4\nangles_deg = [45.0]\n", 1)
 
 FILES = {"lammps": ["lammps_settings.in", "lammps_pair.in", "lammps_walls.in"],
@@ -61,9 +62,9 @@ def check_written(code: str, out: Path, figure: bool = False) -> None:
 
 
 @pytest.mark.parametrize("code", [c for c in CODES if c != "lammps"])
-def test_writes_input_and_report_for_every_code(code, wiring_run):
+def test_writes_input_and_report_for_every_code(code, code_run):
     """With ``--no-figure``. LAMMPS (with the figure): :func:`test_writes_lammps_input_and_report`."""
-    run = wiring_run(code)
+    run = code_run(code)
     assert run.status == 0
     check_written(code, run.folder)
     assert "e_z residual" in run.out
@@ -71,14 +72,14 @@ def test_writes_input_and_report_for_every_code(code, wiring_run):
     assert "report_" + code + ".png" not in run.out
 
 
-def test_writes_lammps_input_and_report(round_trip_lammps):
+def test_writes_lammps_input_and_report(code_run):
     """One pair_coeff per type pair, one wall fix per particle type; the report's figure
     is a PNG of one panel column per contact, e_z above beta_x (the oblique impacts)."""
     import struct
 
     from vimpact.dem.report import PANEL_IN
 
-    status, _, _, out, _ = round_trip_lammps
+    status, _, _, out, _ = code_run("lammps")
     assert status == 0
     check_written("lammps", out, figure=True)
     text = (out / "lammps_pair.in").read_text()
@@ -140,14 +141,14 @@ def test_steps_per_contact_only_for_codes_with_a_time_step(tmp_path, capsys):
     assert err.count("\n") == 1 and "--steps-per-contact" in err
 
 
-def test_json_gives_the_tangential_residual_over_the_impact_angles(round_trip_lammps):
+def test_json_gives_the_tangential_residual_over_the_impact_angles(code_run):
     """With friction, the beta_x residual is over oblique impacts at the set-up's angles
     (the default angles when it gives none), and the JSON says so."""
     import json
 
     from vimpact.dem.fit import DEFAULT_ANGLES_DEG
 
-    status, out, _, folder, _ = round_trip_lammps
+    status, out, _, folder, _ = code_run("lammps")
     assert status == 0
     data = json.loads(out)
     for c in data["contacts"]:

@@ -18,18 +18,18 @@ MFIX_KEYS = {"DES_COLL_MODEL", "DES_EN_INPUT", "DES_EN_WALL_INPUT", "KN", "KN_W"
 
 
 @pytest.fixture(scope="module")
-def mfix_export(wiring_run):
-    """The MFiX export of :data:`WIRING` and its folder: ``vimpact dem --for mfix``'s run
+def mfix_export(code_run):
+    """The MFiX export of ``WIRING`` and its folder: ``vimpact dem --for mfix``'s run
     of the CLI test, for the checks of its file and of its fit."""
-    run = wiring_run("mfix")
+    run = code_run("mfix")
     assert run.status == 0
     return run.export, run.folder
 
 
-def test_mercurydpm_species_compiles_by_name(wiring_run):
-    """The species file ``vimpact dem --for mercurydpm`` wrote for :data:`WIRING` (the same
+def test_mercurydpm_species_compiles_by_name(code_run):
+    """The species file ``vimpact dem --for mercurydpm`` wrote for ``WIRING`` (the same
     run as the CLI test's)."""
-    run = wiring_run("mercurydpm")
+    run = code_run("mercurydpm")
     assert run.status == 0
     text = (run.folder / "mercurydpm_species.cpp").read_text()
     assert '#include "Species/HertzianBSHPViscoelasticMindlinSpecies.h"' in text

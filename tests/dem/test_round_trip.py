@@ -49,11 +49,12 @@ _NO_LAMMPS = lammps.lammps_available()
 
 
 @pytest.fixture(scope="module")
-def lammps_export(round_trip_lammps):
+def lammps_export(code_run):
     """The LAMMPS export of :data:`TOML` that ``vimpact dem --for lammps`` made (the CLI
     test's run)."""
-    assert round_trip_lammps.status == 0
-    return round_trip_lammps.export
+    run = code_run("lammps")
+    assert run.status == 0
+    return run.export
 
 
 #: the contacts, speeds (m/s) and steps per contact of the head-on LAMMPS collisions against
@@ -88,12 +89,15 @@ def test_lammps_restitutes_what_the_report_predicts(lammps_export, lammps_collis
         assert fine == pytest.approx(predicted, abs=5e-5)
 
 
-def test_rebound_round_trip_with_the_exported_callback(round_trip_targets, tmp_path):
+def test_rebound_round_trip_with_the_exported_callback(code_run):
+    """The callback module ``vimpact dem --for rebound`` wrote for :data:`TOML` (the CLI
+    test's run)."""
     rebound = pytest.importorskip("rebound", reason="REBOUND round trip: pip install rebound")
-    problem, targets = round_trip_targets
-    ex = export(problem, "rebound", tmp_path, targets=targets, figure=False)
+    run = code_run("rebound")
+    assert run.status == 0
+    ex = run.export
     spec = importlib.util.spec_from_file_location("vimpact_restitution_rt",
-                                                  tmp_path / "vimpact_restitution.py")
+                                                  run.folder / "vimpact_restitution.py")
     cor = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(cor)
     fit = next(f for f in ex.fits if f.contact.key == cor.CONTACT)

@@ -6,13 +6,15 @@ import pytest
 
 from tests.dem.codes import need
 from vimpact.dem import yade
-from vimpact.dem.export import export
 
 
 @pytest.fixture(scope="module")
-def yade_export(round_trip_targets):
-    problem, targets = round_trip_targets
-    return problem, export(problem, "yade", targets=targets)
+def yade_export(code_run):
+    """The set-up and the export that ``vimpact dem --for yade`` made of the round trips'
+    set-up (the CLI test's run)."""
+    run = code_run("yade")
+    assert run.status == 0
+    return run.export.problem, run.export
 
 
 @pytest.fixture(scope="module")
