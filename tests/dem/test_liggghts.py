@@ -25,16 +25,17 @@ def exported(liggghts_export):
 
 @pytest.fixture(scope="module")
 def liggghts_rows(liggghts_export):
-    """LIGGGHTS on the exported files at the default step (100 per contact) and at 800: in
-    each run the head-on collisions of every contact and the oblique wall impacts, at the
-    report's oblique speeds (its lowest and highest among them) and angles."""
+    """LIGGGHTS on the exported files at the default step (100 per contact) and at 800 (one
+    LIGGGHTS start): at each step the head-on collisions of every contact and the oblique
+    wall impacts, at the report's oblique speeds (its lowest and highest among them) and
+    angles."""
     need(liggghts.liggghts_available(), "LIGGGHTS")
     problem, ex = liggghts_export
     ob = ex.targets["a-floor"].oblique
     speeds, angles = sorted(set(ob.v.tolist())), sorted(set(ob.angle_deg.tolist()))
     assert speeds[0] == problem.speeds.min() and speeds[-1] == problem.speeds.max()
-    return {steps: liggghts.round_trip(problem, speeds, steps, fits=ex.fits, angles_deg=angles,
-                                       head_on=True) for steps in (100, 800)}
+    return liggghts.round_trips(problem, speeds, (100, 800), fits=ex.fits, angles_deg=angles,
+                                head_on=True)
 
 
 def test_liggghts_runs_the_exported_files_and_restitutes_the_prediction(exported, liggghts_rows):

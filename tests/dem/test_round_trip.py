@@ -161,8 +161,8 @@ def test_lammps_runs_the_exported_files_at_every_size_level():
     fits = export(problem, "lammps", tangential=False).fits  # the normal law is checked here
     speeds = np.geomspace(problem.speeds.min(), problem.speeds.max(), 5)
     diff = {}
-    for steps in (lammps.STEPS_PER_CONTACT, 4 * lammps.STEPS_PER_CONTACT):
-        rows = lammps.round_trip_files(problem, speeds, steps, fits=fits)
+    steps_list = (lammps.STEPS_PER_CONTACT, 4 * lammps.STEPS_PER_CONTACT)
+    for steps, rows in lammps.round_trips_files(problem, speeds, steps_list, fits=fits).items():
         assert {(r["contact"], r["level"]) for r in rows} == {
             (f.contact.key, k) for f in fits for k in range(len(f.contact.levels()))}
         diff[steps] = max(abs(r["e"] - r["predicted"]) for r in rows)
@@ -188,12 +188,13 @@ def test_lammps_oblique_wall_impacts_give_the_reported_beta(problem, lammps_expo
     assert ob is not None and f.beta_oblique is not None and ob.mu == 0.5
     speeds, angles = sorted(set(ob.v.tolist())), sorted(set(ob.angle_deg.tolist()))
     diff = {}
-    for steps in (lammps.STEPS_PER_CONTACT, 4 * lammps.STEPS_PER_CONTACT):
-        rows = lammps.round_trip_files(problem, speeds, steps, fits=ex.fits, angles_deg=angles,
-                                       contacts={"a-floor"})
+    fine = 4 * lammps.STEPS_PER_CONTACT
+    runs = lammps.round_trips_files(problem, speeds, (lammps.STEPS_PER_CONTACT, fine),
+                                    fits=ex.fits, angles_deg=angles, contacts={"a-floor"})
+    for steps, rows in runs.items():
         assert len(rows) == len(speeds) * len(angles)
         diff[steps] = max(abs(r["beta"] - r["predicted_beta"]) for r in rows)
-    fine = 4 * lammps.STEPS_PER_CONTACT
+    rows = runs[fine]
     assert diff[fine] < 3e-3
     assert diff[fine] < diff[lammps.STEPS_PER_CONTACT] / 2  # first order in the step
     for r, beta_vimpact in oblique_rows_against_vimpact(rows, ob):

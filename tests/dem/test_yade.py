@@ -25,16 +25,16 @@ def exported(yade_export):
 
 @pytest.fixture(scope="module")
 def yade_rows(yade_export):
-    """Yade on the exported file at the default step (400 per contact) and at 1600: in each
-    run the head-on collisions of every contact and the oblique wall impacts, at the
-    report's oblique speeds (its lowest and highest among them) and angles."""
+    """Yade on the exported file at the default step (400 per contact) and at 1600 (one
+    Yade start): at each step the head-on collisions of every contact and the oblique wall
+    impacts, at the report's oblique speeds (its lowest and highest among them) and angles."""
     need(yade.yade_available(), "Yade")
     problem, ex = yade_export
     ob = ex.targets["a-floor"].oblique
     speeds, angles = sorted(set(ob.v.tolist())), sorted(set(ob.angle_deg.tolist()))
     assert speeds[0] == problem.speeds.min() and speeds[-1] == problem.speeds.max()
-    return {steps: yade.round_trip(problem, speeds, steps, fits=ex.fits, angles_deg=angles,
-                                   head_on=True) for steps in (400, 1600)}
+    return yade.round_trips(problem, speeds, (400, 1600), fits=ex.fits, angles_deg=angles,
+                            head_on=True)
 
 
 def test_yade_runs_the_exported_file_and_restitutes_the_prediction(exported, yade_rows):

@@ -667,6 +667,19 @@ def round_trip_files(problem: DemProblem, speeds, steps_per_contact: int = STEPS
     tangential impulse with LAMMPS' solid-sphere inertia) and ``predicted_beta`` (the
     report's law with the contact's friction, :func:`oblique_beta`). ``contacts``: the keys
     of the contacts to collide (default: every contact; the files are always complete).
+    Several time steps in one process: :func:`round_trips_files`.
+    """
+    return round_trips_files(problem, speeds, [steps_per_contact], fits, angles_deg,
+                             contacts)[steps_per_contact]
+
+
+def round_trips_files(problem: DemProblem, speeds, steps_per_contact,
+                      fits: list[ContactFit] | None = None, angles_deg=None,
+                      contacts=None) -> dict[int, list[dict]]:
+    """Return :func:`round_trip_files`' rows at each of the time steps ``steps_per_contact``.
+
+    Each time step is a LAMMPS run of its own on the files exported for it, all in one
+    process (:func:`run_lammps_many`); a dict from steps per contact to rows.
     """
     from vimpact.dem import linear
     from vimpact.dem.fit import Oblique
@@ -676,7 +689,6 @@ def round_trip_files(problem: DemProblem, speeds, steps_per_contact: int = STEPS
         from vimpact.dem.export import export
 
         fits = export(problem, CODE).fits
-    files = render(problem, fits, steps_per_contact)
     r_max = max(max(t.radii) for t in problem.types)
     z_pairs = 20.0 * r_max
     oblique = angles_deg is not None
@@ -729,52 +741,62 @@ def round_trip_files(problem: DemProblem, speeds, steps_per_contact: int = STEPS
                                        f.params["k_t"], f.params["x_gamma_t"]))
                 for cs, b in zip(mine, b_pred):
                     cs["predicted_beta"] = float(b)
-    dt = shortest_contact(problem, fits) / steps_per_contact
     vmin = float(min(speeds))
     t_end = 2e-3 * r_max / vmin + 3.0 * max(
         float(hertz_contact_time(f.params["E_star_Pa"], *f.contact.effective(lvl), vmin))
         for f in fits for lvl in f.contact.levels())
-    lines = ["include lammps_settings.in", "boundary f f f",
-             f"region box block {-4 * r_max:.6g} {x + 4 * r_max:.6g} {-4 * r_max:.6g} "
-             f"{4 * r_max:.6g} {-4 * r_max:.6g} {z_pairs + 4 * r_max:.6g}",
-             f"create_box {len(problem.types)} box", "include lammps_pair.in"]
-    for k, (typ, (ax, ay, az), R, rho, (vx, vy, vz)) in enumerate(atoms, start=1):
-        lines += [f"create_atoms {typ} single {ax:.12g} {ay:.12g} {az:.12g}",
-                  f"set atom {k} diameter {2 * R:.12g} density {rho:.12g}",
-                  f"set atom {k} vx {vx:.12g} vy {vy:.12g} vz {vz:.12g}"]
-    if "lammps_walls.in" in files:
-        lines.append("include lammps_walls.in")
-    lines += ["fix integrate all nve/sphere", "thermo 0", f"run {int(math.ceil(t_end / dt))}"]
+    steps_list = [int(n) for n in steps_per_contact]
     names = []
     for k in range(1, len(atoms) + 1):
-        lines += [f"variable vx{k} equal vx[{k}]", f"variable vy{k} equal vy[{k}]",
-                  f"variable vz{k} equal vz[{k}]"]
         names += [f"vx{k}", f"vy{k}", f"vz{k}"]
     with tempfile.TemporaryDirectory() as tmp:
-        for name, text in files.items():
-            with open(os.path.join(tmp, name), "w") as fh:
-                fh.write(text)
-        script = "\n".join(f"include {os.path.join(tmp, ln.split()[1])}" if ln.startswith("include ")
-                           else ln for ln in lines) + "\n"
-        values = run_lammps(script, names, timeout=600.0)
-    vel = {k: tuple(values[3 * k - 3:3 * k]) for k in range(1, len(atoms) + 1)}
-    rows = []
-    for case in cases:
-        ids = case.pop("ids")
-        vt, F = case.pop("vt", 0.0), case.pop("F", None)
-        if len(ids) == 1:
-            vx, _, vz = vel[ids[0]]
-            e, dvt = vz / case["v"], vx - vt
-        else:
-            (ax_, ay_, _), (bx_, by_, _) = vel[ids[0]], vel[ids[1]]
-            e, dvt = (bx_ - ax_) / case["v"], (ay_ - by_) - vt
-        row = dict(case, e=e)
-        if oblique:
-            # the tangential impulse changes the contact-point velocity F times the centres'
-            row["beta"] = -(vt + F * dvt) / vt
-        rows.append(row)
-    return rows
-
+        runs = []
+        for n in steps_list:
+            files = render(problem, fits, n)
+            folder = os.path.join(tmp, str(n))
+            os.makedirs(folder, exist_ok=True)
+            for name, text in files.items():
+                with open(os.path.join(folder, name), "w") as fh:
+                    fh.write(text)
+            dt = shortest_contact(problem, fits) / n
+            lines = [f"include {os.path.join(folder, 'lammps_settings.in')}", "boundary f f f",
+                     f"region box block {-4 * r_max:.6g} {x + 4 * r_max:.6g} {-4 * r_max:.6g} "
+                     f"{4 * r_max:.6g} {-4 * r_max:.6g} {z_pairs + 4 * r_max:.6g}",
+                     f"create_box {len(problem.types)} box",
+                     f"include {os.path.join(folder, 'lammps_pair.in')}"]
+            for k, (typ, (ax, ay, az), R, rho, (vx, vy, vz)) in enumerate(atoms, start=1):
+                lines += [f"create_atoms {typ} single {ax:.12g} {ay:.12g} {az:.12g}",
+                          f"set atom {k} diameter {2 * R:.12g} density {rho:.12g}",
+                          f"set atom {k} vx {vx:.12g} vy {vy:.12g} vz {vz:.12g}"]
+            if "lammps_walls.in" in files:
+                lines.append(f"include {os.path.join(folder, 'lammps_walls.in')}")
+            lines += ["fix integrate all nve/sphere", "thermo 0",
+                      f"run {int(math.ceil(t_end / dt))}"]
+            for k in range(1, len(atoms) + 1):
+                lines += [f"variable vx{k} equal vx[{k}]", f"variable vy{k} equal vy[{k}]",
+                          f"variable vz{k} equal vz[{k}]"]
+            runs.append(("\n".join(lines) + "\n", names))
+        results = run_lammps_many(runs, timeout=600.0)
+    out = {}
+    for n, values in zip(steps_list, results):
+        vel = {k: tuple(values[3 * k - 3:3 * k]) for k in range(1, len(atoms) + 1)}
+        rows = []
+        for case in cases:
+            row = {k: v for k, v in case.items() if k not in ("ids", "vt", "F")}
+            ids, vt, F = case["ids"], case.get("vt", 0.0), case.get("F", 0.0)
+            if len(ids) == 1:
+                vx, _, vz = vel[ids[0]]
+                e, dvt = vz / case["v"], vx - vt
+            else:
+                (ax_, ay_, _), (bx_, by_, _) = vel[ids[0]], vel[ids[1]]
+                e, dvt = (bx_ - ax_) / case["v"], (ay_ - by_) - vt
+            row["e"] = e
+            if oblique:
+                # the tangential impulse changes the contact-point velocity F times the centres'
+                row["beta"] = -(vt + F * dvt) / vt
+            rows.append(row)
+        out[n] = rows
+    return out
 
 
 if __name__ == "__main__":  # python -m vimpact.dem.lammps SETUP.toml [STEPS_PER_CONTACT]
