@@ -1,9 +1,10 @@
-"""Runs shared by the DEM tests: the exports are the slow part, so one run of
-``vimpact dem`` feeds every check of what it wrote."""
+"""Runs shared by the DEM tests: the exports are the slow part (the fits, the figure), so
+one run of ``vimpact dem`` feeds every check of what it wrote."""
 
 import contextlib
 import io
 from pathlib import Path
+from typing import NamedTuple
 
 import pytest
 
@@ -18,27 +19,61 @@ def cli(argv: list[str]) -> tuple[int, str, str]:
     return code, out.getvalue(), err.getvalue()
 
 
-@pytest.fixture(scope="session")
-def wiring_run(tmp_path_factory):
-    """``vimpact dem`` on ``WIRING`` (tests/dem/test_cli_dem.py) for a code, run once per
-    code and session: ``wiring_run(code) -> (exit code, stdout, output folder)``.
-    tests/dem/test_cli_dem.py checks the run and its files;
-    tests/dem/test_exported_files.py reads the same files."""
-    runs: dict[str, tuple[int, str, Path]] = {}
+class Run(NamedTuple):
+    """One ``vimpact dem`` run: exit code, stdout, stderr, output folder and the
+    :class:`vimpact.dem.export.Export` the command wrote its files and summary from."""
 
-    def run(code: str) -> tuple[int, str, Path]:
+    status: int
+    out: str
+    err: str
+    folder: Path
+    export: object
+
+
+def dem_run(folder: Path, toml: str, argv: list[str]) -> Run:
+    """Write ``toml`` to ``folder/setup.toml`` and run ``vimpact dem`` on it with ``argv``
+    (output in ``folder/out``), keeping the export it made."""
+    from vimpact.dem import export as export_module
+
+    src = folder / "setup.toml"
+    src.write_text(toml)
+    made = []
+
+    def keep(*args, **kwargs):
+        made.append(run_export(*args, **kwargs))
+        return made[-1]
+
+    run_export = export_module.export
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(export_module, "export", keep)
+        status, out, err = cli(["dem", str(src), "--out", str(folder / "out"), *argv])
+    return Run(status, out, err, folder / "out", made[-1] if made else None)
+
+
+#: the codes the round trips run for real: their ``vimpact dem`` run is on the round trips'
+#: set-up (tests/dem/test_round_trip.py), and the round trips run what that run wrote
+ROUND_TRIP_CODES = ("lammps", "yade", "liggghts", "rebound")
+
+
+@pytest.fixture(scope="session")
+def code_run(tmp_path_factory):
+    """``vimpact dem --for CODE``, run once per code and session: ``code_run(code) -> Run``.
+
+    The codes of :data:`ROUND_TRIP_CODES` on the round trips' set-up (friction, the
+    default impact angles), LAMMPS with ``--json`` and the report's figure; the others on
+    ``WIRING`` (tests/dem/test_cli_dem.py: one impact angle, a cheap tangential search).
+    Every run but LAMMPS' with ``--no-figure``. tests/dem/test_cli_dem.py checks the runs
+    and their files; tests/dem/test_exported_files.py and the round trips read the same
+    files and fits (the exports are the slow part)."""
+    runs: dict[str, Run] = {}
+
+    def run(code: str) -> Run:
         if code not in runs:
-            d = tmp_path_factory.mktemp(f"wiring_{code}")
-            (d / "setup.toml").write_text(wiring())
-            status, out, _ = cli(["dem", str(d / "setup.toml"), "--for", code, "--out",
-                                  str(d / code)])
-            runs[code] = (status, out, d / code)
+            from tests.dem.test_cli_dem import WIRING
+            from tests.dem.test_round_trip import TOML
+
+            toml = TOML if code in ROUND_TRIP_CODES else WIRING
+            argv = ["--for", code] + (["--json"] if code == "lammps" else ["--no-figure"])
+            runs[code] = dem_run(tmp_path_factory.mktemp(f"dem_{code}"), toml, argv)
         return runs[code]
     return run
-
-
-def wiring() -> str:
-    """The set-up of the wiring runs (imported late: the test module imports :func:`cli`)."""
-    from tests.dem.test_cli_dem import WIRING
-
-    return WIRING

@@ -4,7 +4,6 @@ from pathlib import Path
 
 import pytest
 
-from tests.dem.conftest import cli
 from vimpact.cli.main import main
 from vimpact.dem.export import CODES
 
@@ -35,7 +34,8 @@ default = 0.5
 """
 
 #: the same set-up with one impact angle: for tests of the wiring (files, names, lines), not of
-#: the fits' quality, so that the tangential searches have 4 oblique targets, not 24
+#: the fits' quality, so that the tangential searches have 4 oblique targets, not 24 (the
+#: codes the round trips run are run on the round trips' set-up: tests/dem/conftest.py)
 WIRING = TOML.replace("n = 4\n", "n = 4\nangles_deg = [45.0]\n", 1)
 
 FILES = {"lammps": ["lammps_settings.in", "lammps_pair.in", "lammps_walls.in"],
@@ -44,26 +44,16 @@ FILES = {"lammps": ["lammps_settings.in", "lammps_pair.in", "lammps_walls.in"],
          "mfix": ["mfix.dat"], "rebound": ["vimpact_restitution.py"]}
 
 
-@pytest.fixture(scope="module")
-def lammps_json(tmp_path_factory):
-    """``vimpact dem`` on :data:`TOML` (friction, no angles: the default ones) for LAMMPS
-    with ``--json``, run once: the LAMMPS case of the file checks and the JSON check of the
-    tangential residual both read it (the LAMMPS fit is the slowest of the codes; the plain
-    text summary of ``--for lammps`` is the example of docs/dem.md, run by tests/docs)."""
-    d = tmp_path_factory.mktemp("lammps_json")
-    (d / "setup.toml").write_text(TOML)
-    status, out, _ = cli(["dem", str(d / "setup.toml"), "--for", "lammps", "--out", str(d),
-                          "--json"])
-    return status, out, d
-
-
-def check_written(code: str, out: Path) -> None:
+def check_written(code: str, out: Path, figure: bool = False) -> None:
     """The code's files and its report are written; the report names every contact and
-    says what the code cannot represent."""
-    for name in FILES[code] + [f"report_{code}.md", f"report_{code}.png"]:
+    says what the code cannot represent, and links its figure or says that none was drawn."""
+    for name in FILES[code] + [f"report_{code}.md"]:
         assert (out / name).stat().st_size > 0, name
+    assert (out / f"report_{code}.png").exists() == figure
     report = (out / f"report_{code}.md").read_text()
     assert "a-b" in report and "a-floor" in report and "b-floor" in report
+    assert (f"](report_{code}.png)" in report) == figure
+    assert ("No figure was drawn (`--no-figure`)." in report) != figure
     table = report.split("## Notes")[0]
     if code == "rebound":
         assert "not represented" in table
@@ -72,19 +62,26 @@ def check_written(code: str, out: Path) -> None:
 
 
 @pytest.mark.parametrize("code", [c for c in CODES if c != "lammps"])
-def test_writes_input_and_report_for_every_code(code, wiring_run):
-    """LAMMPS: :func:`test_writes_lammps_input_and_report`."""
-    status, text, out = wiring_run(code)
-    assert status == 0
-    check_written(code, out)
-    assert "e_z residual" in text
+def test_writes_input_and_report_for_every_code(code, code_run):
+    """With ``--no-figure``. LAMMPS (with the figure): :func:`test_writes_lammps_input_and_report`."""
+    run = code_run(code)
+    assert run.status == 0
+    check_written(code, run.folder)
+    assert "e_z residual" in run.out
+    assert f"wrote {run.folder / f'report_{code}.md'}" in run.out
+    assert "report_" + code + ".png" not in run.out
 
 
-def test_writes_lammps_input_and_report(lammps_json):
-    """One pair_coeff per type pair, one wall fix per particle type."""
-    status, _, out = lammps_json
+def test_writes_lammps_input_and_report(code_run):
+    """One pair_coeff per type pair, one wall fix per particle type; the report's figure
+    is a PNG of one panel column per contact, e_z above beta_x (the oblique impacts)."""
+    import struct
+
+    from vimpact.dem.report import PANEL_IN
+
+    status, _, _, out, _ = code_run("lammps")
     assert status == 0
-    check_written("lammps", out)
+    check_written("lammps", out, figure=True)
     text = (out / "lammps_pair.in").read_text()
     assert [ln.split()[1:3] for ln in text.splitlines() if ln.startswith("pair_coeff")] == \
         [["1", "1"], ["1", "2"], ["2", "2"]]
@@ -92,6 +89,11 @@ def test_writes_lammps_input_and_report(lammps_json):
     assert sum(ln.startswith("fix wall_floor_") for ln in walls) == 2
     settings = (out / "lammps_settings.in").read_text()
     assert "units si" in settings and "timestep" in text
+    png = (out / "report_lammps.png").read_bytes()
+    assert png[:8] == b"\x89PNG\r\n\x1a\n" and png[12:16] == b"IHDR"
+    width, height = struct.unpack(">II", png[16:24])
+    dpi = 110  # report.figure's
+    assert (width, height) == (round(5 * PANEL_IN[0] * dpi), round(2 * PANEL_IN[1] * dpi))
 
 
 @pytest.mark.parametrize("edit, words", [
@@ -120,7 +122,7 @@ def test_json_output_is_the_fits_and_progress_goes_to_stderr(tmp_path, capsys):
     src = tmp_path / "setup.toml"
     src.write_text(TOML)
     assert main(["dem", str(src), "--for", "liggghts", "--out", str(tmp_path), "--json",
-                 "--steps-per-contact", "40"]) == 0
+                 "--steps-per-contact", "40", "--no-figure"]) == 0
     cap = capsys.readouterr()
     data = json.loads(cap.out)  # strict JSON: no NaN or Infinity
     assert data["code"] == "liggghts"
@@ -139,14 +141,14 @@ def test_steps_per_contact_only_for_codes_with_a_time_step(tmp_path, capsys):
     assert err.count("\n") == 1 and "--steps-per-contact" in err
 
 
-def test_json_gives_the_tangential_residual_over_the_impact_angles(lammps_json):
+def test_json_gives_the_tangential_residual_over_the_impact_angles(code_run):
     """With friction, the beta_x residual is over oblique impacts at the set-up's angles
     (the default angles when it gives none), and the JSON says so."""
     import json
 
     from vimpact.dem.fit import DEFAULT_ANGLES_DEG
 
-    status, out, folder = lammps_json
+    status, out, _, folder, _ = code_run("lammps")
     assert status == 0
     data = json.loads(out)
     for c in data["contacts"]:

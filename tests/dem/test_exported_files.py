@@ -6,10 +6,6 @@ import re
 import numpy as np
 import pytest
 
-from tests.dem.test_cli_dem import WIRING
-from vimpact.dem.export import export
-from vimpact.dem.problem import problem_from_toml
-
 #: MercuryDPM: the species class (Kernel/Species/HertzianBSHPViscoelasticMindlinSpecies.h) and
 #: the setters of its parts (HertzianViscoelasticNormalSpecies, MindlinSpecies, ParticleSpecies;
 #: MindlinSpecies::setSlidingDissipation is read by MindlinInteraction::computeFrictionForce)
@@ -22,18 +18,20 @@ MFIX_KEYS = {"DES_COLL_MODEL", "DES_EN_INPUT", "DES_EN_WALL_INPUT", "KN", "KN_W"
 
 
 @pytest.fixture(scope="module")
-def mfix_export(tmp_path_factory):
-    """The MFiX export of :data:`WIRING`, once for the checks of its file and of its fit."""
-    out = tmp_path_factory.mktemp("mfix")
-    return export(problem_from_toml(WIRING, "files"), "mfix", out), out
+def mfix_export(code_run):
+    """The MFiX export of ``WIRING`` and its folder: ``vimpact dem --for mfix``'s run
+    of the CLI test, for the checks of its file and of its fit."""
+    run = code_run("mfix")
+    assert run.status == 0
+    return run.export, run.folder
 
 
-def test_mercurydpm_species_compiles_by_name(wiring_run):
-    """The species file ``vimpact dem --for mercurydpm`` wrote for :data:`WIRING` (the same
+def test_mercurydpm_species_compiles_by_name(code_run):
+    """The species file ``vimpact dem --for mercurydpm`` wrote for ``WIRING`` (the same
     run as the CLI test's)."""
-    status, _, out = wiring_run("mercurydpm")
-    assert status == 0
-    text = (out / "mercurydpm_species.cpp").read_text()
+    run = code_run("mercurydpm")
+    assert run.status == 0
+    text = (run.folder / "mercurydpm_species.cpp").read_text()
     assert '#include "Species/HertzianBSHPViscoelasticMindlinSpecies.h"' in text
     assert "HertzianBSHPViscoelasticSlidingFrictionSpecies" not in text
     code = "\n".join(ln.split("//")[0] for ln in text.splitlines())

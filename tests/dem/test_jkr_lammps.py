@@ -12,8 +12,8 @@ from tests.dem.codes import need
 from vimpact.dem import lammps
 from vimpact.dem.jkr import (
     JkrLaw,
-    lammps_jkr_restitution,
-    lammps_oblique_wall_impact,
+    lammps_jkr_restitutions,
+    lammps_oblique_wall_impacts,
     law_sticking_velocity,
     oblique_wall_impact,
 )
@@ -49,8 +49,9 @@ def test_lammps_pair_collision_follows_the_effective_law():
     law = JkrLaw.pair(E_star, R1, _mass(R1), R2, _mass(R2), COHESION, ETA_N0)
     v_stick = law_sticking_velocity(law, 0.02)
     wall = JkrLaw(E_star, R1, _mass(R1), COHESION, ETA_N0)
-    for v in (0.7 * v_stick, 1.3 * v_stick, 0.1):
-        e = lammps_jkr_restitution(COEFFS, law, R1, RHO, v, R2=R2, rho2=RHO)
+    speeds = (0.7 * v_stick, 1.3 * v_stick, 0.1)
+    for v, e in zip(speeds, lammps_jkr_restitutions(COEFFS, law, R1, RHO, speeds, R2=R2,
+                                                    rho2=RHO)):
         expected = law.restitution(v)
         if v < v_stick:
             assert e == 0.0 and expected == 0.0
@@ -75,8 +76,8 @@ def test_lammps_caps_the_jkr_tangential_force_at_the_raised_limit():
     coeffs = (f"jkr {w['E']} {w['eta_n0']} {w['nu']} {w['cohesion']} damping viscoelastic "
               f"tangential mindlin {w['k_t']} {w['x_gamma_t']} {w['mu_s']}")
     law = JkrLaw(w["E"] / (2.0 * (1.0 - w["nu"] ** 2)), R1, _mass(R1), w["cohesion"], w["eta_n0"])
-    for v in (0.03, 0.4):
-        e, beta = lammps_oblique_wall_impact(coeffs, law, RHO, v, 45.0)
+    speeds = (0.03, 0.4)
+    for v, (e, beta) in zip(speeds, lammps_oblique_wall_impacts(coeffs, law, RHO, speeds, 45.0)):
         e_jkr, beta_jkr = oblique_wall_impact(law, w["k_t"], w["x_gamma_t"], w["mu_s"], v, 45.0,
                                               steps_per_contact=4000)
         _, beta_clipped = oblique_wall_impact(law, w["k_t"], w["x_gamma_t"], w["mu_s"], v, 45.0,

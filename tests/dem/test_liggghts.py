@@ -2,20 +2,19 @@
 ``liggghts_settings.in`` and ``liggghts.in`` unchanged, restitutes what the report
 predicts on head-on pair and wall collisions, and its time-step error shrinks with the step."""
 
-import numpy as np
 import pytest
 
 from tests.dem.codes import need
-from tests.dem.test_round_trip import TOML
 from vimpact.dem import liggghts
-from vimpact.dem.export import export
-from vimpact.dem.problem import problem_from_toml
 
 
 @pytest.fixture(scope="module")
-def liggghts_export():
-    problem = problem_from_toml(TOML, "round-trip")
-    return problem, export(problem, "liggghts")
+def liggghts_export(code_run):
+    """The set-up and the export that ``vimpact dem --for liggghts`` made of the round trips'
+    set-up (the CLI test's run)."""
+    run = code_run("liggghts")
+    assert run.status == 0
+    return run.export.problem, run.export
 
 
 @pytest.fixture(scope="module")
@@ -24,13 +23,26 @@ def exported(liggghts_export):
     return problem, ex.fits
 
 
-def test_liggghts_runs_the_exported_files_and_restitutes_the_prediction(exported):
+@pytest.fixture(scope="module")
+def liggghts_rows(liggghts_export):
+    """LIGGGHTS on the exported files at the default step (100 per contact) and at 800 (one
+    LIGGGHTS start): at each step the head-on collisions of every contact and the oblique
+    wall impacts, at the report's oblique speeds (its lowest and highest among them) and
+    angles."""
     need(liggghts.liggghts_available(), "LIGGGHTS")
-    problem, fits = exported
-    speeds = np.geomspace(problem.speeds.min(), problem.speeds.max(), 5)
+    problem, ex = liggghts_export
+    ob = ex.targets["a-floor"].oblique
+    speeds, angles = sorted(set(ob.v.tolist())), sorted(set(ob.angle_deg.tolist()))
+    assert speeds[0] == problem.speeds.min() and speeds[-1] == problem.speeds.max()
+    return liggghts.round_trips(problem, speeds, (100, 800), fits=ex.fits, angles_deg=angles,
+                                head_on=True)
+
+
+def test_liggghts_runs_the_exported_files_and_restitutes_the_prediction(exported, liggghts_rows):
+    _, fits = exported
     diff = {}
     for steps in (100, 800):
-        rows = liggghts.round_trip(problem, speeds, steps, fits=fits)
+        rows = [r for r in liggghts_rows[steps] if "angle" not in r]
         assert {r["contact"] for r in rows} == {f.contact.key for f in fits}
         diff[steps] = max(abs(r["e"] - r["predicted"]) for r in rows)
     assert diff[100] < 1e-3          # the exported default step
@@ -45,23 +57,21 @@ def test_rigid_wall_gets_hard_particles(exported):
     assert text.index("hard_particles yes") < text.index("youngsModulus")
 
 
-def test_liggghts_oblique_wall_impacts_give_the_reported_beta(liggghts_export):
+def test_liggghts_oblique_wall_impacts_give_the_reported_beta(liggghts_export, liggghts_rows):
     """LIGGGHTS on the exported files, oblique wall impacts with the set-up's friction at
     the report's speeds and angles: its beta is the report's prediction (its Hertz-Mindlin
     history law with the lever R - delta/2 at walls) to its time-step error, shrinking with
     the step, and within the stated beta_x residual (plus that error) of vimpact's."""
-    need(liggghts.liggghts_available(), "LIGGGHTS")
     from tests.dem.test_round_trip import oblique_rows_against_vimpact
 
-    problem, ex = liggghts_export
+    _, ex = liggghts_export
     f = next(x for x in ex.fits if x.contact.key == "a-floor")
     ob = ex.targets["a-floor"].oblique
     speeds, angles = sorted(set(ob.v.tolist())), sorted(set(ob.angle_deg.tolist()))
     diff, rows = {}, {}
     for steps in (100, 800):
-        rows[steps] = [r for r in liggghts.round_trip(problem, speeds, steps, fits=ex.fits,
-                                                      angles_deg=angles)
-                       if r["contact"] == "a-floor"]
+        rows[steps] = [r for r in liggghts_rows[steps]
+                       if r["contact"] == "a-floor" and "angle" in r]
         assert len(rows[steps]) == len(speeds) * len(angles)
         diff[steps] = max(abs(r["beta"] - r["predicted_beta"]) for r in rows[steps])
     assert diff[800] < 1e-2

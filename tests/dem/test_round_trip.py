@@ -49,31 +49,55 @@ _NO_LAMMPS = lammps.lammps_available()
 
 
 @pytest.fixture(scope="module")
-def lammps_export(problem):
-    return export(problem, "lammps")
+def lammps_export(code_run):
+    """The LAMMPS export of :data:`TOML` that ``vimpact dem --for lammps`` made (the CLI
+    test's run)."""
+    run = code_run("lammps")
+    assert run.status == 0
+    return run.export
+
+
+#: the contacts, speeds (m/s) and steps per contact of the head-on LAMMPS collisions against
+#: the report's law
+COLLISIONS = [(key, v, steps) for key in ("a-floor", "a-b") for v in (0.1, 1.0)
+              for steps in (1000, 4000)]
+
+
+@pytest.fixture(scope="module")
+def lammps_collisions(lammps_export):
+    """LAMMPS' e of each of :data:`COLLISIONS` (one LAMMPS run each, in one process)."""
+    need(_NO_LAMMPS, "LAMMPS")
+    fits = {f.contact.key: f for f in lammps_export.fits}
+    runs = []
+    for key, v, steps in COLLISIONS:
+        f = fits[key]
+        R, m = f.contact.nominal()
+        runs.append((f, v, float(hertz_contact_time(f.params["E_star_Pa"], R, m, v)), steps))
+    return dict(zip(COLLISIONS, lammps.lammps_restitutions(runs)))
 
 
 @pytest.mark.parametrize("key", ["a-floor", "a-b"])
-def test_lammps_restitutes_what_the_report_predicts(lammps_export, key):
-    need(_NO_LAMMPS, "LAMMPS")
+def test_lammps_restitutes_what_the_report_predicts(lammps_export, lammps_collisions, key):
     fits = {f.contact.key: f for f in lammps_export.fits}
     f = fits[key]
-    R, m = f.contact.nominal()
     for v in (0.1, 1.0):
-        t_c = float(hertz_contact_time(f.params["E_star_Pa"], R, m, v))
         predicted = float(lammps.predicted_restitution(f, v))
-        coarse = lammps.lammps_restitution(f, v, t_c, steps_per_contact=1000)
-        fine = lammps.lammps_restitution(f, v, t_c, steps_per_contact=4000)
+        coarse = lammps_collisions[key, v, 1000]
+        fine = lammps_collisions[key, v, 4000]
         # LAMMPS' velocity-Verlet error shrinks with the time step towards the prediction
         assert abs(fine - predicted) < abs(coarse - predicted) or abs(fine - predicted) < 1e-6
         assert fine == pytest.approx(predicted, abs=5e-5)
 
 
-def test_rebound_round_trip_with_the_exported_callback(problem, tmp_path):
+def test_rebound_round_trip_with_the_exported_callback(code_run):
+    """The callback module ``vimpact dem --for rebound`` wrote for :data:`TOML` (the CLI
+    test's run)."""
     rebound = pytest.importorskip("rebound", reason="REBOUND round trip: pip install rebound")
-    ex = export(problem, "rebound", tmp_path)
+    run = code_run("rebound")
+    assert run.status == 0
+    ex = run.export
     spec = importlib.util.spec_from_file_location("vimpact_restitution_rt",
-                                                  tmp_path / "vimpact_restitution.py")
+                                                  run.folder / "vimpact_restitution.py")
     cor = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(cor)
     fit = next(f for f in ex.fits if f.contact.key == cor.CONTACT)
@@ -137,8 +161,8 @@ def test_lammps_runs_the_exported_files_at_every_size_level():
     fits = export(problem, "lammps", tangential=False).fits  # the normal law is checked here
     speeds = np.geomspace(problem.speeds.min(), problem.speeds.max(), 5)
     diff = {}
-    for steps in (lammps.STEPS_PER_CONTACT, 4 * lammps.STEPS_PER_CONTACT):
-        rows = lammps.round_trip_files(problem, speeds, steps, fits=fits)
+    steps_list = (lammps.STEPS_PER_CONTACT, 4 * lammps.STEPS_PER_CONTACT)
+    for steps, rows in lammps.round_trips_files(problem, speeds, steps_list, fits=fits).items():
         assert {(r["contact"], r["level"]) for r in rows} == {
             (f.contact.key, k) for f in fits for k in range(len(f.contact.levels()))}
         diff[steps] = max(abs(r["e"] - r["predicted"]) for r in rows)
@@ -164,12 +188,13 @@ def test_lammps_oblique_wall_impacts_give_the_reported_beta(problem, lammps_expo
     assert ob is not None and f.beta_oblique is not None and ob.mu == 0.5
     speeds, angles = sorted(set(ob.v.tolist())), sorted(set(ob.angle_deg.tolist()))
     diff = {}
-    for steps in (lammps.STEPS_PER_CONTACT, 4 * lammps.STEPS_PER_CONTACT):
-        rows = lammps.round_trip_files(problem, speeds, steps, fits=ex.fits, angles_deg=angles,
-                                       contacts={"a-floor"})
+    fine = 4 * lammps.STEPS_PER_CONTACT
+    runs = lammps.round_trips_files(problem, speeds, (lammps.STEPS_PER_CONTACT, fine),
+                                    fits=ex.fits, angles_deg=angles, contacts={"a-floor"})
+    for steps, rows in runs.items():
         assert len(rows) == len(speeds) * len(angles)
         diff[steps] = max(abs(r["beta"] - r["predicted_beta"]) for r in rows)
-    fine = 4 * lammps.STEPS_PER_CONTACT
+    rows = runs[fine]
     assert diff[fine] < 3e-3
     assert diff[fine] < diff[lammps.STEPS_PER_CONTACT] / 2  # first order in the step
     for r, beta_vimpact in oblique_rows_against_vimpact(rows, ob):

@@ -34,7 +34,8 @@ def test_lammps_residual_target_is_met_by_splitting(tmp_path):
     worst1 = max(f.res_e_z.max_abs for f in one.fits)
     assert met1 and one.problem.size_classes == 1 and worst1 > 0.05
     target = worst1 / 3.0
-    ex, met, needed = export_to_residual(problem, "lammps", target, tmp_path, tangential=False)
+    ex, met, needed = export_to_residual(problem, "lammps", target, tmp_path, tangential=False,
+                                         figure=False)
     worst = max(f.res_e_z.max_abs for f in ex.fits)
     assert met and worst <= target and needed == ex.problem.size_classes > 1
     assert "pair_coeff 2 3" in (tmp_path / "lammps_pair.in").read_text()
@@ -44,5 +45,5 @@ def test_cli_says_how_many_classes(tmp_path, capsys):
     src = tmp_path / "setup.toml"
     src.write_text(RANGE)
     assert main(["dem", str(src), "--for", "liggghts", "--out", str(tmp_path),
-                 "--residual", "1.0"]) == 0
+                 "--residual", "1.0", "--no-figure"]) == 0
     assert "size classes: 1 per size-range type (2 particle types)" in capsys.readouterr().out

@@ -2,20 +2,19 @@
 ``yade_materials.py`` unchanged on head-on collisions, restitutes what the
 report predicts, and its time-step error shrinks with the step."""
 
-import numpy as np
 import pytest
 
 from tests.dem.codes import need
-from tests.dem.test_round_trip import TOML
 from vimpact.dem import yade
-from vimpact.dem.export import export
-from vimpact.dem.problem import problem_from_toml
 
 
 @pytest.fixture(scope="module")
-def yade_export():
-    problem = problem_from_toml(TOML, "round-trip")
-    return problem, export(problem, "yade")
+def yade_export(code_run):
+    """The set-up and the export that ``vimpact dem --for yade`` made of the round trips'
+    set-up (the CLI test's run)."""
+    run = code_run("yade")
+    assert run.status == 0
+    return run.export.problem, run.export
 
 
 @pytest.fixture(scope="module")
@@ -24,35 +23,45 @@ def exported(yade_export):
     return problem, ex.fits
 
 
-def test_yade_runs_the_exported_file_and_restitutes_the_prediction(exported):
+@pytest.fixture(scope="module")
+def yade_rows(yade_export):
+    """Yade on the exported file at the default step (400 per contact) and at 1600 (one
+    Yade start): at each step the head-on collisions of every contact and the oblique wall
+    impacts, at the report's oblique speeds (its lowest and highest among them) and angles."""
     need(yade.yade_available(), "Yade")
-    problem, fits = exported
-    speeds = np.geomspace(problem.speeds.min(), problem.speeds.max(), 5)
+    problem, ex = yade_export
+    ob = ex.targets["a-floor"].oblique
+    speeds, angles = sorted(set(ob.v.tolist())), sorted(set(ob.angle_deg.tolist()))
+    assert speeds[0] == problem.speeds.min() and speeds[-1] == problem.speeds.max()
+    return yade.round_trips(problem, speeds, (400, 1600), fits=ex.fits, angles_deg=angles,
+                            head_on=True)
+
+
+def test_yade_runs_the_exported_file_and_restitutes_the_prediction(exported, yade_rows):
+    _, fits = exported
     diff = {}
     for steps in (400, 1600):
-        rows = yade.round_trip(problem, speeds, steps, fits=fits)
+        rows = [r for r in yade_rows[steps] if "angle" not in r]
         assert {r["contact"] for r in rows} == {f.contact.key for f in fits}  # pairs, same type, wall
         diff[steps] = max(abs(r["e"] - r["predicted"]) for r in rows)
     assert diff[400] < 1e-3          # the exported default step
     assert diff[1600] < diff[400] / 2  # Yade's time-step error, shrinking with the step
 
 
-def test_yade_oblique_wall_impacts_give_the_reported_beta(yade_export):
+def test_yade_oblique_wall_impacts_give_the_reported_beta(yade_export, yade_rows):
     """Yade on the exported file, oblique wall impacts with the set-up's friction at the
     report's speeds and angles: its beta is the report's prediction (which includes
     Yade's wall lever arm R - delta) to its time-step error, shrinking with the step, and
     within the stated beta_x residual (plus that error) of vimpact's."""
-    need(yade.yade_available(), "Yade")
     from tests.dem.test_round_trip import oblique_rows_against_vimpact
 
-    problem, ex = yade_export
+    _, ex = yade_export
     f = next(x for x in ex.fits if x.contact.key == "a-floor")
     ob = ex.targets["a-floor"].oblique
     speeds, angles = sorted(set(ob.v.tolist())), sorted(set(ob.angle_deg.tolist()))
     diff, rows = {}, {}
     for steps in (400, 1600):
-        rows[steps] = [r for r in yade.round_trip(problem, speeds, steps, fits=ex.fits,
-                                                  angles_deg=angles) if r["contact"] == "a-floor"]
+        rows[steps] = [r for r in yade_rows[steps] if r["contact"] == "a-floor" and "angle" in r]
         assert len(rows[steps]) == len(speeds) * len(angles)
         diff[steps] = max(abs(r["beta"] - r["predicted_beta"]) for r in rows[steps])
     assert diff[1600] < 3e-3

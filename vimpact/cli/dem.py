@@ -39,6 +39,10 @@ def add_parser(sub) -> None:
                    help="split every type with a radius range into 1, 2, ... size classes "
                         "(types NAME_1..NAME_k) until the largest e_z residual of every contact "
                         "is at most E (up to 8 classes); the summary says how many it took")
+    p.add_argument("--figure", action=argparse.BooleanOptionalAction, default=True,
+                   help="draw the report's figure report_<code>.png (default); --no-figure "
+                        "skips it (drawing it takes longer than writing the rest of the "
+                        "report) and the Markdown report says that no figure was drawn")
     p.add_argument("--json", action="store_true",
                    help="print the fits (constants, residuals, files written) as JSON")
     p.set_defaults(func=run)
@@ -75,7 +79,7 @@ def run(args: argparse.Namespace) -> int:
         result, met, needed = export_to_residual(problem, args.code, args.residual, out,
                                          Numerics.preset(args.preset),
                                          steps_per_contact=args.steps_per_contact,
-                                         progress=progress)
+                                         progress=progress, figure=args.figure)
         worst = max((f.res_e_z.max_abs for f in result.fits if f.res_e_z is not None),
                     default=math.nan)
         final = result.problem or problem  # the problem refined to meet the residual
@@ -84,7 +88,8 @@ def run(args: argparse.Namespace) -> int:
                    "max_residual_e_z": worst, "met": met, "classes_needed": needed}
     else:
         result = export(problem, args.code, out, Numerics.preset(args.preset),
-                        steps_per_contact=args.steps_per_contact, progress=progress)
+                        steps_per_contact=args.steps_per_contact, progress=progress,
+                        figure=args.figure)
     if args.json:
         data = to_json(result)
         if classes is not None:

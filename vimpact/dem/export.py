@@ -32,11 +32,12 @@ def code_module(code: str):
 
 def export(problem: DemProblem, code: str, out_dir=None, numerics=None,
            targets: dict[str, Targets] | None = None, steps_per_contact: int | None = None,
-           progress=None, tangential: bool | None = None) -> Export:
+           progress=None, tangential: bool | None = None, figure: bool = True) -> Export:
     """Fit ``code``'s constants for every contact of ``problem``; write the files.
 
     With ``out_dir``, the code's input file(s), ``report_<code>.md`` and
-    ``report_<code>.png`` are written there. ``targets`` (from an earlier call, by
+    ``report_<code>.png`` are written there (``figure=False``: no PNG, and the
+    report says that no figure was drawn). ``targets`` (from an earlier call, by
     contact key) skips the vimpact runs of the contacts it holds (those without
     ``beta_x`` are run again when the code has a tangential restitution).
     ``steps_per_contact`` sets the exported time step of the codes that get one (LAMMPS,
@@ -83,13 +84,15 @@ def export(problem: DemProblem, code: str, out_dir=None, numerics=None,
         for name, text in mod.render(problem, fits, **render_kw).items():
             (out / name).write_text(text, encoding="utf-8")
             files.append(out / name)
-        png = report.figure(code, problem, targets, fits, out / f"report_{code}.png")
+        png = (report.figure(code, problem, targets, fits, out / f"report_{code}.png")
+               if figure else None)
         md = out / f"report_{code}.md"
         md.write_text(report.markdown(code, problem, targets, fits, [p.name for p in files],
-                                      png.name, steps, getattr(mod, "TIME_STEP_ERROR", None),
+                                      None if png is None else png.name, steps,
+                                      getattr(mod, "TIME_STEP_ERROR", None),
                                       getattr(mod, "BETA_TIME_STEP_ERROR", None)),
                       encoding="utf-8")
-        files += [md, png]
+        files += [md] if png is None else [md, png]
     return Export(code, fits, targets, files, problem)
 
 
@@ -99,7 +102,7 @@ MAX_SIZE_CLASSES = 8
 
 def export_to_residual(problem: DemProblem, code: str, residual: float, out_dir=None,
                        numerics=None, steps_per_contact: int | None = None,
-                       progress=None, tangential: bool | None = None
+                       progress=None, tangential: bool | None = None, figure: bool = True
                        ) -> tuple[Export, bool, int]:
     """Split the size-range types into size classes until ``e_z`` meets ``residual``.
 
@@ -110,7 +113,7 @@ def export_to_residual(problem: DemProblem, code: str, residual: float, out_dir=
     the residual (what is left is not the size range's, e.g. the speed dependence a
     constant-``e`` code cannot follow). Writes the files of the best problem (with
     ``beta_x`` and the tangential fits, unless ``tangential=False``; the search itself
-    uses ``e_z`` only).
+    uses ``e_z`` only; ``figure`` as in :func:`export`).
 
     Returns
     -------
@@ -154,5 +157,5 @@ def export_to_residual(problem: DemProblem, code: str, residual: float, out_dir=
     needed = k if met else (0 if stalled else math.ceil(k * worst / residual))
     if out_dir is not None:
         ex = export(prob, code, out_dir, numerics, ex.targets, steps_per_contact, progress,
-                    tangential)
+                    tangential, figure)
     return ex, met, needed

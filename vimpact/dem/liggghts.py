@@ -247,7 +247,7 @@ def liggghts_available() -> str | None:
 
 def round_trip(problem: DemProblem, speeds, steps_per_contact: int = STEPS_PER_CONTACT,
                fits: list[ContactFit] | None = None, timeout: float = 600.0,
-               angles_deg=None, contacts=None) -> list[dict]:
+               angles_deg=None, contacts=None, head_on: bool | None = None) -> list[dict]:
     """Run LIGGGHTS once with the exported files on head-on collisions of every contact.
 
     The files are included unchanged; nominal sizes, ``speeds`` in m/s. One dict
@@ -257,8 +257,24 @@ def round_trip(problem: DemProblem, speeds, steps_per_contact: int = STEPS_PER_C
     With ``angles_deg``: oblique impacts of the wall contacts only at those angles from
     the normal (``v_c0 = v tan(angle)``, no spin); rows also have ``angle``, ``beta``
     (LIGGGHTS', the contact-point velocity from the tangential impulse with its
-    solid-sphere inertia) and ``predicted_beta`` (:func:`tangential_beta`). ``contacts``:
-    the keys of the contacts whose rows are returned (default: every contact).
+    solid-sphere inertia) and ``predicted_beta`` (:func:`tangential_beta`);
+    ``head_on=True`` adds the head-on collisions of every contact to the same run (one
+    LIGGGHTS start for both). ``contacts``: the keys of the contacts whose rows are
+    returned (default: every contact). Several time steps in one LIGGGHTS start:
+    :func:`round_trips`.
+    """
+    return round_trips(problem, speeds, [steps_per_contact], fits, timeout, angles_deg,
+                       contacts, head_on)[steps_per_contact]
+
+
+def round_trips(problem: DemProblem, speeds, steps_per_contact,
+                fits: list[ContactFit] | None = None, timeout: float = 600.0,
+                angles_deg=None, contacts=None, head_on: bool | None = None
+                ) -> dict[int, list[dict]]:
+    """Return :func:`round_trip`'s rows at each of the time steps ``steps_per_contact``.
+
+    One LIGGGHTS start: each time step is a run of its own after ``clear``, with the
+    files exported for it; a dict from steps per contact to rows.
     """
     import os
     import subprocess
@@ -270,7 +286,8 @@ def round_trip(problem: DemProblem, speeds, steps_per_contact: int = STEPS_PER_C
         from vimpact.dem.export import export
 
         fits = export(problem, CODE).fits
-    files = render(problem, fits, steps_per_contact)
+    if head_on is None:
+        head_on = angles_deg is None
     n_types = len(problem.types) + len(problem.walls)
     cases: list[dict[str, Any]] = []
     # per atom: type, position (m), radius (m), density (kg/m^3), velocity (m/s)
@@ -282,9 +299,8 @@ def round_trip(problem: DemProblem, speeds, steps_per_contact: int = STEPS_PER_C
     Y = _youngs(problem)
     for f in fits:
         c = f.contact
-        if angles_deg is not None and not c.is_wall:
-            continue
-        for v, ang in [(v, a) for v in speeds for a in (angles_deg or [None])]:
+        angles = list(angles_deg) if angles_deg is not None and c.is_wall else []
+        for v, ang in [(v, a) for v in speeds for a in ([None] if head_on else []) + angles]:
             second = c.second
             R1 = c.first.radius
             R2 = R1 if isinstance(second, WallType) else second.radius
@@ -294,10 +310,7 @@ def round_trip(problem: DemProblem, speeds, steps_per_contact: int = STEPS_PER_C
             case: dict[str, Any] = {"contact": c.key, "v": float(v),
                                     "predicted": float(f.params["e_liggghts"]), "ids": []}
             if ang is not None:
-                Ys, Gs = shear_ratio(Y, c.first.index - 1, c.second.index - 1)
-                F = linear.mass_factor(c)
-                R_, m_ = c.nominal()
-                case.update(angle=float(ang), vt=vt, F=F)
+                case.update(angle=float(ang), vt=vt, F=linear.mass_factor(c))
             if isinstance(second, WallType):
                 atoms.append((c.first.index, (x, 0.0, R1 + gap), R1, c.first.density,
                               (vt, 0.0, -float(v))))
@@ -311,64 +324,77 @@ def round_trip(problem: DemProblem, speeds, steps_per_contact: int = STEPS_PER_C
                 case["ids"] = [len(atoms) - 1, len(atoms)]
             cases.append(case)
             top = x
-        if angles_deg is not None:  # the report's beta of all this contact's impacts in one call
-            mine = [cs for cs in cases if cs["contact"] == c.key]
+        if angles:  # the report's beta of all this contact's oblique impacts in one call
+            Ys, Gs = shear_ratio(Y, c.first.index - 1, c.second.index - 1)
+            R_, m_ = c.nominal()
+            mine = [cs for cs in cases if cs["contact"] == c.key and "angle" in cs]
             v_all = np.array([cs["v"] for cs in mine])
-            beta = tangential_beta(f.params["coefficientRestitution"], Ys, Gs, F, c.mu,
+            beta = tangential_beta(f.params["coefficientRestitution"], Ys, Gs,
+                                   linear.mass_factor(c), c.mu,
                                    np.array([cs["vt"] for cs in mine]) / v_all,
                                    f.params.get("tangential_damping", True),
                                    wall=(R_, m_, v_all))
             for cs, b in zip(mine, beta):
                 cs["predicted_beta"] = float(b)
-    dt = time_step(fits, steps_per_contact)
     t_end = max(1e-3 * f.contact.first.radius / min(speeds) for f in fits) + 3.0 * max(
         float(laws.hertz_contact_time(f.params["E_star_Pa"], *f.contact.nominal(), min(speeds)))
         for f in fits)
-    lines = ["include liggghts_settings.in", "boundary f f f",
-             f"region box block {-r_max * 4:.6g} {top + 4 * r_max:.6g} {-4 * r_max:.6g} "
-             f"{4 * r_max:.6g} {-4 * r_max:.6g} {z_pairs + 4 * r_max:.6g} units box",
-             f"create_box {n_types} box", f"neighbor {0.5 * r_max:.6g} bin",
-             "include liggghts.in"]
-    for k, (typ, (ax, ay, az), R, rho, (vx, vy, vz)) in enumerate(atoms, start=1):
-        lines += [f"create_atoms {typ} single {ax:.12g} {ay:.12g} {az:.12g} units box",
-                  f"set atom {k} diameter {2 * R:.12g} density {rho:.12g}",
-                  f"group one id {k}", f"velocity one set {vx:.12g} {vy:.12g} {vz:.12g} units box",
-                  "group one delete"]
-    lines += ["fix integrate all nve/sphere", "thermo 0", f"run {int(math.ceil(t_end / dt))}"]
-    for k in range(1, len(atoms) + 1):
-        lines += [f"variable vx{k} equal vx[{k}]", f"variable vz{k} equal vz[{k}]",
-                  f'print "VIMPACT {k} ${{vx{k}}} ${{vz{k}}}"']
+    steps_list = [int(n) for n in steps_per_contact]
+    lines = []
+    for part, n in enumerate(steps_list):
+        dt = time_step(fits, n)
+        lines += (["clear"] if part else []) + [
+            f"include {n}/liggghts_settings.in", "boundary f f f",
+            f"region box block {-r_max * 4:.6g} {top + 4 * r_max:.6g} {-4 * r_max:.6g} "
+            f"{4 * r_max:.6g} {-4 * r_max:.6g} {z_pairs + 4 * r_max:.6g} units box",
+            f"create_box {n_types} box", f"neighbor {0.5 * r_max:.6g} bin",
+            f"include {n}/liggghts.in"]
+        for k, (typ, (ax, ay, az), R, rho, (vx, vy, vz)) in enumerate(atoms, start=1):
+            lines += [f"create_atoms {typ} single {ax:.12g} {ay:.12g} {az:.12g} units box",
+                      f"set atom {k} diameter {2 * R:.12g} density {rho:.12g}",
+                      f"group one id {k}",
+                      f"velocity one set {vx:.12g} {vy:.12g} {vz:.12g} units box",
+                      "group one delete"]
+        lines += ["fix integrate all nve/sphere", "thermo 0",
+                  f"run {int(math.ceil(t_end / dt))}"]
+        for k in range(1, len(atoms) + 1):
+            lines += [f"variable vx{k} equal vx[{k}]", f"variable vz{k} equal vz[{k}]",
+                      f'print "VIMPACT {part} {k} ${{vx{k}}} ${{vz{k}}}"']
     with tempfile.TemporaryDirectory() as tmp:
-        for name, text in files.items():
-            with open(os.path.join(tmp, name), "w") as fh:
-                fh.write(text)
+        for n in steps_list:
+            os.makedirs(os.path.join(tmp, str(n)), exist_ok=True)
+            for name, text in render(problem, fits, n).items():
+                with open(os.path.join(tmp, str(n), name), "w") as fh:
+                    fh.write(text)
         with open(os.path.join(tmp, "in.drive"), "w") as fh:
             fh.write("\n".join(lines) + "\n")
         proc = subprocess.run([LIGGGHTS, "-in", "in.drive", "-log", "none"], cwd=tmp,
                               capture_output=True, text=True, timeout=timeout,
                               env=dict(os.environ, OMP_NUM_THREADS="1"))
-    vel = {}
+    vel: dict[tuple[int, int], tuple[float, float]] = {}
     for ln in proc.stdout.splitlines():
         if ln.startswith("VIMPACT "):
-            _, atom, vx_end, vz_end = ln.split()
-            vel[int(atom)] = (float(vx_end), float(vz_end))
-    if proc.returncode != 0 or len(vel) != len(atoms):
+            _, part_s, atom, vx_end, vz_end = ln.split()
+            vel[int(part_s), int(atom)] = (float(vx_end), float(vz_end))
+    if proc.returncode != 0 or len(vel) != len(atoms) * len(steps_list):
         raise RuntimeError(f"LIGGGHTS failed: {(proc.stdout + proc.stderr).strip()[-2000:]}")
-    rows = []
-    for case in cases:
-        ids = case.pop("ids")
-        vt, F = case.pop("vt", None), case.pop("F", None)
-        if len(ids) == 1:
-            e = vel[ids[0]][1] / case["v"]
-        else:
-            e = (vel[ids[1]][0] - vel[ids[0]][0]) / case["v"]
-        row = dict(case, e=e)
-        if vt:
-            # the tangential impulse changes the contact-point velocity F times the centre's
-            row["beta"] = -(vt + F * (vel[ids[0]][0] - vt)) / vt
-        rows.append(row)
-    return [r for r in rows if contacts is None or r["contact"] in contacts]
-
+    out = {}
+    for part, n in enumerate(steps_list):
+        rows = []
+        for case in cases:
+            row = {k: v for k, v in case.items() if k not in ("ids", "vt", "F")}
+            ids, vt, F = case["ids"], case.get("vt", 0.0), case.get("F", 0.0)
+            first = vel[part, ids[0]]
+            if len(ids) == 1:
+                row["e"] = first[1] / case["v"]
+            else:
+                row["e"] = (vel[part, ids[1]][0] - first[0]) / case["v"]
+            if vt:
+                # the tangential impulse changes the contact-point velocity F times the centre's
+                row["beta"] = -(vt + F * (first[0] - vt)) / vt
+            rows.append(row)
+        out[n] = [r for r in rows if contacts is None or r["contact"] in contacts]
+    return out
 
 
 if __name__ == "__main__":  # python -m vimpact.dem.liggghts SETUP.toml [STEPS_PER_CONTACT]

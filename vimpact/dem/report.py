@@ -112,7 +112,7 @@ def _fmt(x) -> str:
 
 
 def markdown(code: str, problem: DemProblem, targets: dict[str, Targets],
-             fits: list[ContactFit], files: list[str], png: str,
+             fits: list[ContactFit], files: list[str], png: str | None,
              steps_per_contact: int | None = None, step_error=None,
              beta_step_error: str | None = None) -> str:
     """Return the report text (Markdown).
@@ -120,6 +120,8 @@ def markdown(code: str, problem: DemProblem, targets: dict[str, Targets],
     ``steps_per_contact`` and ``step_error`` (the code module's
     ``TIME_STEP_ERROR``) add the exported time step and the code's error at it,
     ``beta_step_error`` (``BETA_TIME_STEP_ERROR``) its measured error in ``beta_x``.
+    ``png``: the figure's file name, or ``None`` when no figure was drawn (the report
+    says so).
     """
     lines = [f"# vimpact dem: {code}", "",
              f"Input: `{problem.source}`; normal impact speeds {problem.speeds.min():g} to "
@@ -171,7 +173,8 @@ def markdown(code: str, problem: DemProblem, targets: dict[str, Targets],
                          + " m/s and impact angles "
                          + ", ".join(f"{a:g}" for a in sorted(set(ob.angle_deg.tolist())))
                          + " deg (from the normal, no spin)")
-    lines += ["", f"![vimpact vs {code}]({png})", ""]
+    lines += ["", f"![vimpact vs {code}]({png})" if png is not None else
+              "No figure was drawn (`--no-figure`).", ""]
     return "\n".join(lines)
 
 

@@ -314,45 +314,49 @@ YADE = "yade"
 
 _DRIVER = r"""
 import json
-exec(open({materials!r}).read())
-cases = {cases!r}
-walls_needed = sorted({{c["wall"] for c in cases if c["wall"]}})
-for w in walls_needed:
-    O.bodies.append(wall(0.0, axis=2, material=vimpact_mat[w]))
-runs = []
-x = 0.0
-for c in cases:
-    R1, R2, v = c["R1"], c["R2"], c["v"]
-    x += 4.0 * (R1 + (R2 or R1)) + 0.01
-    gap = 1e-3 * R1
-    if c["wall"]:
-        b1 = O.bodies.append(sphere((x, 0.0, R1 + gap), R1, material=vimpact_mat[c["first"]]))
-        O.bodies[b1].state.vel = Vector3(c.get("vt", 0.0), 0.0, -v)
-        runs.append((b1, None))
-    else:
-        z = 1.0  # far above any wall; the pair collides along x
-        b1 = O.bodies.append(sphere((x - R1 - gap / 2, 0.0, z), R1, material=vimpact_mat[c["first"]]))
-        b2 = O.bodies.append(sphere((x + R2 + gap / 2, 0.0, z), R2, material=vimpact_mat[c["second"]]))
-        m1, m2 = O.bodies[b1].state.mass, O.bodies[b2].state.mass
-        O.bodies[b1].state.vel = Vector3(v * m2 / (m1 + m2), 0.0, 0.0)
-        O.bodies[b2].state.vel = Vector3(-v * m1 / (m1 + m2), 0.0, 0.0)
-        runs.append((b1, b2))
-O.engines = [ForceResetter(),
-             InsertionSortCollider([Bo1_Sphere_Aabb(), Bo1_Wall_Aabb()]),
-             InteractionLoop([Ig2_Sphere_Sphere_ScGeom(), Ig2_Wall_Sphere_ScGeom()],
-                             [vimpact_ip2], [vimpact_law]),
-             NewtonIntegrator(damping=0.0)]
-O.dt = {dt!r}
-O.run({steps}, True)
-out = []
-for c, (b1, b2) in zip(cases, runs):
-    if b2 is None:
-        e = O.bodies[b1].state.vel[2] / c["v"]
-    else:
-        e = (O.bodies[b2].state.vel[0] - O.bodies[b1].state.vel[0]) / c["v"]
-    out.append(dict(c, e=float(e), vx_end=float(O.bodies[b1].state.vel[0]),
-                    spin=float(O.bodies[b1].state.angVel[1])))
-json.dump({{"rows": out, "open": O.interactions.countReal()}}, open({result!r}, "w"))
+results = []
+for part in {parts!r}:
+    O.reset()
+    exec(open(part["materials"]).read())
+    cases = part["cases"]
+    walls_needed = sorted({{c["wall"] for c in cases if c["wall"]}})
+    for w in walls_needed:
+        O.bodies.append(wall(0.0, axis=2, material=vimpact_mat[w]))
+    runs = []
+    x = 0.0
+    for c in cases:
+        R1, R2, v = c["R1"], c["R2"], c["v"]
+        x += 4.0 * (R1 + (R2 or R1)) + 0.01
+        gap = 1e-3 * R1
+        if c["wall"]:
+            b1 = O.bodies.append(sphere((x, 0.0, R1 + gap), R1, material=vimpact_mat[c["first"]]))
+            O.bodies[b1].state.vel = Vector3(c.get("vt", 0.0), 0.0, -v)
+            runs.append((b1, None))
+        else:
+            z = 1.0  # far above any wall; the pair collides along x
+            b1 = O.bodies.append(sphere((x - R1 - gap / 2, 0.0, z), R1, material=vimpact_mat[c["first"]]))
+            b2 = O.bodies.append(sphere((x + R2 + gap / 2, 0.0, z), R2, material=vimpact_mat[c["second"]]))
+            m1, m2 = O.bodies[b1].state.mass, O.bodies[b2].state.mass
+            O.bodies[b1].state.vel = Vector3(v * m2 / (m1 + m2), 0.0, 0.0)
+            O.bodies[b2].state.vel = Vector3(-v * m1 / (m1 + m2), 0.0, 0.0)
+            runs.append((b1, b2))
+    O.engines = [ForceResetter(),
+                 InsertionSortCollider([Bo1_Sphere_Aabb(), Bo1_Wall_Aabb()]),
+                 InteractionLoop([Ig2_Sphere_Sphere_ScGeom(), Ig2_Wall_Sphere_ScGeom()],
+                                 [vimpact_ip2], [vimpact_law]),
+                 NewtonIntegrator(damping=0.0)]
+    O.dt = part["dt"]
+    O.run(part["steps"], True)
+    out = []
+    for c, (b1, b2) in zip(cases, runs):
+        if b2 is None:
+            e = O.bodies[b1].state.vel[2] / c["v"]
+        else:
+            e = (O.bodies[b2].state.vel[0] - O.bodies[b1].state.vel[0]) / c["v"]
+        out.append(dict(c, e=float(e), vx_end=float(O.bodies[b1].state.vel[0]),
+                        spin=float(O.bodies[b1].state.angVel[1])))
+    results.append({{"rows": out, "open": O.interactions.countReal()}})
+json.dump(results, open({result!r}, "w"))
 """
 
 
@@ -367,7 +371,7 @@ def yade_available() -> str | None:
 
 def round_trip(problem: DemProblem, speeds, steps_per_contact: int = STEPS_PER_CONTACT,
                fits: list[ContactFit] | None = None, timeout: float = 600.0,
-               angles_deg=None, contacts=None) -> list[dict]:
+               angles_deg=None, contacts=None, head_on: bool | None = None) -> list[dict]:
     """Run Yade once with the exported ``yade_materials.py`` on head-on collisions of every contact.
 
     The file is used unchanged; nominal sizes, ``speeds`` in m/s. One dict per
@@ -377,8 +381,23 @@ def round_trip(problem: DemProblem, speeds, steps_per_contact: int = STEPS_PER_C
     With ``angles_deg``: oblique impacts of the wall contacts only, at those angles from
     the normal (``v_c0 = v tan(angle)``, no spin); each row also has ``angle``, ``beta``
     (Yade's ``-v_c,end / v_c0``, ``v_c = v_x - R omega_y`` from its velocity and spin)
-    and ``predicted_beta`` (the report's law, :func:`yade_oblique`). ``contacts``: the keys
-    of the contacts whose rows are returned (default: every contact).
+    and ``predicted_beta`` (the report's law, :func:`yade_oblique`); ``head_on=True``
+    adds the head-on collisions of every contact to the same run (one Yade start for
+    both). ``contacts``: the keys of the contacts whose rows are returned (default: every
+    contact). Several time steps in one Yade start: :func:`round_trips`.
+    """
+    return round_trips(problem, speeds, [steps_per_contact], fits, timeout, angles_deg,
+                       contacts, head_on)[steps_per_contact]
+
+
+def round_trips(problem: DemProblem, speeds, steps_per_contact, fits: list[ContactFit] | None = None,
+                timeout: float = 600.0, angles_deg=None, contacts=None,
+                head_on: bool | None = None) -> dict[int, list[dict]]:
+    """Return :func:`round_trip`'s rows at each of the time steps ``steps_per_contact``.
+
+    One Yade start: each time step is a scene of its own (``O.reset()``, the file it
+    was exported with run again), one after another; a dict from steps per contact to
+    rows.
     """
     import json
     import os
@@ -389,17 +408,16 @@ def round_trip(problem: DemProblem, speeds, steps_per_contact: int = STEPS_PER_C
         from vimpact.dem.export import export
 
         fits = export(problem, CODE).fits
-    text = render(problem, fits, steps_per_contact)["yade_materials.py"]
-    dt = time_step(fits, steps_per_contact)
+    if head_on is None:
+        head_on = angles_deg is None
     cases = []
     for f in fits:
         c = f.contact
-        if angles_deg is not None and not c.is_wall:
-            continue
+        angles = list(angles_deg) if angles_deg is not None and c.is_wall else []
         second = c.second
         R2 = None if isinstance(second, WallType) else second.radius
         for v in speeds:
-            for ang in (angles_deg if angles_deg is not None else [None]):
+            for ang in ([None] if head_on else []) + angles:
                 case: dict[str, Any] = {
                     "contact": c.key, "first": c.first.name, "second": second.name,
                     "wall": second.name if c.is_wall else None, "v": float(v),
@@ -407,9 +425,9 @@ def round_trip(problem: DemProblem, speeds, steps_per_contact: int = STEPS_PER_C
                 if ang is not None:
                     case.update(angle=float(ang), vt=float(v) * math.tan(math.radians(ang)))
                 cases.append(case)
-        if angles_deg is not None:  # the report's beta of all this contact's impacts in one call
+        if angles:  # the report's beta of all this contact's oblique impacts in one call
             p = f.params
-            mine = [cs for cs in cases if cs["contact"] == c.key]
+            mine = [cs for cs in cases if cs["contact"] == c.key and "angle" in cs]
             v_all = np.array([cs["v"] for cs in mine])
             beta = yade_oblique(p["tc"], p["en"], p["et"], mass_ratio(c), linear.mass_factor(c),
                                 p["mu"], np.array([math.tan(math.radians(cs["angle"]))
@@ -419,27 +437,37 @@ def round_trip(problem: DemProblem, speeds, steps_per_contact: int = STEPS_PER_C
                 cs["predicted_beta"] = float(b)
     t_end = max(1e-3 * cs["R1"] / cs["v"] for cs in cases) + 3.0 * max(
         f.params["t_contact"] for f in fits)
+    steps_list = [int(n) for n in steps_per_contact]
     with tempfile.TemporaryDirectory() as tmp:
-        mats, drv, res = (os.path.join(tmp, n) for n in ("yade_materials.py", "drive.py", "out.json"))
-        with open(mats, "w") as fh:
-            fh.write(text)
+        parts = []
+        for n in steps_list:
+            mats = os.path.join(tmp, f"{n}", "yade_materials.py")
+            os.makedirs(os.path.dirname(mats), exist_ok=True)
+            with open(mats, "w") as fh:
+                fh.write(render(problem, fits, n)["yade_materials.py"])
+            dt = time_step(fits, n)
+            parts.append({"materials": mats, "cases": cases, "dt": dt,
+                          "steps": int(math.ceil(t_end / dt))})
+        drv, res = os.path.join(tmp, "drive.py"), os.path.join(tmp, "out.json")
         with open(drv, "w") as fh:
-            fh.write(_DRIVER.format(materials=mats, cases=cases, dt=dt,
-                                    steps=int(math.ceil(t_end / dt)), result=res))
+            fh.write(_DRIVER.format(parts=parts, result=res))
         proc = subprocess.run([YADE, "-n", "-x", drv], cwd=tmp, capture_output=True, text=True,
                               timeout=timeout, env=dict(os.environ, OMP_NUM_THREADS="1"))
         if not os.path.exists(res):
             raise RuntimeError(f"Yade failed: {(proc.stdout + proc.stderr).strip()[-2000:]}")
         with open(res) as fh:
-            data = json.load(fh)
-    if data["open"]:
-        raise RuntimeError(f"Yade round trip: {data['open']} contacts still open at the end")
-    rows = data["rows"]
-    for r in rows:
-        if "vt" in r:
-            r["beta"] = -(r["vx_end"] - r["R1"] * r["spin"]) / r["vt"]
-    return [r for r in rows if contacts is None or r["contact"] in contacts]
-
+            results = json.load(fh)
+    out = {}
+    for n, data in zip(steps_list, results):
+        if data["open"]:
+            raise RuntimeError(f"Yade round trip: {data['open']} contacts still open at the end "
+                               f"({n} steps per contact)")
+        rows = data["rows"]
+        for r in rows:
+            if "vt" in r:
+                r["beta"] = -(r["vx_end"] - r["R1"] * r["spin"]) / r["vt"]
+        out[n] = [r for r in rows if contacts is None or r["contact"] in contacts]
+    return out
 
 
 if __name__ == "__main__":  # python -m vimpact.dem.yade SETUP.toml [STEPS_PER_CONTACT]
