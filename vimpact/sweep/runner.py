@@ -532,8 +532,7 @@ def _run(spec, spec_path, out, parts, resume, progress, workers, scheduler, shar
                     fresh.append((table, summary))
                     if spec.n_chunks > 1:
                         own = ContentHash().update(table, also=whole).hexdigest()
-                    else:
-                        whole.update(table)
+                    # (one chunk: hashed while its table is encoded, store.combine)
                 if spec.n_chunks > 1 or fresh is None:
                     store.write_part(spec, table, parts, chunk, summary, own)
                     done[chunk] = store.part_path(parts, chunk, spec.n_chunks)
@@ -546,7 +545,7 @@ def _run(spec, spec_path, out, parts, resume, progress, workers, scheduler, shar
             return parts
         t0 = time.perf_counter()
         _combine(spec, parts, out, log, stages, fresh,
-                 whole.hexdigest() if fresh is not None else None)
+                 whole.hexdigest() if fresh is not None and spec.n_chunks > 1 else None)
         _timed(timings, "write_s", t0)
     except KeyboardInterrupt:
         bar.close(finished)
