@@ -462,6 +462,10 @@ def _codes(name: str, values, choices, default: str, n: int, reasons) -> np.ndar
     if values is None:
         return np.full(n, choices.index(default), dtype=np.int8)
     values = np.asarray(values)
+    if values.ndim == 1 and n > 1 and values.strides[0] == 0 and isinstance(values[0], str) \
+            and values[0] in choices:
+        # one value in every row (a view of one element): compared once
+        return np.full(n, choices.index(values[0]), dtype=np.int8)
     text = values.dtype.kind == "U"  # compared as it is (as objects: a str per row, 5 ms/1e5)
     if not text:
         values = values.astype(object)

@@ -82,8 +82,11 @@ def engine_columns(spec, p: dict[str, np.ndarray]) -> tuple[list[tuple[np.ndarra
     """
     n = len(p["nu"])
     nu = p["nu"]
-    common = {"tangential": np.full(n, spec.tangential),
-              "tangential_memory": np.full(n, spec.tangential_memory),
+    # the effect choices: one str in every row as a read-only view of one element (a
+    # str array of n rows costs some 4 ms per 1e5 rows to make and to compare; the
+    # engine reads a view's one value once, vimpact.engine.columns)
+    common = {"tangential": np.broadcast_to(np.array(spec.tangential), (n,)),
+              "tangential_memory": np.broadcast_to(np.array(spec.tangential_memory), (n,)),
               "rotation": np.full(n, spec.rotation)}
     # no "model" column: the engine infers it from the rheology (it only decides how the
     # engine reports Q1, Q2, which the table takes from the spec for a grid)
