@@ -248,9 +248,10 @@ def guard_nan(cols: dict, status: np.ndarray, error: np.ndarray, vc0_zero: np.nd
     for k in np.flatnonzero(bad):  # rare: the message names this row's columns
         names = ", ".join(c for c, m in bad_cols.items() if m[k])
         error[k] = f"NaN in {names} of a row with status {STATUS_NAMES[status[k]]!r}"
-    status[bad] = STATUS_CODE["non_finite"]
-    for c in OUTPUTS:
-        cols[c][bad] = np.nan
+    if bad.any():  # (rare: no pass over the outputs otherwise)
+        status[bad] = STATUS_CODE["non_finite"]
+        for c in OUTPUTS:
+            cols[c][bad] = np.nan
     return bad
 
 
