@@ -128,12 +128,11 @@ def compute_chunk(spec: SweepSpec, chunk: int, timings: dict | None = None):
     batches, inputs = engine_columns(spec, params)
     outputs = RESULTS | (ADHESION_RESULTS if spec.has_adhesion else {})
     cols: dict[str, np.ndarray] = {"row": np.arange(start, stop, dtype=np.int64)}
+    given = {**params, **inputs}
     for c in spec.columns():
-        if c not in ("row",) + LABELS and c not in outputs:
-            cols[c] = np.full(n, np.nan)
-    for key, values in {**params, **inputs}.items():
-        if key in cols:
-            cols[key][:] = values
+        if c not in ("row",) + LABELS and c not in outputs:  # (a copy: one pass)
+            cols[c] = (np.array(np.broadcast_to(given[c], (n,)), dtype=np.float64)
+                       if c in given else np.full(n, np.nan))
     # statuses and paths as integer codes (STATUS_NAMES; path_names), text only in the
     # Arrow column; a row no batch reaches stays invalid; one batch of all the chunk's
     # rows in order (the usual case) hands over its result columns as they are
@@ -239,19 +238,25 @@ def guard_nan(cols: dict, status: np.ndarray, error: np.ndarray, vc0_zero: np.nd
     Returns the rows changed (bool).
     """
     explained = np.broadcast_to(np.asarray(vc0_zero, dtype=bool), finished.shape)
+    # NaN in any output first (one OR per column), each column's own rows only then
+    tangential = [c for c in OUTPUTS if c in TANGENTIAL_OUTPUTS]
+    other = [c for c in OUTPUTS if c not in TANGENTIAL_OUTPUTS]
+    nan_other = np.logical_or.reduce([np.isnan(cols[c]) for c in other])
+    nan_tangential = np.logical_or.reduce([np.isnan(cols[c]) for c in tangential])
+    bad = finished & (nan_other | (nan_tangential & ~explained))
+    if not bad.any():
+        return bad
     nothing = np.zeros(finished.shape, dtype=bool)
     bad_cols = {c: np.isnan(cols[c]) & finished
                 & ~(explained if c in TANGENTIAL_OUTPUTS else nothing) for c in OUTPUTS}
-    bad = np.logical_or.reduce(list(bad_cols.values()))
     from vimpact.engine.result import STATUS_CODE, STATUS_NAMES
 
     for k in np.flatnonzero(bad):  # rare: the message names this row's columns
         names = ", ".join(c for c, m in bad_cols.items() if m[k])
         error[k] = f"NaN in {names} of a row with status {STATUS_NAMES[status[k]]!r}"
-    if bad.any():  # (rare: no pass over the outputs otherwise)
-        status[bad] = STATUS_CODE["non_finite"]
-        for c in OUTPUTS:
-            cols[c][bad] = np.nan
+    status[bad] = STATUS_CODE["non_finite"]
+    for c in OUTPUTS:
+        cols[c][bad] = np.nan
     return bad
 
 
