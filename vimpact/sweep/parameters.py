@@ -103,7 +103,9 @@ def engine_columns(spec, p: dict[str, np.ndarray]) -> tuple[list[tuple[np.ndarra
         Q1 = p.get("Q1", np.zeros(n))
         tau = Q1 / Q1_PER_TAU * REFERENCE_INDENTATION / v_z0
         eta = tau * G
-        sphere = {k: np.full(n, v) for k, v in REFERENCE.items()}
+        # the reference sphere: one value viewed in every row (read only; the engine
+        # checks it once, the table's columns are copies)
+        sphere = {k: np.broadcast_to(np.float64(v), (n,)) for k, v in REFERENCE.items()}
         if "lam" in p:  # the adhesive impact is normal only: v_x0 = 0
             sphere["v_x0_m_s"] = np.zeros(n)
         if "psi" in p:
