@@ -129,10 +129,21 @@ def compute_chunk(spec: SweepSpec, chunk: int, timings: dict | None = None):
     outputs = RESULTS | (ADHESION_RESULTS if spec.has_adhesion else {})
     cols: dict[str, np.ndarray] = {"row": np.arange(start, stop, dtype=np.int64)}
     given = {**params, **inputs}
+    taken: set[int] = set()
     for c in spec.columns():
-        if c not in ("row",) + LABELS and c not in outputs:  # (a copy: one pass)
-            cols[c] = (np.array(np.broadcast_to(given[c], (n,)), dtype=np.float64)
-                       if c in given else np.full(n, np.nan))
+        if c not in ("row",) + LABELS and c not in outputs:
+            value = given.get(c)
+            if value is None:
+                cols[c] = np.full(n, np.nan)
+            elif (isinstance(value, np.ndarray) and value.dtype == np.float64
+                  and value.shape == (n,) and value.flags.c_contiguous
+                  and value.flags.writeable and id(value) not in taken):
+                # the chunk's own array (made for it by chunk_parameters or engine_columns,
+                # which the engine only reads): the column as it is, no copy
+                cols[c] = value
+                taken.add(id(value))
+            else:  # a view of one value, another type, or an array of another column
+                cols[c] = np.array(np.broadcast_to(value, (n,)), dtype=np.float64)
     # statuses and paths as integer codes (STATUS_NAMES; path_names), text only in the
     # Arrow column; a row no batch reaches stays invalid; one batch of all the chunk's
     # rows in order (the usual case) hands over its result columns as they are
