@@ -149,3 +149,42 @@ def test_unpack_row_where_python_floats_raise():
                 w = w.item() if hasattr(w, "item") else w
                 assert type(got[name]) is type(w), (name, got[name], w)
                 assert got[name] == w or (got[name] != got[name] and w != w), (name, got, w)
+
+
+def test_a_whole_batch_dealt_to_the_threads_comes_back_in_row_order():
+    """A batch of one path in row order is dealt to the threads (every other row on
+    two) and its kernel rows stored back by strides: on an odd number of rows, with
+    one and with all threads, each row equals its own impact through ``simulate()``
+    (the serial one-row kernel and the scalar unpack), and the invalid rows of a batch
+    (not dealt: a scatter) keep their places too."""
+    import numba
+
+    import vimpact as v
+
+    rng = np.random.default_rng(11)
+    n = 41
+    cols = {"nu": rng.uniform(0.0, 0.5, n), "G_inf_Pa": 10 ** rng.uniform(6, 9, n),
+            "eta0_Pa_s": 10 ** rng.uniform(0, 4, n), "R_m": rng.uniform(0.01, 0.1, n),
+            "m_kg": rng.uniform(1e-3, 1e-2, n), "v_z0_m_s": rng.uniform(0.5, 5.0, n),
+            "tangential": np.full(n, "none")}
+    broken = {**cols, "nu": np.where(np.arange(n) % 5 == 3, 0.7, cols["nu"])}
+    before = numba.get_num_threads()
+    frames = []
+    try:
+        for threads in sorted({1, before}):
+            numba.set_num_threads(threads)
+            frames += [v.simulate_batch(cols), v.simulate_batch(broken)]
+    finally:
+        numba.set_num_threads(before)
+    for i in range(n):
+        scene = v.Scene(v.Material.kelvin_voigt(cols["nu"][i], cols["eta0_Pa_s"][i],
+                                                G=cols["G_inf_Pa"][i]),
+                        R=cols["R_m"][i], m=cols["m_kg"][i], v_z0=cols["v_z0_m_s"][i],
+                        tangential="none", allow_large_contact=True)
+        one = v.simulate(scene)
+        for k, df in enumerate(frames):
+            if k % 2 and i % 5 == 3:
+                assert df.status[i] == "invalid"
+                continue
+            assert (df.e_z[i], df.t_contact[i], df.u_max[i]) == (one.e_z, one.t_contact,
+                                                                 one.u_max)

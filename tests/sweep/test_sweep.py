@@ -425,3 +425,34 @@ def test_nan_without_a_status_becomes_non_finite(tmp_path):
     assert [STATUS_NAMES[c] for c in status] == ["vc0_zero", "non_finite"] and "e_z" in error[1]
     assert error[0] is None and math.isnan(cols["t_contact_s"][1])
     assert spec.rows == 12 and dataclasses.asdict(spec.numerics)["steps"] == 100
+
+
+def test_nan_guard_tells_explained_from_unexplained_tangential_nan():
+    """e_x NaN where v_c0 = 0 explains it stays; where nothing explains it the row
+    becomes non_finite naming e_x; a row without NaN and an unfinished row stay."""
+    cols = {c: np.ones(4) for c in schema.OUTPUTS}
+    cols["e_x"] = np.array([np.nan, np.nan, 0.2, np.nan])
+    status = np.array([STATUS_CODE["vc0_zero"], STATUS_CODE["ok"], STATUS_CODE["ok"],
+                       STATUS_CODE["time_limit"]], dtype=np.int8)
+    error = np.array([None] * 4, dtype=object)
+    bad = runner.guard_nan(cols, status, error, np.array([True, False, False, False]),
+                           np.array([True, True, True, False]))
+    assert list(bad) == [False, True, False, False]
+    assert [STATUS_NAMES[c] for c in status] == ["vc0_zero", "non_finite", "ok", "time_limit"]
+    assert "e_x" in error[1] and "e_z" not in error[1] and list(error[[0, 2, 3]]) == [None] * 3
+    assert math.isnan(cols["e_z"][1]) and cols["e_z"][2] == 1.0
+
+
+def test_one_value_viewed_in_every_row_is_checked_like_a_full_column():
+    """A sweep hands the engine constant inputs as views of one value: checked once
+    when good, and a bad one names every row as a full column does."""
+    from vimpact.model.validation import check_column
+
+    for value, rule in [(0.01, "positive"), (-1.0, "positive"), (np.inf, "friction"),
+                        (np.nan, "finite"), (3, "non_negative")]:
+        view = np.broadcast_to(np.asarray(value), (5,))
+        got, want = np.empty(5, dtype=object), np.empty(5, dtype=object)
+        x = check_column("R_m", view, rule, got)
+        y = check_column("R_m", np.array(view), rule, want)
+        assert x.dtype == y.dtype == np.float64 and x.flags.writeable
+        assert np.array_equal(x, y, equal_nan=True) and list(got) == list(want)

@@ -325,7 +325,9 @@ class SceneColumns:
         reasons = np.empty(n, dtype=object)  # (NumPy fills an object array with None)
         num = {}
         for name, (rule, default) in NUMERIC.items():
-            values = arrays[name] if name in arrays else np.full(n, default)
+            # (a default: one value viewed in every row, checked once by check_column)
+            values = arrays[name] if name in arrays else np.broadcast_to(np.asarray(default),
+                                                                         (n,))
             num[name] = check_column(name, values, rule, reasons)
         k = max(arms, default=0)
         G_arm, tau_arm = np.zeros((n, k)), np.zeros((n, k))
@@ -346,7 +348,8 @@ class SceneColumns:
         if "Theta_kg_m2" in arrays:
             Theta = check_column("Theta_kg_m2", arrays["Theta_kg_m2"], "positive", reasons)
         else:
-            ratio = arrays.get("theta_ratio", np.full(n, DEFAULT_THETA_RATIO))
+            ratio = arrays.get("theta_ratio",
+                               np.broadcast_to(np.asarray(DEFAULT_THETA_RATIO), (n,)))
             Theta = check_column("theta_ratio", ratio, "positive", reasons) * m * R**2
         model = _model(arrays.get("model"), G_arm, num["eta0_Pa_s"], n, reasons)
         seeded = ((codes["tangential_memory"] == TANGENTIAL_MEMORY.index("seed"))
@@ -462,6 +465,10 @@ def _codes(name: str, values, choices, default: str, n: int, reasons) -> np.ndar
     if values is None:
         return np.full(n, choices.index(default), dtype=np.int8)
     values = np.asarray(values)
+    if values.ndim == 1 and n > 1 and values.strides[0] == 0 and isinstance(values[0], str) \
+            and values[0] in choices:
+        # one value in every row (a view of one element): compared once
+        return np.full(n, choices.index(values[0]), dtype=np.int8)
     text = values.dtype.kind == "U"  # compared as it is (as objects: a str per row, 5 ms/1e5)
     if not text:
         values = values.astype(object)

@@ -144,7 +144,9 @@ def route(cols: SceneColumns, numerics: Numerics) -> Routes:
     paths: list[Path] = []
     group = np.full(len(cols), -1, dtype=np.int64)
     keys = key[key >= 0]
-    for k in (np.unique(keys) if len(keys) > 16 else sorted(set(keys.tolist()))):
+    # the distinct keys in ascending order: a key is < 2**7, so counted (np.unique sorts
+    # or hashes the whole batch)
+    for k in np.flatnonzero(np.bincount(keys)) if len(keys) else ():
         group[key == k] = len(paths)
         paths.append(_path_of_key(int(k), numerics.integrator_code))
     return Routes(group, tuple(paths))

@@ -169,7 +169,9 @@ def _run(cols: SceneColumns, numerics: Numerics, n_rec: int, rec_every: int,
                 arrays = {key: value[~costly] for key, value in arrays.items()}
                 if len(idx) == 0:
                     continue
+        dealt = False  # the whole batch in order, dealt to the threads (interleave)
         if n_rec == 0 and len(idx) > threads:
+            dealt = _all_in_order(cols, idx)
             order = interleave(len(idx), threads)
             idx = idx[order]
             if arrays is not None:
@@ -192,7 +194,13 @@ def _run(cols: SceneColumns, numerics: Numerics, n_rec: int, rec_every: int,
         else:  # (one row: a serial kernel, whatever the thread count)
             run_path(path, sub, numerics, sub_rec, rec_every, sub_out, arrays)
         kernel_s += time.perf_counter() - t0
-        if not whole:
+        if dealt:  # (idx is interleave(n, threads): a strided copy per thread, no scatter)
+            start = 0
+            for k in range(threads):
+                stop = start + len(range(k, n, threads))
+                out[k::threads] = sub_out[start:stop]
+                start = stop
+        elif not whole:
             out[idx] = sub_out
             if n_rec:
                 rec[idx] = sub_rec

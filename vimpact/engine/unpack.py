@@ -176,9 +176,10 @@ def unpack(cols: SceneColumns, out: np.ndarray, paths: Coded,
         result["status"], result["path"] = Coded(status, STATUS_NAMES), paths
     else:
         result["status"], result["path"] = _NAMES[status], paths.decode()
-    for name in ("t_hertz", "d_hertz", "a_hertz", "Q1", "Q2", "nu"):
-        result[name] = np.where(valid, result[name], np.nan)
-    result["n_steps"] = np.where(valid, result["n_steps"], 0)
+    if not valid.all():  # (every row valid, the usual case: nothing to blank)
+        for name in ("t_hertz", "d_hertz", "a_hertz", "Q1", "Q2", "nu"):
+            result[name] = np.where(valid, result[name], np.nan)
+        result["n_steps"] = np.where(valid, result["n_steps"], 0)
     return {name: result[name] for name in RESULT_FIELDS}
 
 
@@ -343,11 +344,15 @@ def clip_round_off(values: dict[str, np.ndarray], ok: np.ndarray, passive: np.nd
     ``unstable``); such a value is set to the bound (``beta_x`` keeps its sign).
     """
     rows = ok & passive
-    with np.errstate(invalid="ignore"):
+    with np.errstate(invalid="ignore"):  # (a column with no value beyond its bound: kept)
         for name in ("e_z", "e_x", "energy_ratio"):
-            values[name] = np.where(rows & (values[name] > 1.0), 1.0, values[name])
+            over = rows & (values[name] > 1.0)
+            if over.any():
+                values[name] = np.where(over, 1.0, values[name])
         b = values["beta_x"]
-        values["beta_x"] = np.where(rows & (np.abs(b) > 1.0), np.sign(b), b)
+        over = rows & (np.abs(b) > 1.0)
+        if over.any():
+            values["beta_x"] = np.where(over, np.sign(b), b)
 
 
 def guard(values: dict[str, np.ndarray], status: np.ndarray,

@@ -135,19 +135,27 @@ def check_column(name: str, values, rule: str, reasons: np.ndarray) -> np.ndarra
     The column as float64, with NaN where the row is bad.
     """
     raw = np.asarray(values)
+    test, allowed = RULES[rule]
+    if raw.ndim == 1 and raw.shape[0] > 1 and raw.strides[0] == 0 and raw.dtype.kind in "fiu":
+        # one value in every row (a view of one element, e.g. a default): checked once
+        one = raw[:1].astype(np.float64)
+        with np.errstate(invalid="ignore"):
+            if bool(test(one)[0]):
+                return np.full(raw.shape[0], one[0])
     if raw.dtype.kind in "fiu":
         x = raw.astype(np.float64)
     else:  # object, strings, bools: element by element (rare)
         x = np.array([_float_or_nan(v) for v in raw.ravel()], dtype=np.float64)
-    test, allowed = RULES[rule]
     with np.errstate(invalid="ignore"):
         bad = ~test(x)
     if raw.dtype.kind == "b":
         bad[:] = True
-    for i in unexplained(bad, reasons):
+    rows = np.flatnonzero(bad)
+    for i in rows[is_none(reasons[rows])] if rows.size else rows:  # (unexplained(bad, ...))
         reasons[i] = message(name, raw.ravel()[i].item() if hasattr(raw.ravel()[i], "item")
                              else raw.ravel()[i], allowed if raw.dtype.kind != "b" else "a number")
-    x[bad] = np.nan
+    if rows.size:  # (no bad row, the usual case: no second pass over the column)
+        x[bad] = np.nan
     return x
 
 

@@ -82,8 +82,11 @@ def engine_columns(spec, p: dict[str, np.ndarray]) -> tuple[list[tuple[np.ndarra
     """
     n = len(p["nu"])
     nu = p["nu"]
-    common = {"tangential": np.full(n, spec.tangential),
-              "tangential_memory": np.full(n, spec.tangential_memory),
+    # the effect choices: one str in every row as a read-only view of one element (a
+    # str array of n rows costs some 4 ms per 1e5 rows to make and to compare; the
+    # engine reads a view's one value once, vimpact.engine.columns)
+    common = {"tangential": np.broadcast_to(np.array(spec.tangential), (n,)),
+              "tangential_memory": np.broadcast_to(np.array(spec.tangential_memory), (n,)),
               "rotation": np.full(n, spec.rotation)}
     # no "model" column: the engine infers it from the rheology (it only decides how the
     # engine reports Q1, Q2, which the table takes from the spec for a grid)
@@ -100,7 +103,9 @@ def engine_columns(spec, p: dict[str, np.ndarray]) -> tuple[list[tuple[np.ndarra
         Q1 = p.get("Q1", np.zeros(n))
         tau = Q1 / Q1_PER_TAU * REFERENCE_INDENTATION / v_z0
         eta = tau * G
-        sphere = {k: np.full(n, v) for k, v in REFERENCE.items()}
+        # the reference sphere: one value viewed in every row (read only; the engine
+        # checks it once, the table's columns are copies)
+        sphere = {k: np.broadcast_to(np.float64(v), (n,)) for k, v in REFERENCE.items()}
         if "lam" in p:  # the adhesive impact is normal only: v_x0 = 0
             sphere["v_x0_m_s"] = np.zeros(n)
         if "psi" in p:

@@ -128,12 +128,22 @@ def compute_chunk(spec: SweepSpec, chunk: int, timings: dict | None = None):
     batches, inputs = engine_columns(spec, params)
     outputs = RESULTS | (ADHESION_RESULTS if spec.has_adhesion else {})
     cols: dict[str, np.ndarray] = {"row": np.arange(start, stop, dtype=np.int64)}
+    given = {**params, **inputs}
+    taken: set[int] = set()
     for c in spec.columns():
         if c not in ("row",) + LABELS and c not in outputs:
-            cols[c] = np.full(n, np.nan)
-    for key, values in {**params, **inputs}.items():
-        if key in cols:
-            cols[key][:] = values
+            value = given.get(c)
+            if value is None:
+                cols[c] = np.full(n, np.nan)
+            elif (isinstance(value, np.ndarray) and value.dtype == np.float64
+                  and value.shape == (n,) and value.flags.c_contiguous
+                  and value.flags.writeable and id(value) not in taken):
+                # the chunk's own array (made for it by chunk_parameters or engine_columns,
+                # which the engine only reads): the column as it is, no copy
+                cols[c] = value
+                taken.add(id(value))
+            else:  # a view of one value, another type, or an array of another column
+                cols[c] = np.array(np.broadcast_to(value, (n,)), dtype=np.float64)
     # statuses and paths as integer codes (STATUS_NAMES; path_names), text only in the
     # Arrow column; a row no batch reaches stays invalid; one batch of all the chunk's
     # rows in order (the usual case) hands over its result columns as they are
@@ -239,10 +249,17 @@ def guard_nan(cols: dict, status: np.ndarray, error: np.ndarray, vc0_zero: np.nd
     Returns the rows changed (bool).
     """
     explained = np.broadcast_to(np.asarray(vc0_zero, dtype=bool), finished.shape)
+    # NaN in any output first (one OR per column), each column's own rows only then
+    tangential = [c for c in OUTPUTS if c in TANGENTIAL_OUTPUTS]
+    other = [c for c in OUTPUTS if c not in TANGENTIAL_OUTPUTS]
+    nan_other = np.logical_or.reduce([np.isnan(cols[c]) for c in other])
+    nan_tangential = np.logical_or.reduce([np.isnan(cols[c]) for c in tangential])
+    bad = finished & (nan_other | (nan_tangential & ~explained))
+    if not bad.any():
+        return bad
     nothing = np.zeros(finished.shape, dtype=bool)
     bad_cols = {c: np.isnan(cols[c]) & finished
                 & ~(explained if c in TANGENTIAL_OUTPUTS else nothing) for c in OUTPUTS}
-    bad = np.logical_or.reduce(list(bad_cols.values()))
     from vimpact.engine.result import STATUS_CODE, STATUS_NAMES
 
     for k in np.flatnonzero(bad):  # rare: the message names this row's columns
@@ -532,8 +549,7 @@ def _run(spec, spec_path, out, parts, resume, progress, workers, scheduler, shar
                     fresh.append((table, summary))
                     if spec.n_chunks > 1:
                         own = ContentHash().update(table, also=whole).hexdigest()
-                    else:
-                        whole.update(table)
+                    # (one chunk: hashed while its table is encoded, store.combine)
                 if spec.n_chunks > 1 or fresh is None:
                     store.write_part(spec, table, parts, chunk, summary, own)
                     done[chunk] = store.part_path(parts, chunk, spec.n_chunks)
@@ -546,7 +562,7 @@ def _run(spec, spec_path, out, parts, resume, progress, workers, scheduler, shar
             return parts
         t0 = time.perf_counter()
         _combine(spec, parts, out, log, stages, fresh,
-                 whole.hexdigest() if fresh is not None else None)
+                 whole.hexdigest() if fresh is not None and spec.n_chunks > 1 else None)
         _timed(timings, "write_s", t0)
     except KeyboardInterrupt:
         bar.close(finished)

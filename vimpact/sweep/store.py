@@ -58,6 +58,7 @@ import os
 import shutil
 import sys
 from pathlib import Path
+from typing import cast
 
 from vimpact.model.validation import InputError
 from vimpact.sweep.spec import AUTO_CHUNK_ROWS
@@ -447,7 +448,8 @@ def _write_fresh(spec, parts: Path, out: Path, explain_paths, fresh: list,
 
     ``fresh``: ``(table, summary)`` of every chunk in chunk order. The content hash
     is computed from the rows in memory (``digest``: given by the caller, who computed
-    it from them; computed here if ``None``), the parts (if any) are not read: the
+    it from them; computed here if ``None``, for one chunk while its table is encoded:
+    :func:`~vimpact.tableformat.files.write_atomic`), the parts (if any) are not read: the
     table is the one :func:`combine` would make from them, byte for byte, and they are
     removed once it is written and its footer checked. One chunk has no part: a
     failed write (disk full) keeps nothing, the chunk is computed again by the next
@@ -467,7 +469,7 @@ def _write_fresh(spec, parts: Path, out: Path, explain_paths, fresh: list,
                 paths[name] = {"rows": 0, "first_row": entry["first_row"]}
             paths[name]["rows"] += entry["rows"]
     paths = _explained(paths, explain_paths)
-    if digest is None:
+    if digest is None and len(tables) > 1:
         whole = ContentHash()
         for table in tables:
             whole.update(table)
@@ -479,8 +481,9 @@ def _write_fresh(spec, parts: Path, out: Path, explain_paths, fresh: list,
     if written:
         check_room(out, parts, sum(p.stat().st_size for p in written))
     try:
-        write_atomic(tables[0].replace_schema_metadata(meta), out, more=tables[1:],
-                     content_sha256=digest)
+        # (one table without a digest: hashed while it is encoded, write_atomic)
+        digest = cast(str, write_atomic(tables[0].replace_schema_metadata(meta), out,
+                                        more=tables[1:], content_sha256=digest))
     except OSError as exc:
         if written:
             raise _kept(exc, parts) from exc
