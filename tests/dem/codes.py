@@ -22,3 +22,16 @@ def need(why: str | None, code: str) -> None:
     if os.environ.get(REQUIRE):
         pytest.fail(f"{code} round trip required ({REQUIRE} is set) but {why}")
     pytest.skip(f"{code} round trip: {why}")
+
+
+def round_trips_at_report_points(code, export, steps: tuple[int, ...]) -> dict[int, list[dict]]:
+    """Run ``code``'s round trips (its module: :mod:`vimpact.dem.yade` or ``.liggghts``) on
+    ``export`` ``(problem, export)`` at each of ``steps`` per contact, in one start of the
+    code: the head-on collisions of every contact and the oblique wall impacts, at the
+    report's oblique speeds (its lowest and highest among them) and angles."""
+    problem, ex = export
+    ob = ex.targets["a-floor"].oblique
+    speeds, angles = sorted(set(ob.v.tolist())), sorted(set(ob.angle_deg.tolist()))
+    assert speeds[0] == problem.speeds.min() and speeds[-1] == problem.speeds.max()
+    return code.round_trips(problem, speeds, steps, fits=ex.fits, angles_deg=angles,
+                            head_on=True)

@@ -4,7 +4,7 @@ predicts on head-on pair and wall collisions, and its time-step error shrinks wi
 
 import pytest
 
-from tests.dem.codes import need
+from tests.dem.codes import need, round_trips_at_report_points
 from vimpact.dem import liggghts
 
 
@@ -30,12 +30,7 @@ def liggghts_rows(liggghts_export):
     wall impacts, at the report's oblique speeds (its lowest and highest among them) and
     angles."""
     need(liggghts.liggghts_available(), "LIGGGHTS")
-    problem, ex = liggghts_export
-    ob = ex.targets["a-floor"].oblique
-    speeds, angles = sorted(set(ob.v.tolist())), sorted(set(ob.angle_deg.tolist()))
-    assert speeds[0] == problem.speeds.min() and speeds[-1] == problem.speeds.max()
-    return liggghts.round_trips(problem, speeds, (100, 800), fits=ex.fits, angles_deg=angles,
-                                head_on=True)
+    return round_trips_at_report_points(liggghts, liggghts_export, (100, 800))
 
 
 def test_liggghts_runs_the_exported_files_and_restitutes_the_prediction(exported, liggghts_rows):

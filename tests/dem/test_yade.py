@@ -4,7 +4,7 @@ report predicts, and its time-step error shrinks with the step."""
 
 import pytest
 
-from tests.dem.codes import need
+from tests.dem.codes import need, round_trips_at_report_points
 from vimpact.dem import yade
 
 
@@ -29,12 +29,7 @@ def yade_rows(yade_export):
     Yade start): at each step the head-on collisions of every contact and the oblique wall
     impacts, at the report's oblique speeds (its lowest and highest among them) and angles."""
     need(yade.yade_available(), "Yade")
-    problem, ex = yade_export
-    ob = ex.targets["a-floor"].oblique
-    speeds, angles = sorted(set(ob.v.tolist())), sorted(set(ob.angle_deg.tolist()))
-    assert speeds[0] == problem.speeds.min() and speeds[-1] == problem.speeds.max()
-    return yade.round_trips(problem, speeds, (400, 1600), fits=ex.fits, angles_deg=angles,
-                            head_on=True)
+    return round_trips_at_report_points(yade, yade_export, (400, 1600))
 
 
 def test_yade_runs_the_exported_file_and_restitutes_the_prediction(exported, yade_rows):

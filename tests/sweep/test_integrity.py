@@ -22,6 +22,7 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 import pytest
 
+from tests.oracles.content_hash import definition_hash
 from tests.sweep import GRID_KV, faults, write
 from vimpact import cli
 from vimpact.model.validation import InputError
@@ -85,34 +86,6 @@ def test_content_hash_is_independent_of_the_parquet_encoding(tmp_path):
     assert integrity.content_hash(nulls) == integrity.content_hash(pa.table({"error": pa.nulls(2)}))
 
 
-def _definition_hash(table) -> str:
-    """The content hash written out from its definition (:class:`ContentHash`), row by
-    row in plain Python: an independent reference for the vectorized one."""
-    import hashlib
-    import struct
-
-    h = hashlib.sha256(f"vimpact content sha256 v1\nrows {table.num_rows}\n".encode())
-    for name, column in zip(table.column_names, table.columns):
-        kind = column.type
-        valid, values, data = b"", b"", b""
-        for x in column.to_pylist():
-            valid += b"\x01" if x is not None else b"\x00"
-            if pa.types.is_string(kind):
-                raw = (x or "").encode()
-                values += struct.pack("<q", len(raw))
-                data += raw
-            elif pa.types.is_boolean(kind):
-                values += b"\x01" if x else b"\x00"
-            elif pa.types.is_floating(kind):
-                values += struct.pack("<d", 0.0 if x is None else x)
-            else:
-                values += struct.pack("<q", 0 if x is None else x)
-        h.update(f"column {name}\n".encode())
-        for stream in (valid, values, data):
-            h.update(hashlib.sha256(stream).digest())
-    return h.hexdigest()
-
-
 def test_content_hash_follows_its_definition_with_and_without_nulls():
     """Columns with and without nulls (the latter hashed from their buffers as they
     are), several Arrow chunks, a slice at an offset: the digest of the definition."""
@@ -123,7 +96,7 @@ def test_content_hash_follows_its_definition_with_and_without_nulls():
                       "status": ["ok", "ok", "invalid", None, "ok", "", "half_space"]})
     two_chunks = pa.concat_tables([table.slice(0, 3), table.slice(3)])
     for t in (table, two_chunks, table.slice(2, 4), two_chunks.slice(1, 5), table.slice(7)):
-        assert integrity.content_hash(t) == _definition_hash(t)
+        assert integrity.content_hash(t) == definition_hash(t)
 
 
 @pytest.mark.parametrize("change", ["value", "nan payload", "null", "string", "name", "order"])

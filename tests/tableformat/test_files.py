@@ -1,12 +1,10 @@
 """A table hashed while Parquet encodes it is the file hashed first, byte for byte."""
 
-import hashlib
-import struct
-
 import pyarrow as pa
 import pyarrow.parquet as pq
 import pytest
 
+from tests.oracles.content_hash import definition_hash
 from tests.sweep import faults
 from vimpact.tableformat import files, integrity
 
@@ -27,27 +25,6 @@ def _table(rows: int = 3000) -> pa.Table:
                                           b"other": b"kept"})
 
 
-def _definition_hash(table: pa.Table) -> str:
-    """The content hash from its definition, row by row (independent of ContentHash)."""
-    h = hashlib.sha256(f"vimpact content sha256 v1\nrows {table.num_rows}\n".encode())
-    for name, column in zip(table.column_names, table.columns):
-        valid, values, data = b"", b"", b""
-        for x in column.to_pylist():
-            valid += b"\x01" if x is not None else b"\x00"
-            if pa.types.is_string(column.type):
-                raw = (x or "").encode()
-                values += struct.pack("<q", len(raw))
-                data += raw
-            elif pa.types.is_floating(column.type):
-                values += struct.pack("<d", 0.0 if x is None else x)
-            else:
-                values += struct.pack("<q", 0 if x is None else x)
-        h.update(f"column {name}\n".encode())
-        for stream in (valid, values, data):
-            h.update(hashlib.sha256(stream).digest())
-    return h.hexdigest()
-
-
 def test_hashed_while_encoded_is_the_same_file(tmp_path, monkeypatch):
     """From PARALLEL_HASH_BYTES on, write_atomic hashes the rows on a thread while Parquet
     encodes them and adds the metadata (and the Arrow schema with it) when the file is
@@ -62,7 +39,7 @@ def test_hashed_while_encoded_is_the_same_file(tmp_path, monkeypatch):
     monkeypatch.setattr(files, "_write_hashing", lambda *a: called.append(1) or real(*a))
     during = files.write_atomic(table, tmp_path / "during.parquet")
     assert called == [1]
-    assert first == during == _definition_hash(table)
+    assert first == during == definition_hash(table)
     assert (tmp_path / "first.parquet").read_bytes() == (tmp_path / "during.parquet").read_bytes()
     back = pq.read_table(tmp_path / "during.parquet")
     assert back.schema.equals(table.schema) and integrity.content_hash(back) == during
