@@ -150,11 +150,10 @@ def check_column(name: str, values, rule: str, reasons: np.ndarray) -> np.ndarra
         bad = ~test(x)
     if raw.dtype.kind == "b":
         bad[:] = True
-    rows = np.flatnonzero(bad)
-    for i in rows[is_none(reasons[rows])] if rows.size else rows:  # (unexplained(bad, ...))
+    for i in unexplained(bad, reasons):
         reasons[i] = message(name, raw.ravel()[i].item() if hasattr(raw.ravel()[i], "item")
                              else raw.ravel()[i], allowed if raw.dtype.kind != "b" else "a number")
-    if rows.size:  # (no bad row, the usual case: no second pass over the column)
+    if bad.any():  # (no bad row, the usual case: no second pass over the column)
         x[bad] = np.nan
     return x
 
