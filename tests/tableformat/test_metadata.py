@@ -44,7 +44,7 @@ def metadata_values(draw) -> dict:
     return values
 
 
-@settings(max_examples=200, deadline=None)
+@settings(max_examples=200, deadline=None, database=None)
 @given(metadata_values())
 def test_decode_inverts_encode(values):
     raw = encode_metadata(values)
@@ -52,7 +52,7 @@ def test_decode_inverts_encode(values):
     assert decode_metadata(raw) == values
 
 
-@settings(max_examples=50, deadline=None)
+@settings(max_examples=50, deadline=None, database=None)
 @given(metadata_values())
 def test_the_stored_text_decodes_and_encodes_back_to_itself(values):
     """On the text side the pair is an identity too: a stored entry re-encoded from its
