@@ -311,6 +311,12 @@ def rejected_step_factor(err):
 
 
 @jit(internal=True)
+def step_underflow(h, sig):
+    """Whether the step ``h`` is too small to move the time ``sig`` (or not positive, or NaN)."""
+    return h <= 4.0 * _EPS * abs(sig) or not (h > 0.0)
+
+
+@jit(internal=True)
 def accepted_step_factor(err, err_old, rejected):
     """Return the PI step-size factor after an accepted step (Hairer, Norsett & Wanner).
 
@@ -407,7 +413,7 @@ def kv_normal_impact(tau0, rtol, max_steps, rec, rec_every, out):
     steps = 0
     u_max = 0.0
     while steps < max_steps:
-        if h <= 4.0 * _EPS * abs(sig) or not (h > 0.0):  # step size underflow
+        if step_underflow(h, sig):
             status = STATUS_NON_FINITE
             break
         s1, v1, t1, fs1, fv1, ft1, es, ev, et = _dp_step(s, v, t, fs, fv, ft, h, tau0, unloading)

@@ -175,10 +175,12 @@ from vimpact.kernels.continuum_kv import (
     _E5,
     _E6,
     _E7,
+    _EPS,
     RTOL_MAX,
     RTOL_MIN,
     accepted_step_factor,
     rejected_step_factor,
+    step_underflow,
 )
 from vimpact.kernels.jit import jit
 from vimpact.kernels.layout import (
@@ -205,8 +207,6 @@ __all__ = ["maxwell_stick_impact", "maxwell_stick_batch", "GN"]
 
 #: Normal stiffness factor of the continuum force (both halves of the row).
 GN = 2.0 * ELEMENT_STIFFNESS
-
-_EPS = 2.220446049250313e-16
 
 # Dormand-Prince continuous extension (Hairer, Norsett & Wanner, DOPRI5 ``contd5``)
 _D1 = -12715105075.0 / 11282082432.0
@@ -886,7 +886,7 @@ def maxwell_stick_impact(tau0, g, tau, kappa, mu_t, tangential, rtol, max_steps,
             if phase == 0 and nh + 1 >= hs.shape[0] - 1:
                 grow = True
                 break
-            if h <= 4.0 * _EPS * abs(sig) or not (h > 0.0):
+            if step_underflow(h, sig):
                 status = STATUS_NON_FINITE
                 break
             err = _step(phase, m, y, h, K, y1, tmp, mask, n_rk, tau0, ga, itau, n, kappa, mu_t, tang,
