@@ -15,8 +15,10 @@ from vimpact.cli.main import main
 
 
 @pytest.mark.parametrize("module, argv, code, stream, text", [
-    ("vimpact", ["simulate", "--Q1", "1", "--nu", "2"], 2, "stderr", "--nu"),
-    ("vimpact.cli", ["--version"], 0, "stdout", vimpact.__version__),
+    pytest.param("vimpact", ["simulate", "--Q1", "1", "--nu", "2"], 2, "stderr", "--nu",
+                 id="vimpact-bad-value"),
+    pytest.param("vimpact.cli", ["--version"], 0, "stdout", vimpact.__version__,
+                 id="vimpact.cli-version"),
 ])
 def test_python_m_runs_the_command_line(module, argv, code, stream, text):
     proc = subprocess.run([sys.executable, "-m", module, *argv], capture_output=True, text=True)

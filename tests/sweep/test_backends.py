@@ -177,8 +177,8 @@ def dask_cluster():
     one numba thread, and give the in-process table) and costs half the worker start-ups
     (each imports distributed, numba, the kernels, pandas and pyarrow). It also makes the
     sweep refill its queue: one worker has 4 task slots for the reference spec's 5 chunks.
-    Two workers killed mid-sweep: the slow test_kill_9_during_a_dask_sweep_then_resume and
-    tests/faults/test_dask_cluster.py.
+    Two workers: the slow test_kill_9_during_a_dask_sweep_then_resume (``--workers 2``) and
+    tests/faults/test_dask_cluster.py (one of the two killed).
     """
     pytest.importorskip("distributed")
     from distributed import Client
