@@ -306,9 +306,11 @@ def test_largest_admissible_dashpot_is_fully_damped(capsys):
 
 # ---- the real entry point ------------------------------------------------------
 
+# the two ways a bad input leaves: a refusal that main returns, after arithmetic that overflows
+# (a warning would be a second line in a real process), and argparse's own exit inside main
+# (the catalogue above runs steps-1e9 and every other case in-process)
 @pytest.mark.parametrize("args, names", [
     pytest.param(with_value(PHYS, "--vz0", "1e200"), ["--vz0 = 1e+200"], id="vz0-1e200"),
-    pytest.param(DIM + ["--steps", "1e9"], ["--steps = 1000000000"], id="steps-1e9"),
     pytest.param(with_value(PHYS, "--E", ""), ["--E", "''"], id="E-empty"),
 ])
 def test_installed_entry_point(args, names):

@@ -171,9 +171,18 @@ def test_combine_refuses_missing_chunks(tmp_path, reference):
 
 @pytest.fixture(scope="module")
 def dask_cluster():
+    """A real LocalCluster of one worker process, shared by the tests that need one.
+
+    One worker is enough for what these tests check (tasks run in another process, with
+    one numba thread, and give the in-process table) and costs half the worker start-ups
+    (each imports distributed, numba, the kernels, pandas and pyarrow). It also makes the
+    sweep refill its queue: one worker has 4 task slots for the reference spec's 5 chunks.
+    Two workers: the slow test_kill_9_during_a_dask_sweep_then_resume (``--workers 2``) and
+    tests/faults/test_dask_cluster.py (one of the two killed).
+    """
     pytest.importorskip("distributed")
     from distributed import Client
-    cluster = runner.local_cluster(2)
+    cluster = runner.local_cluster(1)
     client = Client(cluster)
     yield cluster, client
     client.close()

@@ -123,13 +123,21 @@ def fit_error_model(steps, elements, err, floor, p0: float) -> dict:
     def resid(x):
         return np.log(model(x, S, E)) - np.log(y)
 
+    log_s, log_e = np.log(S), np.log(E)
+
+    def jac(x):  # d resid / d (log a, p, log b, q): the 18 fits need no finite differences
+        ts, te = np.exp(x[0]) * S ** -x[1], np.exp(x[2]) * E ** -x[3]
+        m = ts + te
+        return np.column_stack([ts / m, -log_s * ts / m, te / m, -log_e * te / m])
+
     best = None
     for p in (p0, 1.0, 2.0):
         for q in (1.0, 2.0, 3.0):
             la = np.log(np.median(y * S ** p))
             lb = np.log(np.median(y * E ** q)) - 2.0
             for x0 in ([la, p, lb, q], [la - 2.0, p, lb + 2.0, q]):
-                r = least_squares(resid, x0, bounds=([-60, 0.2, -60, 0.2], [60, 5, 60, 5]))
+                r = least_squares(resid, x0, jac=jac,
+                                  bounds=([-60, 0.2, -60, 0.2], [60, 5, 60, 5]))
                 if best is None or r.cost < best.cost:
                     best = r
     assert best is not None  # the loops above ran
