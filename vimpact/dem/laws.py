@@ -34,7 +34,14 @@ from functools import lru_cache
 
 import numpy as np
 
-from vimpact.kernels.stepped import LAW_LAMMPS, LAW_LIGGGHTS, LAW_MERCURY, LAW_YADE, stepped_impacts
+from vimpact.kernels.stepped import (
+    LAW_LAMMPS,
+    LAW_LIGGGHTS,
+    LAW_MERCURY,
+    LAW_YADE,
+    lanes_work,
+    stepped_impacts,
+)
 from vimpact.model.hertz import HERTZ_TIME_FACTOR
 
 #: integrator tolerances of every law (relative, absolute)
@@ -504,7 +511,8 @@ def _stepped(law: int, alpha: np.ndarray, w0: np.ndarray, mu, steps: int, consta
     unfinished = stepped_impacts(
         np.int64(law), column(alpha), w0,
         np.zeros(n) if lever is None else column(lever), column(F) - 1.0,
-        np.minimum(column(mu), 1e300), p, contact_time / steps, np.int64(50 * steps), e, wend)
+        np.minimum(column(mu), 1e300), p, contact_time / steps, np.int64(50 * steps), e, wend,
+        *lanes_work())
     if unfinished:
         raise RuntimeError("stepped contact law did not end its contact")
     return e.reshape(shape), (-wend / w0).reshape(shape)
