@@ -1,6 +1,7 @@
 """Fits reproduce known constants from synthetic targets made by the law itself."""
 
 import functools
+import math
 
 import numpy as np
 import pytest
@@ -268,3 +269,54 @@ def test_lockstep_yade_et_searches_equal_the_searches_one_by_one_and_recover_et(
     for b, (a, _), et in zip(yade_oblique_many([dict(a, et=et) for (a, _), et in
                                                 zip(contacts, together)]), contacts, together):
         np.testing.assert_array_equal(b, yade_oblique(**dict(a, et=et)))
+
+
+@pytest.mark.parametrize("A", [3e-7, 2e-5])
+def test_viscoelastic_hertz_fit_ends_where_scipys_bounded_search_ends(A):
+    """The fit of ``A`` drives :func:`fit_scalar_many` (not scipy, which the LAMMPS export
+    no longer imports); it ends exactly where ``minimize_scalar(method="bounded")`` ends on
+    the same cost, with the same bracket and tolerance."""
+    from scipy.optimize import minimize_scalar
+
+    p = problem_from_toml(SYNTHETIC)
+    c = p.contacts[0]
+    _, m_nom = c.nominal()
+    t = _synthetic(p, c, A, mass_factor=lambda m: (m / m_nom) ** 0.5)
+    f = t.m / m_nom
+    unit = f * t.v / laws.hertz_overlap(c.E_star, t.R, t.m, t.v)
+    guess = float(np.median(np.maximum(1.0 - t.e_z, 1e-9) / laws.SMALL_DAMPING_SLOPE / unit))
+    lo = math.log10(guess) - 3.0
+    hi = min(math.log10(guess) + 3.0, math.log10(1e3 / unit.max()))
+
+    def cost(logA):
+        r = laws.viscoelastic_hertz_curve(np.minimum(10.0**logA * unit, 1e3)) - t.e_z
+        return float(np.mean(r * r))
+
+    ref = minimize_scalar(cost, bounds=(lo, hi), method="bounded",
+                          options={"xatol": 1e-9, "maxiter": 500})
+    A_fit, _ = fit_viscoelastic_hertz(t, c.E_star, mass_factor=f)
+    assert A_fit == 10.0**ref.x
+
+
+def test_a_deferred_beta_x_is_computed_once_when_read():
+    """``ContactFit`` given a function for ``beta_x`` calls it on the first read only (not
+    to say whether the code represents ``beta_x``); an array or ``None`` is kept as is."""
+    from vimpact.dem.fit import ContactFit, Residual
+
+    calls = []
+
+    def curve():
+        calls.append(1)
+        return [0.25, -0.5]
+
+    c = problem_from_toml(SYNTHETIC).contacts[0]
+    res = Residual(0.0, 0.0)
+    f = ContactFit(c, {}, np.ones(2), curve, res)
+    assert f.has_beta_x and not calls
+    np.testing.assert_array_equal(f.beta_x, [0.25, -0.5])
+    np.testing.assert_array_equal(f.beta_x, [0.25, -0.5])
+    assert len(calls) == 1
+    f.beta_x = np.zeros(2)
+    np.testing.assert_array_equal(f.beta_x, np.zeros(2))
+    none = ContactFit(c, {}, np.ones(2), None, res)
+    assert not none.has_beta_x and none.beta_x is None

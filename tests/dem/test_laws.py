@@ -158,3 +158,23 @@ def test_mfix_law_sticks_like_the_ode_and_slides_like_coulomb():
     mu, w0 = 0.3, np.tan(np.radians([75.0, 85.0]))
     _, b = laws.mfix_coulomb(0.0, w_t, zeta_t, F, mu, w0)
     assert b == pytest.approx(-1.0 + 2.0 * mu * F / w0, abs=2e-3)
+
+
+def test_master_curve_is_scipys_cubic_spline_bit_for_bit():
+    """The stored spline coefficients are those of scipy's not-a-knot ``CubicSpline``
+    through the tabulated points, and their evaluation (without scipy) gives scipy's
+    numbers bit for bit: at random points, the breakpoints, the ends and just outside."""
+    from scipy.interpolate import CubicSpline
+
+    from vimpact.dem import _hertz_table as tab
+
+    breaks, c = laws._master_curve()
+    ref = CubicSpline(np.linspace(*tab.LOG_ALPHA, tab.N), np.array(tab.E_CLIPPED))
+    np.testing.assert_array_equal(breaks, ref.x)
+    np.testing.assert_array_equal(c, ref.c)
+    x = np.concatenate([np.random.default_rng(7).uniform(-7.0, 3.0, 20000), breaks,
+                        np.nextafter(breaks, -np.inf), [-7.0 - 1e-12, 3.0 + 1e-12],
+                        np.log10(np.geomspace(1e-7, 1e3, 5001))])
+    np.testing.assert_array_equal(laws._spline_at(breaks, c, x), ref(x))
+    alphas = np.geomspace(1e-7, 1e3, 301)
+    np.testing.assert_array_equal(laws.viscoelastic_hertz_curve(alphas), ref(np.log10(alphas)))

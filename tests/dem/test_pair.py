@@ -153,3 +153,24 @@ def test_batch_matches_single_and_marks_wall_nan():
     one = simulate_pair(b1, b2, FAST)
     assert df.loc[0, "e_z"] == one.e_z and df.loc[0, "v_x2"] == one.body2[1]
     assert math.isnan(df.loc[1, "v_z2"]) and np.isfinite(df.loc[1, "v_z1"])
+
+
+def test_pair_restitutions_in_one_batch_equal_the_curves_one_by_one():
+    """Several pairs' curves (normal, full stick, oblique with friction) in one engine batch
+    give each curve bit for bit what :func:`pair_restitution` gives it alone; an unknown
+    option is refused by name."""
+    from vimpact.engine.pairs import pair_restitution, pair_restitutions
+
+    b1 = Body(KV, R=0.01, m=0.004)
+    b2 = Body(v.Material.kelvin_voigt(nu=0.4, G=3e7, eta=600.0), R=0.005, m=6e-4)
+    speeds = np.array([0.1, 0.5, 1.3])
+    curves = [(b1, Wall(), speeds, {}), (b1, b2, speeds[:2], {"tangential": True}),
+              (b2, Wall(), speeds, {"tangential": True, "vc_ratio": 0.6, "mu": 0.3})]
+    together = pair_restitutions(curves, FAST)
+    for (a, b, s, options), df in zip(curves, together):
+        alone = pair_restitution(a, b, s, numerics=FAST, **options)
+        assert list(df.columns) == list(alone.columns)
+        for col in df.columns:
+            np.testing.assert_array_equal(df[col].to_numpy(), alone[col].to_numpy())
+    with pytest.raises(ValueError, match="options"):
+        pair_restitutions([(b1, Wall(), speeds, {"angle": 3.0})], FAST)

@@ -200,3 +200,29 @@ def test_lammps_oblique_wall_impacts_give_the_reported_beta(problem, lammps_expo
     for r, beta_vimpact in oblique_rows_against_vimpact(rows, ob):
         assert abs(r["beta"] - beta_vimpact) <= f.res_beta_x.max_abs + diff[fine]
         assert r["e"] == pytest.approx(r["predicted"], abs=2e-4)
+
+
+def test_full_stick_beta_of_a_contact_with_friction_is_lammps_law_in_stick(lammps_export):
+    """A contact with friction is fitted and reported over its oblique impacts, so its
+    full-stick ``beta_x`` (the Hertz-Mindlin ODE with the fitted ``k_t``, ``x_gamma_t``) is
+    only worked out when read; read, it is the limit of the stepped LAMMPS law with no
+    Coulomb cap (an independent integration): the largest difference falls about as the
+    time step (5e-4 at 2000 steps per contact, about 4x less per 4x steps), to below 1e-4."""
+    import math
+
+    from vimpact.dem import laws, linear
+
+    for key in ("a-floor", "a-b"):
+        f = next(f for f in lammps_export.fits if f.contact.key == key)
+        t, p = lammps_export.targets[key], f.params
+        assert f.has_beta_x and f.beta_oblique is not None
+        assert f.beta_x.shape == t.v.shape
+        alpha = p["A_s"] * t.v / laws.hertz_overlap(p["E_star_Pa"], t.R, t.m, t.v)
+        gaps = []
+        for steps in (2000, 8000, 32000):
+            _, stick = laws.hertz_mindlin_coulomb(
+                alpha, p["k_t"] / (2.0 * p["E_star_Pa"]), p["x_gamma_t"],
+                linear.mass_factor(f.contact), math.inf, np.ones_like(alpha), steps)
+            gaps.append(float(np.max(np.abs(f.beta_x - stick))))
+        assert gaps[0] < 1e-3 and gaps[2] < 1e-4, gaps
+        assert gaps[1] < gaps[0] / 3.0 and gaps[2] < gaps[1] / 3.0, gaps

@@ -75,3 +75,34 @@ def test_a_contact_that_never_ends_is_refused():
     with pytest.raises(RuntimeError, match="did not end"):
         laws.hertz_mindlin_coulomb(np.array([np.nan]), 1.0, 1.0, 3.5, 0.3, np.array([1.0]),
                                    steps=STEPS)
+
+
+def test_points_sharing_the_kernels_lanes_get_what_they_get_alone():
+    """The kernel steps :data:`~vimpact.kernels.stepped.LANES` points side by side and
+    hands a finished point's lane to the next one: fewer points than lanes, more, and points
+    that do not end within ``max_steps`` (NaN, counted) give each point bit for bit what it
+    gives stepped alone."""
+    from vimpact.kernels.stepped import LANES, LAW_LAMMPS, lanes_work, stepped_impacts
+
+    rng, w0, mu = _points(5, 3 * LANES + 3)
+    n = w0.size
+    alpha = 10.0 ** rng.uniform(-3.0, 0.5, n)
+    p = np.column_stack([rng.uniform(0.3, 1.0, n), rng.uniform(0.1, 2.0, n), np.zeros(n)])
+    lever, spin, cap = rng.uniform(0.0, 0.3, n), np.full(n, 2.5), np.minimum(mu, 1e300)
+    h = laws.HERTZ_TIME_FACTOR / STEPS
+    for max_steps in (50 * STEPS, STEPS + 4):  # the second: about half the points do not end
+        for m in (2, n):
+            e, w = np.empty(m), np.empty(m)
+            left = stepped_impacts(np.int64(LAW_LAMMPS), alpha[:m], w0[:m], lever[:m], spin[:m],
+                                   cap[:m], p[:m], h, np.int64(max_steps), e, w, *lanes_work())
+            alone = np.empty((m, 2))
+            count = 0
+            for i in range(m):
+                sl = slice(i, i + 1)
+                count += stepped_impacts(np.int64(LAW_LAMMPS), alpha[sl], w0[sl], lever[sl],
+                                         spin[sl], cap[sl], p[sl], h, np.int64(max_steps),
+                                         alone[i, :1], alone[i, 1:], *lanes_work())
+            np.testing.assert_array_equal(e, alone[:, 0])
+            np.testing.assert_array_equal(w, alone[:, 1])
+            assert left == count
+        assert max_steps == 50 * STEPS or 0 < left < n

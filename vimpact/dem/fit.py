@@ -14,14 +14,14 @@ is reported as it is, never tuned away.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.optimize import minimize_scalar
 
 from vimpact.dem import laws
 from vimpact.dem.problem import Contact, DemProblem
-from vimpact.engine.pairs import pair_restitution
+from vimpact.engine.pairs import pair_restitutions
 
 #: impact angles (degrees from the normal, no spin) of the tangential targets when the
 #: set-up gives no ``[speeds] angles_deg``
@@ -62,21 +62,37 @@ def oblique_targets(problem: DemProblem, contact: Contact, numerics=None) -> Obl
 
     At :data:`OBLIQUE_SPEEDS` of the set-up's speeds (m/s) times its impact angles
     (``[speeds] angles_deg``, else :data:`DEFAULT_ANGLES_DEG`, degrees from the
-    normal).
+    normal), all in one engine batch.
     """
     from vimpact.model.numerics import Numerics
 
-    numerics = numerics or Numerics.preset("fast")
+    curves = _oblique_curves(problem, contact)
+    return _oblique_of(problem, contact, curves,
+                       pair_restitutions(curves, numerics or Numerics.preset("fast")))
+
+
+def _oblique_curves(problem: DemProblem, contact: Contact) -> list[tuple]:
+    """Return the curves (:func:`vimpact.engine.pairs.pair_restitutions`) of :func:`oblique_targets`."""
     sp = problem.speeds
     pick = np.unique(np.linspace(0, sp.size - 1, min(OBLIQUE_SPEEDS, sp.size)).round().astype(int))
     speeds = sp[pick]
-    angles = problem.angles_deg or DEFAULT_ANGLES_DEG
     b1, b2 = contact.levels()[len(contact.levels()) // 2]
+    return [(b1, b2, speeds, {"tangential": True, "vc_ratio": math.tan(math.radians(a)),
+                              "mu": contact.mu}) for a in _angles(problem)]
+
+
+def _angles(problem: DemProblem) -> tuple:
+    """Impact angles of the oblique targets, degrees from the normal."""
+    return problem.angles_deg or DEFAULT_ANGLES_DEG
+
+
+def _oblique_of(problem: DemProblem, contact: Contact, curves: list[tuple], frames: list
+                ) -> Oblique:
+    """Return :class:`Oblique` from the ``curves`` of :func:`_oblique_curves` and their results."""
+    b1, b2 = curves[0][:2]
     R, m = contact.effective((b1, b2))
     vs, an, ez, bx = [], [], [], []
-    for a in angles:
-        df = pair_restitution(b1, b2, speeds, tangential=True, vc_ratio=math.tan(math.radians(a)),
-                              mu=contact.mu, numerics=numerics)
+    for a, (_, _, speeds, _), df in zip(_angles(problem), curves, frames):
         # like the normal targets: a point counts if it has data (a contact wider than
         # 0.2 R, status half_space, is kept and noted in the report)
         done = np.isfinite(df["e_z"].to_numpy(dtype=float)) & np.isfinite(
@@ -171,21 +187,31 @@ def compute_targets(problem: DemProblem, contact: Contact, *, tangential: bool =
                     numerics=None) -> Targets:
     """Run vimpact for ``contact`` at every size level and speed of ``problem``.
 
-    With adhesion through :func:`adhesive_restitution` (``e_z`` 0 where the sphere
-    sticks).
+    Every impact of the contact (normal, full stick and the oblique ones of
+    :func:`oblique_targets`) runs in one engine batch
+    (:func:`vimpact.engine.pairs.pair_restitutions`); with adhesion, the normal impacts
+    through :func:`adhesive_restitution` (``e_z`` 0 where the sphere sticks).
     """
     from vimpact.model.numerics import Numerics
 
     numerics = numerics or Numerics.preset("fast")
+    levels = contact.levels()
+    adhesive = contact.adhesion > 0.0
+    oblique = tangential and math.isfinite(contact.mu)
+    curves: list[tuple] = ([] if adhesive else [(b1, b2, problem.speeds, {}) for b1, b2 in levels])
+    if tangential:
+        curves += [(b1, b2, problem.speeds, {"tangential": True}) for b1, b2 in levels]
+    slant = _oblique_curves(problem, contact) if oblique else []
+    frames = pair_restitutions(curves + slant, numerics) if curves or slant else []
+    nl = len(levels)
+    normal = ([adhesive_restitution(contact, level, problem.speeds, numerics) for level in levels]
+              if adhesive else frames[:nl])
+    stick = frames[len(curves) - nl:len(curves)] if tangential else []
     parts = []
-    for k, (b1, b2) in enumerate(contact.levels()):
-        R, m = contact.effective((b1, b2))
-        df = (adhesive_restitution(contact, (b1, b2), problem.speeds, numerics)
-              if contact.adhesion > 0.0 else
-              pair_restitution(b1, b2, problem.speeds, numerics=numerics))
-        beta = (pair_restitution(b1, b2, problem.speeds, tangential=True, numerics=numerics)
-                ["beta_x"].to_numpy(dtype=float) if tangential else None)
-        parts.append((k, R, m, df, beta))
+    for k, level in enumerate(levels):
+        R, m = contact.effective(level)
+        beta = stick[k]["beta_x"].to_numpy(dtype=float) if tangential else None
+        parts.append((k, R, m, normal[k], beta))
     n = problem.speeds.size
     cat = np.concatenate
     e_z = cat([p[3]["e_z"].to_numpy(dtype=float) for p in parts])
@@ -203,8 +229,8 @@ def compute_targets(problem: DemProblem, contact: Contact, *, tangential: bool =
         beta_x=cat([p[4] for p in parts]) if tangential else None,
         t_contact=cat([p[3]["t_contact"].to_numpy(dtype=float) for p in parts]),
         status=cat([p[3]["status"].to_numpy(dtype=str) for p in parts]),
-        oblique=(oblique_targets(problem, contact, numerics)
-                 if tangential and math.isfinite(contact.mu) else None),
+        oblique=(_oblique_of(problem, contact, slant, frames[len(curves):]) if oblique
+                 else None),
     )
 
 
@@ -233,7 +259,10 @@ class ContactFit:
     ----------
     contact : the contact; ``params`` : the exported constants (name -> value, SI)
     e_z : restitution the code's law gives at the target points with ``params``
-    beta_x : likewise for the tangential restitution, or ``None`` if not represented
+    beta_x : likewise for the tangential restitution, or ``None`` if not represented;
+        constructed with a function instead of an array, it is computed when first read
+        (a contact with friction is fitted and reported over its oblique impacts, so its
+        full-stick curve is only worked out if someone asks for it)
     res_e_z : residual of ``e_z`` against vimpact
     res_beta_x : residual of ``beta_x`` against vimpact (``None`` if not represented): over
         the oblique impacts with friction when the contact has a finite friction
@@ -245,11 +274,27 @@ class ContactFit:
     contact: Contact
     params: dict
     e_z: np.ndarray
-    beta_x: np.ndarray | None
+    _beta_x: np.ndarray | Callable[[], np.ndarray] | None
     res_e_z: Residual
     res_beta_x: Residual | None = None
     notes: list[str] = field(default_factory=list)
     beta_oblique: np.ndarray | None = None
+
+    @property
+    def beta_x(self) -> np.ndarray | None:
+        """The code's full-stick ``beta_x`` at the target points (computed on first read)."""
+        if callable(self._beta_x):
+            self._beta_x = np.asarray(self._beta_x(), dtype=float)
+        return self._beta_x
+
+    @beta_x.setter
+    def beta_x(self, value: np.ndarray | None) -> None:
+        self._beta_x = value
+
+    @property
+    def has_beta_x(self) -> bool:
+        """Whether the code represents ``beta_x`` (without computing a deferred curve)."""
+        return self._beta_x is not None
 
 
 def fit_constant(target: np.ndarray, lo: float = 0.0, hi: float = 1.0) -> tuple[float, Residual]:
@@ -284,13 +329,10 @@ def fit_viscoelastic_hertz(t: Targets, E_star: float, mass_factor: np.ndarray | 
     guess = float(np.median(np.maximum(1.0 - t.e_z, 1e-9) / laws.SMALL_DAMPING_SLOPE / unit))
     lo, hi = math.log10(guess) - 3.0, min(math.log10(guess) + 3.0, math.log10(1e3 / unit.max()))
 
-    def cost(logA: float) -> float:
-        r = predict(10.0**logA) - t.e_z
-        return float(np.mean(r * r))
-
-    best = minimize_scalar(cost, bounds=(lo, hi), method="bounded",
-                           options={"xatol": 1e-9, "maxiter": 500})
-    A = 10.0**best.x
+    # Brent's bounded search of scipy's minimize_scalar (without importing scipy.optimize)
+    logA = fit_scalar_many(lambda jobs: [predict(10.0**x) for _, x in jobs], [t.e_z], [lo],
+                           [hi], xatol=1e-9, maxiter=500)[0]
+    A = 10.0**logA
     return A, predict(A)
 
 

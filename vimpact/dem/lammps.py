@@ -45,6 +45,7 @@ import os
 import subprocess
 import sys
 import tempfile
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -120,9 +121,10 @@ def fit(problem: DemProblem, targets: dict[str, Targets]) -> list[ContactFit]:
             k_relaxed = params["k_t"]
             params["k_t"], params["x_gamma_t"], b = _fit_tangential(c, t, A, params,
                                                                     searched.get(c.key))
-            res_b = Residual.of(b, t.beta_x)
-            basis = "in full stick"
-            if t.oblique is not None:
+            if t.oblique is None:
+                res_b = Residual.of(b, t.beta_x)
+                basis = "in full stick"
+            else:
                 b_ob = oblique_beta(c, t.oblique, A, params, params["k_t"], params["x_gamma_t"])
                 res_b = Residual.of(b_ob, t.oblique.beta_x)
                 basis = (f"with the contact's friction mu = {c.mu:g} over impact angles "
@@ -301,7 +303,8 @@ def _search_oblique(items: list[tuple[Contact, Oblique, float, dict]]) -> list[n
 
 
 def _fit_tangential(c: Contact, t: Targets, A: float, params: dict,
-                    z: np.ndarray | None = None) -> tuple[float, float, np.ndarray]:
+                    z: np.ndarray | None = None
+                    ) -> tuple[float, float, np.ndarray | Callable[[], np.ndarray]]:
     """Fit ``k_t`` (Pa) and ``x_gamma_t`` >= 0 to vimpact's ``beta_x`` (least RMS).
 
     Over the oblique impacts with the contact's friction when it has one (``t.oblique``), else in
@@ -309,7 +312,9 @@ def _fit_tangential(c: Contact, t: Targets, A: float, params: dict,
     and ``x_gamma_t = 0.4``, near the fits of Kelvin-Voigt pairs (with friction: shrinking
     grids in ``(ln(k_t / k_relaxed), ln x_gamma_t)``, :func:`_search_oblique`, every
     candidate of a grid stepped at once; ``z`` its result when already searched). Returns
-    them and the law's full-stick ``beta`` at every point of ``t``.
+    them and the law's full-stick ``beta`` at every point of ``t``: with friction, a
+    function that computes it (one ODE solve per point; the fit and the report use the
+    oblique impacts, so :class:`ContactFit` computes it only when it is read).
     """
     from scipy.optimize import minimize
 
@@ -319,7 +324,7 @@ def _fit_tangential(c: Contact, t: Targets, A: float, params: dict,
         if z is None:
             z = _search_oblique([(c, ob, A, params)])[0]
         k, x = k0 * math.exp(float(z[0])), math.exp(float(z[1]))
-        return k, x, _tangential_beta(c, t, A, params, k, x)
+        return k, x, functools.partial(_tangential_beta, c, t, A, dict(params), k, x)
     else:
         if t.beta_x is None:
             raise ValueError(f"contact {c.key}: no beta_x targets to fit (neither full stick "

@@ -44,7 +44,7 @@ def figure(code: str, problem: DemProblem, targets: dict[str, Targets],
     from matplotlib.figure import Figure
 
     n = len(fits)
-    rows = 2 if any(f.beta_x is not None for f in fits) else 1
+    rows = 2 if any(f.has_beta_x for f in fits) else 1
     fig = Figure(figsize=(PANEL_IN[0] * n, PANEL_IN[1] * rows))
     FigureCanvasAgg(fig)
     axes = fig.subplots(rows, n, squeeze=False, gridspec_kw=_margins(n, rows))

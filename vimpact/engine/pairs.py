@@ -112,20 +112,51 @@ def pair_restitution(body1: Body, other: Body | Wall, speeds, *, tangential: boo
     -------
     pandas.DataFrame with columns ``v_z0, e_z, beta_x, t_contact, a_max, status``.
     """
-    speeds = np.asarray(speeds, dtype=float)
-    require("speeds", speeds, speeds.ndim == 1 and speeds.size > 0 and bool(np.all(speeds > 0))
-            and bool(np.all(np.isfinite(speeds))), "a non-empty 1-D array of finite speeds > 0")
-    base = pair_scene(Body(body1.material, body1.R, body1.m, body1.Theta, v_z=1.0,
-                           rotation=body1.rotation),
-                      other if isinstance(other, Wall) else
-                      Body(other.material, other.R, other.m, other.Theta, rotation=other.rotation),
-                      tangential="stick" if tangential else "none", mu=mu,
-                      allow_large_contact=True)
-    scenes = [Scene(base.material, R=base.R, m=base.m, v_z0=v, v_x0=vc_ratio * v if tangential
-                    else 0.0, Theta=base.Theta if base.rotation else None,
-                    rotation=base.rotation, tangential=base.tangential, mu=mu,
-                    allow_large_contact=True) for v in speeds]
-    df = simulate_batch(scenes, numerics)
-    out = df[["e_z", "beta_x", "t_contact", "a_max", "status"]].reset_index(drop=True)
-    out.insert(0, "v_z0", speeds)
+    return pair_restitutions([(body1, other, speeds, {"tangential": tangential,
+                                                      "vc_ratio": vc_ratio, "mu": mu})],
+                             numerics)[0]
+
+
+def pair_restitutions(curves: Sequence[tuple[Body, Body | Wall, object, dict]], numerics=None
+                      ) -> list[pd.DataFrame]:
+    """:func:`pair_restitution` of several pairs and options, all in one engine batch.
+
+    ``curves``: ``(body1, other, speeds, options)`` with ``options`` the keywords
+    ``tangential``, ``vc_ratio``, ``mu`` of :func:`pair_restitution` (absent: its
+    defaults). Every impact is a row of one :func:`~vimpact.engine.simulate.simulate_batch`
+    call (rows are independent: each gets what it gets alone). Returns one DataFrame per
+    curve, as :func:`pair_restitution` returns it.
+    """
+    scenes: list[Scene] = []
+    bounds = []
+    for body1, other, speeds, options in curves:
+        unknown = sorted(set(options) - {"tangential", "vc_ratio", "mu"})
+        require("options", unknown, not unknown, "keywords among tangential, vc_ratio, mu")
+        speeds = np.asarray(speeds, dtype=float)
+        require("speeds", speeds, speeds.ndim == 1 and speeds.size > 0
+                and bool(np.all(speeds > 0)) and bool(np.all(np.isfinite(speeds))),
+                "a non-empty 1-D array of finite speeds > 0")
+        tangential = bool(options.get("tangential", False))
+        vc_ratio = float(options.get("vc_ratio", 1.0))
+        mu = options.get("mu", math.inf)
+        base = pair_scene(Body(body1.material, body1.R, body1.m, body1.Theta, v_z=1.0,
+                               rotation=body1.rotation),
+                          other if isinstance(other, Wall) else
+                          Body(other.material, other.R, other.m, other.Theta,
+                               rotation=other.rotation),
+                          tangential="stick" if tangential else "none", mu=mu,
+                          allow_large_contact=True)
+        start = len(scenes)
+        scenes += [Scene(base.material, R=base.R, m=base.m, v_z0=v,
+                         v_x0=vc_ratio * v if tangential else 0.0,
+                         Theta=base.Theta if base.rotation else None, rotation=base.rotation,
+                         tangential=base.tangential, mu=mu, allow_large_contact=True)
+                   for v in speeds]
+        bounds.append((start, len(scenes), speeds))
+    df = simulate_batch(scenes, numerics)[["e_z", "beta_x", "t_contact", "a_max", "status"]]
+    out = []
+    for start, stop, speeds in bounds:
+        part = df.iloc[start:stop].reset_index(drop=True)
+        part.insert(0, "v_z0", speeds)
+        out.append(part)
     return out

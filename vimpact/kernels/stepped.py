@@ -1,4 +1,4 @@
-"""Oblique impacts stepped under the friction laws of DEM codes, one point after another.
+"""Oblique impacts stepped under the friction laws of DEM codes, several points side by side.
 
 The kernel of :mod:`vimpact.dem.laws`' stepped laws (LAMMPS' Hertz-Mindlin,
 MercuryDPM's Hertz-Mindlin species, LIGGGHTS' Hertz with history, Yade's
@@ -10,7 +10,8 @@ centre's tangential speed ``u_x`` (from ``w0``) and the spin ``R omega`` (from
 with ``w = u_x - arm R omega``. Which law is the integer ``law`` (``LAW_*``); its
 constants per point are the columns of ``p`` (below). Every point is independent:
 the arithmetic is that of the laws written with NumPy over all points at once, in
-the same order, so the numbers are the same bit for bit.
+the same order, so the numbers are the same bit for bit (and the same whichever
+points share the lanes of :func:`stepped_impacts`).
 
 Constants ``p[:, 0..3]`` of each law (units of :mod:`vimpact.dem.laws`):
 
@@ -101,9 +102,25 @@ def _force(law, x, v, s, w, alpha, cap, p0, p1, p2):
     return f, el + p2 * w, s
 
 
-@jit()
-def stepped_impacts(law, alpha, w0, lever, spin, cap, p, h, max_steps, e, w_end):
+#: points stepped side by side (:func:`stepped_impacts`)
+LANES = 8
+
+
+def lanes_work() -> tuple[np.ndarray, np.ndarray]:
+    """Return the work space ``(point, state)`` of :func:`stepped_impacts`' lanes."""
+    return np.empty((2, LANES), dtype=np.int64), np.empty((7, LANES))
+
+
+@jit(nrt=False)
+def stepped_impacts(law, alpha, w0, lever, spin, cap, p, h, max_steps, e, w_end, point, state):
     """Step every point's impact until its overlap is back to zero.
+
+    :data:`LANES` points are stepped side by side, one step of each in turn, and a
+    point that ends hands its lane to the next point not yet started: the steps of
+    different points do not wait for each other (one point's steps form a chain of
+    dependent operations, which alone leaves the processor idle most of the time).
+    Each point's arithmetic is its own, in the order of the laws (bit for bit what it
+    gives stepped alone).
 
     Parameters
     ----------
@@ -116,46 +133,72 @@ def stepped_impacts(law, alpha, w0, lever, spin, cap, p, h, max_steps, e, w_end)
     h : time step in the law's time unit; max_steps : steps at most
     e, w_end : 1-D outputs: ``-v`` and ``u_x - R omega`` where the overlap ended
         (NaN where it did not within ``max_steps``)
+    point, state : work space of the lanes, ``(2, LANES)`` int64 and ``(7, LANES)`` float
+        (the kernel allocates nothing: it compiles without reference counting)
 
     Returns the number of points whose overlap did not end within ``max_steps``.
     """
-    unfinished = 0
-    for i in range(w0.shape[0]):
-        a = alpha[i]
-        lev = lever[i]
-        sp = spin[i]
-        c = cap[i]
-        p0 = p[i, 0]
-        p1 = p[i, 1]
-        p2 = p[i, 2]
-        x = 0.0
-        v = 1.0
-        s = 0.0
-        ux = w0[i]
-        om = 0.0
-        an = 0.0
-        at = 0.0
+    n = w0.shape[0]
+    for i in range(n):
         e[i] = np.nan
         w_end[i] = np.nan
-        ended = False
-        for _ in range(max_steps):
-            arm = 1.0 - lev * x
-            v_half = v - 0.5 * h * an
-            ux_half = ux - 0.5 * h * at
-            om_half = om + 0.5 * h * arm * sp * at
-            x = x + h * v_half
-            arm = 1.0 - lev * x
+    # per lane: its point (-1: none left), steps taken and the state of the point
+    taken = point[1]
+    point = point[0]
+    x = state[0]
+    v = state[1]
+    s = state[2]
+    ux = state[3]
+    om = state[4]
+    an = state[5]
+    at = state[6]
+    started = 0
+    for k in range(LANES):
+        point[k] = -1
+        taken[k] = 0
+        x[k], v[k], s[k], ux[k], om[k], an[k], at[k] = 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0
+        if k < n:
+            point[k] = k
+            ux[k] = w0[k]
+            started += 1
+    live = started
+    unfinished = 0
+    while live > 0:
+        for k in range(LANES):
+            i = point[k]
+            if i < 0:
+                continue
+            lev = lever[i]
+            sp = spin[i]
+            arm = 1.0 - lev * x[k]
+            v_half = v[k] - 0.5 * h * an[k]
+            ux_half = ux[k] - 0.5 * h * at[k]
+            om_half = om[k] + 0.5 * h * arm * sp * at[k]
+            xk = x[k] + h * v_half
+            arm = 1.0 - lev * xk
             w_half = ux_half - arm * om_half
-            s = s + h * w_half
-            an, at, s = _force(law, x, v_half, s, w_half, a, c, p0, p1, p2)
-            v = v_half - 0.5 * h * an
-            ux = ux_half - 0.5 * h * at
-            om = om_half + 0.5 * h * arm * sp * at
-            if x <= 0.0:
-                e[i] = -v
-                w_end[i] = ux - om
-                ended = True
-                break
-        if not ended:
-            unfinished += 1
+            sk = s[k] + h * w_half
+            ank, atk, sk = _force(law, xk, v_half, sk, w_half, alpha[i], cap[i], p[i, 0],
+                                  p[i, 1], p[i, 2])
+            vk = v_half - 0.5 * h * ank
+            uxk = ux_half - 0.5 * h * atk
+            omk = om_half + 0.5 * h * arm * sp * atk
+            taken[k] += 1
+            if xk <= 0.0 or taken[k] >= max_steps:
+                if xk <= 0.0:
+                    e[i] = -vk
+                    w_end[i] = uxk - omk
+                else:
+                    unfinished += 1
+                if started < n:  # the lane takes the next point, from contact
+                    point[k] = started
+                    taken[k] = 0
+                    x[k], v[k], s[k], ux[k], om[k], an[k], at[k] = (
+                        0.0, 1.0, 0.0, w0[started], 0.0, 0.0, 0.0)
+                    started += 1
+                else:
+                    point[k] = -1
+                    live -= 1
+                continue
+            x[k], v[k], s[k], ux[k], om[k], an[k], at[k] = xk, vk, sk, uxk, omk, ank, atk
     return unfinished
