@@ -266,8 +266,9 @@ def viscoelastic_hertz_mindlin(alpha: float, kappa: float, x_gamma: float, F: fl
 # ---- oblique impacts with Coulomb friction (time-stepped, as the codes do) --
 
 #: time steps per elastic Hertz contact time of the stepped friction laws; their
-#: discretization error in ``beta`` is below 5e-4 at this step (against the stick ODE,
-#: tests/dem/test_laws.py)
+#: discretization error in ``beta`` at this step is first order in the step and about
+#: 5e-4 against the stick ODE: below it on the scenes of tests/dem/test_laws.py, 6.2e-4
+#: for the round-trip set-up's fitted constants (tests/dem/test_round_trip.py)
 FRICTION_STEPS = 2000
 
 
