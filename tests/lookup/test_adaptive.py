@@ -82,6 +82,25 @@ def test_coarser_tolerance_gives_fewer_cells_and_larger_error(analytic):
     assert e_coarse <= 1e-3 and e_fine < e_coarse / 10
 
 
+@pytest.mark.parametrize("kw", [{}, {"max_nodes": 3000}], ids=["met", "max_nodes"])
+def test_every_point_is_evaluated_once_and_kept_with_its_key(kw):
+    """The refinement's bookkeeping: no lattice point goes to ``evaluate`` twice, the
+    points of one call are distinct, and every returned value is ``evaluate``'s at the
+    returned key (also where ``max_nodes`` stops the refinement)."""
+    calls = []
+
+    def counted(keys):
+        calls.append(np.array(keys))
+        return evaluate(keys)
+
+    leaves, keys, values, report = refine_cells(counted, 2, len(NU), 1e-7, max_level=6, **kw)
+    asked = np.concatenate(calls)
+    assert len(np.unique(asked, axis=0)) == len(asked) == report["points"]
+    assert np.array_equal(values, evaluate(keys))
+    assert {tuple(key) for key in keys.tolist()} <= {tuple(key) for key in asked.tolist()}
+    assert report["met"] is False and len(leaves) > 16
+
+
 def test_lookup_reproduces_cubics_exactly():
     """Tensor-product cubic Lagrange per cell and cubic in nu: any polynomial of degree
     <= 3 in each of log Q1, log Q2 and nu is reproduced to round-off, on any tree."""
