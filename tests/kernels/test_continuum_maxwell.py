@@ -155,8 +155,8 @@ def test_random_scenes_agree_with_scipy_reference(seed):
 STIFF_RTOL_FACTOR = 100.0
 
 
-def _stiff_reference(tau0, g, tau, nu, mu_t):
-    ref = maxwell_continuum_reference(tau0, g, tau, kappa_of(nu), mu_t, rtol=1e-12,
+def _stiff_reference(tau0, g, tau, nu, mu_t, rtol=1e-12):
+    ref = maxwell_continuum_reference(tau0, g, tau, kappa_of(nu), mu_t, rtol=rtol,
                                       method="LSODA")
     return np.array([ref.e_z, ref.beta_x, ref.t_contact])
 
@@ -178,8 +178,8 @@ def _stiff_scene(rng):
     return tau0, g, tau, nu, mu_t
 
 
-def _check_stiff(scene, rtol=1e-8):
-    want = _stiff_reference(*scene)
+def _check_stiff(scene, rtol=1e-8, oracle_rtol=1e-12):
+    want = _stiff_reference(*scene, rtol=oracle_rtol)
     out = run(*scene, rtol=rtol)
     assert out[OUT_STATUS] == STATUS_OK
     err = np.abs(outputs(out) - want)
@@ -197,9 +197,16 @@ STIFF_SCENES = [
 ]
 
 
+#: The oracle's rtol for STIFF_SCENES: its error there, against LSODA at rtol 1e-13, is
+#: at most 3.0e-8 on e_z, beta_x, t_contact (1.7e-8, 3.0e-8, 5.9e-9 for the three
+#: scenes; 3.4e-9 at rtol 1e-10, 7e-11 at 1e-12), 33x below the tolerance
+#: STIFF_RTOL_FACTOR * 1e-8 = 1e-6 it is compared with, at 40 % of the cost of rtol 1e-12.
+STIFF_ORACLE_RTOL = 1e-9
+
+
 @pytest.mark.parametrize("scene", STIFF_SCENES)
 def test_stiff_arms_agree_with_implicit_scipy_reference(scene):
-    _check_stiff(scene)
+    _check_stiff(scene, oracle_rtol=STIFF_ORACLE_RTOL)
 
 
 @pytest.mark.slow
