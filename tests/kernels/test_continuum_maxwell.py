@@ -105,20 +105,24 @@ SCENES = [  # (tau0, g, tau, nu, mu_t)
 ]
 
 
-def _compare_with_reference(tau0, g, tau, nu, mu_t):
-    ref = maxwell_continuum_reference(tau0, g, tau, kappa_of(nu), mu_t)
+def _compare_with_reference(tau0, g, tau, nu, mu_t, oracle_rtol=1e-12):
+    tol = _tol_ref(tau0, g)
+    ref = maxwell_continuum_reference(tau0, g, tau, kappa_of(nu), mu_t, rtol=oracle_rtol)
     out = run(tau0, g, tau, nu, mu_t, rtol=RTOL_REF)
     assert out[OUT_STATUS] == STATUS_OK
     got = outputs(out)
     want = np.array([ref.e_z, ref.beta_x, ref.t_contact])
-    tol = _tol_ref(tau0, g)
     assert np.all(np.abs(got - want) < tol), (got - want)
     assert abs(out[OUT_U_MAX] - ref.u_max) < tol
 
 
 @pytest.mark.parametrize("scene", SCENES)
 def test_agrees_with_scipy_reference(scene):
-    _compare_with_reference(*scene)
+    # the oracle at rtol 1e-12 (error <= 1.6e-12 against rtol 1e-14 on these scenes:
+    # e_z, beta_x, t_contact, u_max), 1e-10 where the tolerance is 1e-9 (error 1.6e-11
+    # on the 3-arm scene with a dashpot): both 60x below the tolerance
+    _compare_with_reference(*scene, oracle_rtol=1e-10 if _tol_ref(*scene[:2]) >= 1e-9
+                            else 1e-12)
 
 
 def _random_scene(rng):
