@@ -127,8 +127,9 @@ def test_creeping_peels_end_as_stuck(Q1, lam):
     end stuck, e_z = 0, well before it."""
     res = simulate_adhesive(dimensionless(Q1, lam))
     assert res.status == "stuck" and res.stuck and res.e_z == 0.0
-    out, _ = run(dimensionless(Q1, lam))
-    assert out[K.ADH_STEPS] < 0.05 * kernel_inputs(
+    # the steps of this run (the kernel again through run() takes the same: 658,944
+    # at Q1 = 100, the costliest case, where a second run was half the test)
+    assert res.n_steps < 0.05 * kernel_inputs(
         SceneColumns.from_scenes([dimensionless(Q1, lam)]), Numerics())["max_steps"][0]
 
 

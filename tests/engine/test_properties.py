@@ -70,40 +70,60 @@ def signed_log_uniform(lo: float, hi: float):
     return st.tuples(st.sampled_from((-1.0, 1.0)), log_uniform(lo, hi)).map(lambda t: t[0] * t[1])
 
 
+#: The strategies the draws below use, each built once: building a strategy inside a
+#: composite on every draw (and Hypothesis validating it again) cost more than the
+#: simulations. The draws are the same (the examples are a function of the choices).
+ARM_COUNT = st.integers(1, 4)
+# glassy modulus up to 1e4 G_inf in total; times anywhere in ten decades
+ARM_MODULUS = {n: log_uniform(1e-3, 1e4 / n) for n in range(1, 5)}
+ARM_TIME = log_uniform(1e-5, 1e5)
+ONE_IN_SIX = st.integers(0, 5)
+V_C0 = signed_log_uniform(1e-3, 1e3)
+V_X0_AT_VC0_ZERO = st.one_of(st.just(0.0), V_C0)
+SPLIT = st.one_of(st.sampled_from((0.0, 1.0)), st.floats(-1.0, 2.0))
+KIND = st.sampled_from(("elastic", "kelvin_voigt", "standard_solid", "prony"))
+NU = st.one_of(st.sampled_from((0.0, 0.25, 0.5)), st.floats(0.0, 0.5))
+THETA = st.one_of(st.sampled_from((1e-3, 0.4, 2.0 / 3.0)), log_uniform(1e-3, 2.0 / 3.0))
+Q1 = log_uniform(1e-5, 1e2)
+Q2 = log_uniform(1e-4, 1e4)
+ETA0 = st.one_of(st.just(0.0), log_uniform(1e-5, 1e2))
+
+
 @st.composite
 def prony_arms(draw):
-    n = draw(st.integers(1, 4))
-    # glassy modulus up to 1e4 G_inf in total; times anywhere in ten decades
-    return tuple((draw(log_uniform(1e-3, 1e4 / n)), draw(log_uniform(1e-5, 1e5)))
-                 for _ in range(n))
+    n = draw(ARM_COUNT)
+    return tuple((draw(ARM_MODULUS[n]), draw(ARM_TIME)) for _ in range(n))
 
 
 @st.composite
 def tangential_state(draw):
     """``(v_x0, omega0)`` with ``v_c0 = v_x0 + omega0`` (R = 1) in [-1e3, 1e3]."""
-    if draw(st.integers(0, 5)) == 0:  # v_c0 = 0 exactly, with any spin against sliding
-        v_x0 = draw(st.one_of(st.just(0.0), signed_log_uniform(1e-3, 1e3)))
+    if draw(ONE_IN_SIX) == 0:  # v_c0 = 0 exactly, with any spin against sliding
+        v_x0 = draw(V_X0_AT_VC0_ZERO)
         return v_x0, -v_x0
-    v_c0 = draw(signed_log_uniform(1e-3, 1e3))
-    split = draw(st.one_of(st.sampled_from((0.0, 1.0)), st.floats(-1.0, 2.0)))
-    v_x0 = v_c0 * split
+    v_c0 = draw(V_C0)
+    v_x0 = v_c0 * draw(SPLIT)
     return v_x0, v_c0 - v_x0
+
+
+TANGENTIAL_STATE = tangential_state()
+PRONY_ARMS = prony_arms()
 
 
 @st.composite
 def draws(draw):
-    kind = draw(st.sampled_from(("elastic", "kelvin_voigt", "standard_solid", "prony")))
-    nu = draw(st.one_of(st.sampled_from((0.0, 0.25, 0.5)), st.floats(0.0, 0.5)))
-    theta = draw(st.one_of(st.sampled_from((1e-3, 0.4, 2.0 / 3.0)), log_uniform(1e-3, 2.0 / 3.0)))
-    v_x0, omega0 = draw(tangential_state())
+    kind = draw(KIND)
+    nu = draw(NU)
+    theta = draw(THETA)
+    v_x0, omega0 = draw(TANGENTIAL_STATE)
     d = Draw(kind, nu, theta, v_x0, omega0)
     if kind == "kelvin_voigt":
-        d = d._replace(q1=draw(log_uniform(1e-5, 1e2)))
+        d = d._replace(q1=draw(Q1))
     elif kind == "standard_solid":
-        d = d._replace(q1=draw(log_uniform(1e-5, 1e2)), q2=draw(log_uniform(1e-4, 1e4)))
+        d = d._replace(q1=draw(Q1), q2=draw(Q2))
     elif kind == "prony":
-        eta0 = draw(st.one_of(st.just(0.0), log_uniform(1e-5, 1e2)))
-        d = d._replace(arms=draw(prony_arms()), eta0=eta0)
+        eta0 = draw(ETA0)
+        d = d._replace(arms=draw(PRONY_ARMS), eta0=eta0)
     return d
 
 

@@ -90,29 +90,35 @@ def _kernel_rows(rng, n):
 
 def test_unpack_row_is_unpack_of_one_row():
     """simulate()'s scalar unpack gives exactly what the batch unpack gives for the
-    same row (every field, every status, refused rows too)."""
+    same row (every field, every status, refused rows too).
+
+    The batch unpack takes the 400 rows of a scene at once (each row's outputs are its
+    own: a batch of one row is one of these rows)."""
     from vimpact.engine.columns import SceneColumns
     from vimpact.engine.result import RESULT_FIELDS
     from vimpact.engine.unpack import unpack, unpack_row
 
     rng = np.random.default_rng(7)
     statuses = set()
+    n = 400
     for scene in _scenes():
         cols = SceneColumns.from_scenes([scene])
         assert cols.valid[0]
-        out = _kernel_rows(rng, 400)
-        for i in range(len(out)):
-            euler = bool(rng.random() < 0.2)
-            steps = float(rng.choice([0.0, 0.5, 50.0]))
-            refused = (("too_costly", "a reason") if rng.random() < 0.03 else None)
-            refused_col = np.full(1, None, dtype=object)
-            refused_col[0] = refused
-            want = unpack(cols, out[i:i + 1], Coded.encode(np.array(["p"], dtype=object)),
-                          np.array([euler]), np.array([steps]), refused_col)
-            got = unpack_row(cols, out[i], "p", euler, steps, refused)
+        out = _kernel_rows(rng, n)
+        euler, steps = np.zeros(n, dtype=bool), np.zeros(n)
+        refused_col = np.full(n, None, dtype=object)
+        for i in range(n):
+            euler[i] = rng.random() < 0.2
+            steps[i] = rng.choice([0.0, 0.5, 50.0])
+            refused_col[i] = (("too_costly", "a reason") if rng.random() < 0.03 else None)
+        want = unpack(SceneColumns.from_scenes([scene] * n), out,
+                      Coded.encode(np.full(n, "p", dtype=object)), euler, steps, refused_col)
+        for i in range(n):
+            got = unpack_row(cols, out[i], "p", bool(euler[i]), float(steps[i]),
+                             refused_col[i])
             assert list(got) == list(RESULT_FIELDS)
             for name in RESULT_FIELDS:
-                w = want[name][0]
+                w = want[name][i]
                 w = w.item() if hasattr(w, "item") else w
                 g = got[name]
                 assert type(g) is type(w), (name, g, w)

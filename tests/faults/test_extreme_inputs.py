@@ -34,6 +34,7 @@ function of the test alone.
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -56,13 +57,28 @@ ROWS = 6
 FAST = v.Numerics.preset("fast")
 
 
+# Each strategy is built once (functools.cache and the constants below): building it
+# inside the composite on every draw (and Hypothesis validating it again) cost more than
+# the simulations. The draws are the same (the examples are a function of the choices).
+@functools.cache
 def _decades(lo: float, hi: float):
     return st.floats(lo, hi, allow_nan=False, allow_infinity=False).map(lambda x: 10.0 ** x)
 
 
+@functools.cache
 def _signed(lo: float, hi: float):
     return st.one_of(st.just(0.0), st.tuples(st.sampled_from((-1.0, 1.0)), _decades(lo, hi))
                      .map(lambda p: p[0] * p[1]))
+
+
+MODEL = st.sampled_from(v.MODELS)
+NU = st.one_of(st.sampled_from((0.0, 0.5)), st.floats(0.0, 0.5))
+ONE_IN_FIVE = st.integers(0, 4)
+THETA_RATIO = st.one_of(st.just(0.4), _decades(-3.0, 0.0))
+TANGENTIAL = st.sampled_from(("auto", "stick", "none"))
+MU = st.one_of(st.just(math.inf), _decades(-3.0, 1.0))
+ARM_COUNT = st.integers(1, 3)
+ETA0_PER_G_T = st.one_of(st.just(0.0), _decades(-6.0, 2.0))
 
 
 @st.composite
@@ -71,14 +87,14 @@ def rows(draw, fast_arms: bool = False) -> dict:
     ``fast_arms`` (with friction: the element path), else from 1.3e-3 T (full stick
     only: no element kernel to compile in the default run)."""
     tau_lo = -4.0 if fast_arms else -2.9
-    model = draw(st.sampled_from(v.MODELS))
-    nu = draw(st.one_of(st.sampled_from((0.0, 0.5)), st.floats(0.0, 0.5)))
+    model = draw(MODEL)
+    nu = draw(NU)
     G = draw(_decades(-15.0, 15.0))
     R = draw(_decades(-15.0, 15.0))
     v_z0 = draw(_decades(-15.0, 15.0))
     # the mass: mostly the one that puts the Hertz indentation d at 1e-24 ... 0.03 R (a_H
     # <= 0.18 R: most rows stay inside the half-space model and reach the kernels), else free
-    depth = draw(_decades(-24.0, -1.5)) if draw(st.integers(0, 4)) < 4 else None
+    depth = draw(_decades(-24.0, -1.5)) if draw(ONE_IN_FIVE) < 4 else None
     E_star = 2.0 * G / (1.0 - nu)
     m = 16.0 * E_star * math.sqrt(R) * (depth * R) ** 2.5 / (15.0 * v_z0**2) if depth else 0.0
     if not (math.isfinite(m) and 0.0 < m < 1e300):
@@ -86,10 +102,10 @@ def rows(draw, fast_arms: bool = False) -> dict:
     row = {"model": model, "nu": nu, "G_inf_Pa": G, "R_m": R, "m_kg": m, "v_z0_m_s": v_z0,
            "v_x0_m_s": draw(_signed(-15.0, 15.0)) * v_z0,
            "omega0_rad_s": draw(_signed(-15.0, 15.0)) * v_z0 / R,
-           "theta_ratio": draw(st.one_of(st.just(0.4), _decades(-3.0, 0.0))),
+           "theta_ratio": draw(THETA_RATIO),
            "rotation": draw(st.booleans()),
-           "tangential": draw(st.sampled_from(("auto", "stick", "none"))),
-           "mu": draw(st.one_of(st.just(math.inf), _decades(-3.0, 1.0))) if fast_arms else math.inf}
+           "tangential": draw(TANGENTIAL),
+           "mu": draw(MU) if fast_arms else math.inf}
     with np.errstate(all="ignore"):
         T = hertz_scales(G, nu, R, m, v_z0).T
     T = T if math.isfinite(T) and T > 0.0 else 1.0
@@ -99,10 +115,10 @@ def rows(draw, fast_arms: bool = False) -> dict:
     elif model == "standard_solid":
         arms = [(draw(_decades(-3.0, 3.0)) * G, draw(_decades(tau_lo, 4.0)) * T)]
     elif model == "prony":
-        n = draw(st.integers(1, 3))
+        n = draw(ARM_COUNT)
         arms = [(draw(_decades(-3.0, 3.0)) * G, draw(_decades(tau_lo, 4.0)) * T)
                 for _ in range(n)]
-        row["eta0_Pa_s"] = draw(st.one_of(st.just(0.0), _decades(-6.0, 2.0))) * G * T
+        row["eta0_Pa_s"] = draw(ETA0_PER_G_T) * G * T
     row["arms"] = arms
     return row
 

@@ -105,20 +105,24 @@ SCENES = [  # (tau0, g, tau, nu, mu_t)
 ]
 
 
-def _compare_with_reference(tau0, g, tau, nu, mu_t):
-    ref = maxwell_continuum_reference(tau0, g, tau, kappa_of(nu), mu_t)
+def _compare_with_reference(tau0, g, tau, nu, mu_t, oracle_rtol=1e-12):
+    tol = _tol_ref(tau0, g)
+    ref = maxwell_continuum_reference(tau0, g, tau, kappa_of(nu), mu_t, rtol=oracle_rtol)
     out = run(tau0, g, tau, nu, mu_t, rtol=RTOL_REF)
     assert out[OUT_STATUS] == STATUS_OK
     got = outputs(out)
     want = np.array([ref.e_z, ref.beta_x, ref.t_contact])
-    tol = _tol_ref(tau0, g)
     assert np.all(np.abs(got - want) < tol), (got - want)
     assert abs(out[OUT_U_MAX] - ref.u_max) < tol
 
 
 @pytest.mark.parametrize("scene", SCENES)
 def test_agrees_with_scipy_reference(scene):
-    _compare_with_reference(*scene)
+    # the oracle at rtol 1e-12 (error <= 1.6e-12 against rtol 1e-14 on these scenes:
+    # e_z, beta_x, t_contact, u_max), 1e-10 where the tolerance is 1e-9 (error 1.6e-11
+    # on the 3-arm scene with a dashpot): both 60x below the tolerance
+    _compare_with_reference(*scene, oracle_rtol=1e-10 if _tol_ref(*scene[:2]) >= 1e-9
+                            else 1e-12)
 
 
 def _random_scene(rng):
@@ -155,8 +159,8 @@ def test_random_scenes_agree_with_scipy_reference(seed):
 STIFF_RTOL_FACTOR = 100.0
 
 
-def _stiff_reference(tau0, g, tau, nu, mu_t):
-    ref = maxwell_continuum_reference(tau0, g, tau, kappa_of(nu), mu_t, rtol=1e-12,
+def _stiff_reference(tau0, g, tau, nu, mu_t, rtol=1e-12):
+    ref = maxwell_continuum_reference(tau0, g, tau, kappa_of(nu), mu_t, rtol=rtol,
                                       method="LSODA")
     return np.array([ref.e_z, ref.beta_x, ref.t_contact])
 
@@ -178,8 +182,8 @@ def _stiff_scene(rng):
     return tau0, g, tau, nu, mu_t
 
 
-def _check_stiff(scene, rtol=1e-8):
-    want = _stiff_reference(*scene)
+def _check_stiff(scene, rtol=1e-8, oracle_rtol=1e-12):
+    want = _stiff_reference(*scene, rtol=oracle_rtol)
     out = run(*scene, rtol=rtol)
     assert out[OUT_STATUS] == STATUS_OK
     err = np.abs(outputs(out) - want)
@@ -197,9 +201,16 @@ STIFF_SCENES = [
 ]
 
 
+#: The oracle's rtol for STIFF_SCENES: its error there, against LSODA at rtol 1e-13, is
+#: at most 3.0e-8 on e_z, beta_x, t_contact (1.7e-8, 3.0e-8, 5.9e-9 for the three
+#: scenes; 3.4e-9 at rtol 1e-10, 7e-11 at 1e-12), 33x below the tolerance
+#: STIFF_RTOL_FACTOR * 1e-8 = 1e-6 it is compared with, at 40 % of the cost of rtol 1e-12.
+STIFF_ORACLE_RTOL = 1e-9
+
+
 @pytest.mark.parametrize("scene", STIFF_SCENES)
 def test_stiff_arms_agree_with_implicit_scipy_reference(scene):
-    _check_stiff(scene)
+    _check_stiff(scene, oracle_rtol=STIFF_ORACLE_RTOL)
 
 
 @pytest.mark.slow

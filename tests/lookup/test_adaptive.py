@@ -47,6 +47,13 @@ def analytic():
     return build(5e-6)
 
 
+@pytest.fixture(scope="module")
+def coarse():
+    """The same function to 5e-4: 4,180 nodes on leaves of levels 3 to 6 (the 5e-6 tree:
+    43,675 on levels 4 to 8)."""
+    return build(5e-4)
+
+
 def random_points(n, seed):
     rng = np.random.default_rng(seed)
     lb = np.log(BOUNDS)
@@ -71,15 +78,34 @@ def test_refinement_meets_its_tolerance_at_points_it_never_used(analytic):
     assert len(levels) < 4 ** int(levels.max()) / 10
 
 
-def test_coarser_tolerance_gives_fewer_cells_and_larger_error(analytic):
+def test_coarser_tolerance_gives_fewer_cells_and_larger_error(analytic, coarse):
     fine, _ = analytic
-    coarse, report = build(5e-4)
+    coarse, report = coarse
     assert report["met"] and len(coarse.leaves) < len(fine.leaves)
     q1, q2, nu = random_points(50_000, seed=8)
     true = ridge(np.log(q1), np.log(q2), nu)[:, 0]
     e_fine = np.max(np.abs(fine({"Q1": q1, "Q2": q2, "nu": nu})["e_z"] - true))
     e_coarse = np.max(np.abs(coarse({"Q1": q1, "Q2": q2, "nu": nu})["e_z"] - true))
     assert e_coarse <= 1e-3 and e_fine < e_coarse / 10
+
+
+@pytest.mark.parametrize("kw", [{}, {"max_nodes": 1000}], ids=["max_level", "max_nodes"])
+def test_every_point_is_evaluated_once_and_kept_with_its_key(kw):
+    """The refinement's bookkeeping: no lattice point goes to ``evaluate`` twice, the
+    points of one call are distinct, and every returned value is ``evaluate``'s at the
+    returned key (also where ``max_nodes`` stops the refinement)."""
+    calls = []
+
+    def counted(keys):
+        calls.append(np.array(keys))
+        return evaluate(keys)
+
+    leaves, keys, values, report = refine_cells(counted, 2, len(NU), 1e-7, max_level=4, **kw)
+    asked = np.concatenate(calls)
+    assert len(np.unique(asked, axis=0)) == len(asked) == report["points"]
+    assert np.array_equal(values, evaluate(keys))
+    assert {tuple(key) for key in keys.tolist()} <= {tuple(key) for key in asked.tolist()}
+    assert report["met"] is False and len(leaves) > 16
 
 
 def test_lookup_reproduces_cubics_exactly():
@@ -135,10 +161,12 @@ def _as_table(grid, report):
                                    "grid_refinement": json.dumps(report)})
 
 
-def test_parquet_round_trip(analytic, tmp_path):
+def test_parquet_round_trip(coarse, tmp_path):
+    """Through a file and back, the lookups are bit for bit the grid's (on the coarser
+    tree: the round trip does not depend on the number of cells, its file is a tenth)."""
     from vimpact.tableformat.integrity import verify_table
 
-    grid, report = analytic
+    grid, report = coarse
     table = _as_table(grid, report)
     path = table.save(tmp_path / "adaptive.parquet")
     verify_table(path)  # page checksums, content and metadata hashes written
@@ -159,18 +187,18 @@ def test_parquet_round_trip(analytic, tmp_path):
         back.lookup(1.0, 0.3, Q2=1.0, method="linear")
 
 
-def test_damaged_structure_is_refused(analytic, tmp_path):
-    grid, report = analytic
+def test_damaged_structure_is_refused(coarse, tmp_path):
+    grid, report = coarse
     table = _as_table(grid, report)
     table.data = table.data.iloc[16:].reset_index(drop=True)  # a leaf node's rows gone
     with pytest.raises(InputError):
         table.lookup(1.0, 0.3, Q2=1.0)
 
 
-def test_info_of_a_damaged_adaptive_table_says_why(analytic):
+def test_info_of_a_damaged_adaptive_table_says_why(coarse):
     """The summary of a table whose cells cannot be rebuilt names the reason (with a
     recorded build too) instead of failing."""
-    grid, report = analytic
+    grid, report = coarse
     table = _as_table(grid, report)
     table.metadata["vimpact.build"] = json.dumps({"seconds": 1.0, "simulated": 10})
     table.data = table.data.iloc[16:].reset_index(drop=True)  # a leaf node's rows gone
@@ -223,8 +251,8 @@ def test_kelvin_voigt_build_against_direct_simulation(tmp_path):
     assert np.max(np.abs(look["beta_x"] - sim["beta_x"].to_numpy())) <= 1e-4
 
 
-def test_grid_only_views_are_refused_with_a_reason(analytic):
-    grid, report = analytic
+def test_grid_only_views_are_refused_with_a_reason(coarse):
+    grid, report = coarse
     table = _as_table(grid, report)
     with pytest.raises(InputError, match="adaptive table"):
         table.to_xarray()

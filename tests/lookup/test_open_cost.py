@@ -11,6 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from tests.lookup import shipped as open_shipped
 from vimpact.kernels.adaptive_lookup import adaptive_eval
 from vimpact.lookup.adaptive import _TICKS, AdaptiveGrid, _node_keys
 from vimpact.lookup.table import RestitutionTable
@@ -61,7 +62,7 @@ def grids(table: RestitutionTable) -> list[AdaptiveGrid]:
 @pytest.fixture(scope="module", params=ADAPTIVE)
 def shipped(request):
     """A shipped adaptive table's cells and the loops' arrays for them (made once)."""
-    table = RestitutionTable.open(TABLES / f"{request.param}.parquet")
+    table = open_shipped(request.param)
     grid = grids(table)[0]
     child, leaf = reference_tree(grid.leaves, grid.k)
     return table, grid, (child, leaf, reference_leaf_nodes(grid))

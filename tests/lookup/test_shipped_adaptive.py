@@ -6,15 +6,15 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from tests.lookup import shipped
+
 ROOT = Path(__file__).resolve().parents[2]
 TABLE = ROOT / "sweeps" / "tables" / "standard_solid_table.parquet"
 
 
 @pytest.fixture(scope="module")
 def table():
-    from vimpact.lookup.table import RestitutionTable
-
-    return RestitutionTable.open(TABLE)
+    return shipped(TABLE.stem)
 
 
 def test_covers_the_whole_range_and_states_its_error(table):
@@ -74,13 +74,12 @@ def test_the_shipped_band_meets_its_neighbours_within_their_bounds(table):
     stated bounds: the main table and the band at Q2 = 1e-3, the band and the
     Kelvin-Voigt table (plus the band's measured distance to that limit) at 1e-5."""
     from vimpact.lookup.band import BAND_FILE, KELVIN_VOIGT_FILE
-    from vimpact.lookup.table import RestitutionTable
 
     band_path = TABLE.parent / BAND_FILE
     if not band_path.is_file():
         pytest.skip("no band table beside the main one")
-    band = RestitutionTable.open(band_path)
-    kv = RestitutionTable.open(TABLE.parent / KELVIN_VOIGT_FILE)
+    band = shipped(band_path.stem)
+    kv = shipped(Path(KELVIN_VOIGT_FILE).stem)
     rng = np.random.default_rng(7)
     q1, nu = 10 ** rng.uniform(-3, 2, 300), rng.uniform(0, 0.5, 300)
     main_b, band_b, kv_b = table.error_bound(), band.error_bound(), kv.error_bound()
@@ -99,7 +98,6 @@ def test_info_names_the_table_that_answers_below(table):
     main table, the Kelvin-Voigt table (with the measured distance) below the band."""
     from vimpact.lookup.band import BAND_FILE, KELVIN_VOIGT_FILE
     from vimpact.lookup.info import format_info
-    from vimpact.lookup.table import RestitutionTable
 
     band_path = TABLE.parent / BAND_FILE
     if not band_path.is_file():
@@ -108,8 +106,8 @@ def test_info_names_the_table_that_answers_below(table):
     below = table.info()["below"]
     assert below["file"] == BAND_FILE and below["Q2"] == pytest.approx(1e-3)
     assert f"Q2 < 0.001: {BAND_FILE} beside it answers" in format_info(table.info())
-    band = RestitutionTable.open(band_path).info()
+    band = shipped(band_path.stem).info()
     assert band["below"]["file"] == KELVIN_VOIGT_FILE and band["below"]["Q2"] == pytest.approx(1e-5)
     assert 0.0 < band["below"]["limit_distance"]["beta_x"] < 1e-5
-    kv = RestitutionTable.open(TABLE.parent / KELVIN_VOIGT_FILE)
+    kv = shipped(Path(KELVIN_VOIGT_FILE).stem)
     assert kv.info()["below"] is None

@@ -21,6 +21,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from tests.lookup import shipped
+
 ROOT = Path(__file__).resolve().parents[2]
 SHIPPED = ("kelvin_voigt_table", "standard_solid_table", "standard_solid_band")
 #: Set to True once the shipped tables are regenerated; then this guard is live.
@@ -30,13 +32,12 @@ NODE_TOLERANCE = 1e-6
 
 
 def _stale_reasons(name: str) -> list[str]:
-    from vimpact.lookup.table import RestitutionTable
     from vimpact.sweep import load_spec
     from vimpact.tablebuild.verify import numerics_of, simulate_dimensionless
     from vimpact.tableformat.schema import SCHEMA_VERSION
 
     spec_path = ROOT / "sweeps" / f"{name}.toml"
-    table = RestitutionTable.open(ROOT / "sweeps" / "tables" / f"{name}.parquet")
+    table = shipped(name)
     model = table.model
     spec = load_spec(spec_path)
     reasons = []

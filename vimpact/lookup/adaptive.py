@@ -487,31 +487,50 @@ def refine_cells(evaluate: Callable[[np.ndarray], np.ndarray], k: int, n_tensor:
                          f"0 <= min_level <= max_level <= {LATTICE_LEVEL - 1}")
     start = time.perf_counter()
     _, W = check_points(k)
-    known: dict[tuple, int] = {}
+    # the points evaluated so far: packed lattice keys (:func:`_packed`), sorted, and
+    # the row of each in the blocks of values
+    known_keys = np.zeros(0, dtype=np.uint64)
+    known_rows = np.zeros(0, dtype=np.int64)
     blocks: list[np.ndarray] = []
 
-    def fetch(keys: np.ndarray) -> np.ndarray:
+    def lookup(keys: np.ndarray):
+        """Return the unique packed keys of ``keys`` and where they are.
+
+        With ``first`` (first appearance of each), ``inverse`` (back to every key)
+        and the row of each in the values (``-1``: not yet evaluated).
+        """
         flat = keys.reshape(-1, k)
-        tuples = list(map(tuple, flat.tolist()))
-        new, seen = [], set()
-        for t in tuples:
-            if t not in known and t not in seen:
-                seen.add(t)
-                new.append(t)
-        if new:
-            vals = np.asarray(evaluate(np.array(new, dtype=np.int64).reshape(-1, k)), float)
+        packed = _packed(flat)
+        assert packed is not None  # k <= 2 and a cell's points lie on the lattice
+        unique, first, inverse = np.unique(packed, return_index=True, return_inverse=True)
+        rows = np.full(len(unique), -1, dtype=np.int64)
+        if len(known_keys):
+            at = np.minimum(np.searchsorted(known_keys, unique), len(known_keys) - 1)
+            hit = known_keys[at] == unique
+            rows[hit] = known_rows[at[hit]]
+        return flat, unique, first, inverse.ravel(), rows
+
+    def fetch(keys: np.ndarray) -> np.ndarray:
+        nonlocal known_keys, known_rows
+        flat, unique, first, inverse, rows = lookup(keys)
+        new = np.flatnonzero(rows < 0)
+        if len(new):
+            new = new[np.argsort(first[new], kind="stable")]  # in order of first appearance
+            vals = np.asarray(evaluate(flat[first[new]]), float)
             base = sum(len(b) for b in blocks)
             blocks.append(vals)
-            for j, t in enumerate(new):
-                known[t] = base + j
+            rows[new] = base + np.arange(len(new))
+            merged = np.concatenate([known_keys, unique[new]])
+            order = np.argsort(merged, kind="stable")
+            known_keys = merged[order]
+            known_rows = np.concatenate([known_rows, rows[new]])[order]
         allv = np.concatenate(blocks) if len(blocks) > 1 else blocks[0]
         if len(blocks) > 1:
             blocks[:] = [allv]
-        rows = np.array([known[t] for t in tuples], dtype=np.int64)
-        return allv[rows].reshape(keys.shape[:-1] + allv.shape[1:])
+        return allv[rows[inverse]].reshape(keys.shape[:-1] + allv.shape[1:])
 
     def count_new(keys: np.ndarray) -> int:
-        return len({t for t in map(tuple, keys.reshape(-1, k).tolist()) if t not in known})
+        return int(np.sum(lookup(keys)[4] < 0))
 
     active = _local(k, list(range(2**min_level)))  # index along axis 0 fastest
     level = min_level
@@ -525,9 +544,9 @@ def refine_cells(evaluate: Callable[[np.ndarray], np.ndarray], k: int, n_tensor:
         nk, ck = _node_keys(lv, active), _check_keys(lv, active)
         n_new = count_new(np.concatenate([nk.reshape(-1, k), ck.reshape(-1, k)]))
         late = max_seconds is not None and time.perf_counter() - start > max_seconds
-        if late or len(known) + n_new > max_nodes:
+        if late or len(known_keys) + n_new > max_nodes:
             stopped = (f"max_seconds ({max_seconds:g} s) at level {level}" if late else
-                       f"max_nodes ({len(known) + n_new} > {max_nodes}) at level {level}")
+                       f"max_nodes ({len(known_keys) + n_new} > {max_nodes}) at level {level}")
             # no room to check these cells: they stay leaves with unknown error
             fetch(nk)
             for idx in active:
@@ -564,7 +583,7 @@ def refine_cells(evaluate: Callable[[np.ndarray], np.ndarray], k: int, n_tensor:
         levels.append(entry)
         if progress is not None:
             progress(f"level {level}: {len(active)} cells, {n_new} new points "
-                     f"({len(known)} in all), {entry['split']} split, largest check error "
+                     f"({len(known_keys)} in all), {entry['split']} split, largest check error "
                      + (f"{entry['max_error']:.2g}" if entry["max_error"] is not None else "-")
                      + f", {time.perf_counter() - start:.0f} s")
         if final:
@@ -579,12 +598,12 @@ def refine_cells(evaluate: Callable[[np.ndarray], np.ndarray], k: int, n_tensor:
         active = np.concatenate(kids)
         level += 1
     leaves_arr = np.array(leaves, dtype=np.int64).reshape(-1, 1 + k)
-    leaf_keys = np.unique(_node_keys(leaves_arr[:, 0], leaves_arr[:, 1:]).reshape(-1, k), axis=0)
+    leaf_keys = _unique_keys(_node_keys(leaves_arr[:, 0], leaves_arr[:, 1:]).reshape(-1, k))[0]
     values = fetch(leaf_keys)
     over = [u for u in unmet if u["error"] is None or u["error"] > tolerance]
     report = {"tolerance": float(tolerance), "met": not over and stopped == "met",
               "stopped": stopped, "levels": levels, "unmet": over,
               "max_leaf_error": max_leaf if math.isfinite(max_leaf) else None,
-              "leaves": int(len(leaves_arr)), "points": int(len(known)),
+              "leaves": int(len(leaves_arr)), "points": int(len(known_keys)),
               "seconds": round(time.perf_counter() - start, 1)}
     return leaves_arr, leaf_keys, values, report

@@ -364,22 +364,26 @@ def naive_impact(scene, steps, elements, row_width=1.05, max_time=100.0, mu=None
         gain = w_sphere - w_relaxed
         theta[entering] = gain[entering] / (gain[entering] + (w0 - w_sphere_old)[entering])
         # entering elements ramp from the relaxed surface to the sphere over theta h
-        arms_theta = arm_update_coefficients(rheo.tau[None, :], (theta[entering] * h)[:, None])
         # normal force at the moment of entry (relaxed surface, dashpot at v_z then)
         f_entry = np.zeros(n)
-        v_entry = v_z_start + 2.0 * (1.0 - theta) * (v_z_half - v_z_start)
-        f_entry[entering] = c_n * weight * (rheo.spring_stress(w_relaxed[entering], q[entering])
-                                            + rheo.eta0 * v_entry[entering])
         # with arms: the force over the entering part is the relaxed spring and the
         # dashpot on a line, plus the arms' exact mean stress on the ramp
         f_entry_lin = np.zeros(n)
         arm_mean = np.zeros(n)
-        if implicit:
-            f_entry_lin[entering] = c_n * weight * (rheo.G_inf * w_relaxed[entering]
-                                                    + rheo.eta0 * v_entry[entering])
-            arm_mean[entering] = c_n * weight * rheo.arm_mean_stress(
-                w_relaxed[entering], w_sphere[entering], q[entering], theta[entering] * h)
-        q[entering] = advance_arms(q[entering], w_relaxed[entering], w_sphere[entering], arms_theta)
+        if entering.any():  # (on most steps no element enters)
+            arms_theta = arm_update_coefficients(rheo.tau[None, :],
+                                                 (theta[entering] * h)[:, None])
+            v_entry = v_z_start + 2.0 * (1.0 - theta) * (v_z_half - v_z_start)
+            f_entry[entering] = c_n * weight * (rheo.spring_stress(w_relaxed[entering],
+                                                                   q[entering])
+                                                + rheo.eta0 * v_entry[entering])
+            if implicit:
+                f_entry_lin[entering] = c_n * weight * (rheo.G_inf * w_relaxed[entering]
+                                                        + rheo.eta0 * v_entry[entering])
+                arm_mean[entering] = c_n * weight * rheo.arm_mean_stress(
+                    w_relaxed[entering], w_sphere[entering], q[entering], theta[entering] * h)
+            q[entering] = advance_arms(q[entering], w_relaxed[entering], w_sphere[entering],
+                                       arms_theta)
 
         touching = was_in | entering
         w[touching] = w_sphere[touching]
@@ -458,21 +462,24 @@ def naive_impact(scene, steps, elements, row_width=1.05, max_time=100.0, mu=None
         else:  # incremental: only the displacement since entering loads an element
             s_new = s + du_c * theta  # theta = 1 for elements that were in contact
         stay = now_in & was_in
-        arms_new = arm_update_coefficients(rheo.tau[None, :], (theta[new] * h)[:, None])
+        entered = new.any()
         arm_mean_t = np.zeros(n)
-        if implicit and memory != "seed":  # entering: the arms' exact mean
+        if entered and implicit and memory != "seed":  # entering: the arms' exact mean
             arm_mean_t[new] = c_t * weight * rheo.arm_mean_stress(
                 s_start[new], s_new[new], p_start[new], theta[new] * h)
         p[stay] = advance_arms(p_start[stay], s_start[stay], s_new[stay], arms_h)
-        p[new] = advance_arms(p_start[new], s_start[new], s_new[new], arms_new)
+        if entered:
+            arms_new = arm_update_coefficients(rheo.tau[None, :], (theta[new] * h)[:, None])
+            p[new] = advance_arms(p_start[new], s_start[new], s_new[new], arms_new)
         s[now_in] = s_new[now_in]
         t_spring = np.zeros(n)  # tangential force without the dashpot, N
         t_spring[now_in] = c_t * weight * rheo.spring_stress(s[now_in], p[now_in])
         f_t = t_spring + c_t * weight * rheo.eta0 * v_c_half  # stick trial as applied, N
         v_c_entry = v_c_start + 2.0 * (1.0 - theta) * (v_c_half - v_c_start)
         ft_entry = np.zeros(n)
-        ft_entry[new] = c_t * weight * (rheo.spring_stress(s_start[new], p_start[new])
-                                        + rheo.eta0 * v_c_entry[new])
+        if entered:
+            ft_entry[new] = c_t * weight * (rheo.spring_stress(s_start[new], p_start[new])
+                                            + rheo.eta0 * v_c_entry[new])
         ft_end = t_spring + c_t * weight * rheo.eta0 * v_c_end_step
         if memory == "seed":  # the element jumps to the total displacement at entry
             ft_entry[new] = ft_end[new]
@@ -481,7 +488,7 @@ def naive_impact(scene, steps, elements, row_width=1.05, max_time=100.0, mu=None
             slip = now_in & (np.abs(f_t) > mu * force)
             cone_entry = mu * np.maximum(f_entry[new], 0.0)
             ft_entry[new] = np.clip(ft_entry[new], -cone_entry, cone_entry)
-        if implicit and memory != "seed":  # the arms at their exact mean over the entering part
+        if entered and implicit and memory != "seed":  # the arms' exact mean over entering
             arms_entry = rheo.spring_stress(s_start[new], p_start[new]) - rheo.G_inf * s_start[new]
             arms_end = rheo.spring_stress(s[new], p[new]) - rheo.G_inf * s[new]
             ft_entry[new] += 2.0 * arm_mean_t[new] - c_t * weight * (arms_entry + arms_end)
