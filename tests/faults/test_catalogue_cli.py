@@ -5,8 +5,8 @@ names the option as the user typed it and the value (no traceback, nothing on
 stdout). Extreme inputs that are admissible end with exit code 0 and a status
 that says what happened, never a wrong number reported as ``ok``.
 
-The cases run in-process (``vimpact.cli.main.main``) for speed; a few run
-through ``python -m vimpact.cli`` to prove the real entry point.
+The cases run in-process (``vimpact.cli.main.main``) for speed; two run
+through ``python -m vimpact`` and ``python -m vimpact.cli`` to prove the real entry points.
 """
 
 from __future__ import annotations
@@ -308,13 +308,16 @@ def test_largest_admissible_dashpot_is_fully_damped(capsys):
 
 # the two ways a bad input leaves: a refusal that main returns, after arithmetic that overflows
 # (a warning would be a second line in a real process), and argparse's own exit inside main
-# (the catalogue above runs steps-1e9 and every other case in-process)
-@pytest.mark.parametrize("args, names", [
-    pytest.param(with_value(PHYS, "--vz0", "1e200"), ["--vz0 = 1e+200"], id="vz0-1e200"),
-    pytest.param(with_value(PHYS, "--E", ""), ["--E", "''"], id="E-empty"),
+# (the catalogue above runs steps-1e9 and every other case in-process); one through each of
+# the two ``__main__`` modules (``python -m vimpact.cli`` with an exit code that main returns:
+# tests/cli/test_main_module.py)
+@pytest.mark.parametrize("module, args, names", [
+    pytest.param("vimpact", with_value(PHYS, "--vz0", "1e200"), ["--vz0 = 1e+200"],
+                 id="vz0-1e200"),
+    pytest.param("vimpact.cli", with_value(PHYS, "--E", ""), ["--E", "''"], id="E-empty"),
 ])
-def test_installed_entry_point(args, names):
-    proc = subprocess.run([sys.executable, "-m", "vimpact.cli", "simulate", *args],
+def test_installed_entry_point(module, args, names):
+    proc = subprocess.run([sys.executable, "-m", module, "simulate", *args],
                           capture_output=True, text=True, timeout=600)
     assert_one_line_error(proc.returncode, proc.stdout, proc.stderr, *names)
 
