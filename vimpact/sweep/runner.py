@@ -104,8 +104,14 @@ def run_batch(spec: SweepSpec, scene_cols: dict, timings: dict | None = None) ->
             timings["total_s"] = timings.get("total_s", 0.0) + time.perf_counter() - t0
 
 
-def compute_chunk(spec: SweepSpec, chunk: int, timings: dict | None = None):
+def compute_chunk(spec: SweepSpec, chunk: int, timings: dict | None = None,
+                  part: tuple[int, int] | None = None, params: dict | None = None):
     """Simulate the rows of ``chunk`` and return them as a ``pyarrow`` table.
+
+    ``part``: ``(lo, hi)``, only the chunk's rows ``lo`` to ``hi - 1`` (counted from its
+    first row): the same rows as the whole chunk's table has there (a row's results do
+    not depend on the other rows). ``params``: the chunk's parameter sets
+    (:meth:`~vimpact.sweep.spec.SweepSpec.chunk_parameters`, made once for its parts).
 
     Columnar: the chunk's parameters (:mod:`vimpact.sweep.parameters`) become scene
     columns of the engine (:func:`run_batch`: what :func:`vimpact.simulate_batch` runs,
@@ -123,8 +129,17 @@ def compute_chunk(spec: SweepSpec, chunk: int, timings: dict | None = None):
     from vimpact.sweep.parameters import engine_columns
 
     start, stop = spec.chunk_rows(chunk)
+    if params is None:
+        params = spec.chunk_parameters(chunk)
+    if part is not None:
+        lo, hi = part
+        if not 0 <= lo < hi <= stop - start:
+            raise ValueError(f"part = {part!r} is not allowed: must be rows (lo, hi) with "
+                             f"0 <= lo < hi <= {stop - start} of chunk {chunk}")
+        views: dict[int, np.ndarray] = {}  # one array of several inputs: one view of it
+        params = {k: views.setdefault(id(v), v[lo:hi]) for k, v in params.items()}
+        start, stop = start + lo, start + hi
     n = stop - start
-    params = spec.chunk_parameters(chunk)
     batches, inputs = engine_columns(spec, params)
     outputs = RESULTS | (ADHESION_RESULTS if spec.has_adhesion else {})
     cols: dict[str, np.ndarray] = {"row": np.arange(start, stop, dtype=np.int64)}
@@ -540,6 +555,11 @@ def _run(spec, spec_path, out, parts, resume, progress, workers, scheduler, shar
                 fresh = []
             if spec.n_chunks > 1 or fresh is None:
                 parts.mkdir(parents=True, exist_ok=True)
+            if fresh is not None and spec.n_chunks == 1 and spec.rows > files.ROW_GROUP_ROWS:
+                # one chunk of several row groups: each written while the next is computed
+                _stream_one_chunk(spec, parts, out, log, stages, bar, timings)
+                todo = []
+                finished = True
             for chunk in todo:
                 table = compute_chunk(spec, chunk, timings)
                 summary = chunk_summary(table)
@@ -556,6 +576,9 @@ def _run(spec, spec_path, out, parts, resume, progress, workers, scheduler, shar
                 _timed(timings, "write_s", t0)
                 start, stop = spec.chunk_rows(chunk)
                 bar.update(stop - start)
+        if finished:  # (streamed: the table is written)
+            bar.close()
+            return out
         finished = True
         bar.close()
         if shard is not None:
@@ -573,6 +596,40 @@ def _run(spec, spec_path, out, parts, resume, progress, workers, scheduler, shar
     return out
 
 
+def _stream_one_chunk(spec: SweepSpec, parts: Path, out: Path, log, stages: SweepStages,
+                      bar: Progress, timings: dict | None) -> None:
+    """Compute the one chunk of a file-layout sweep in row groups, writing each under the next.
+
+    The chunk's rows in pieces of :data:`~vimpact.tableformat.files.ROW_GROUP_ROWS`
+    (:func:`compute_chunk` ``part``), each hashed and encoded into the table on a
+    thread of its own while the next is computed (:func:`vimpact.sweep.store.combine`
+    ``pieces``): the same table, byte for byte, as written from the whole chunk. No
+    part: an interruption keeps nothing, as for one chunk written whole. ``timings``:
+    ``write_s`` is the time spent writing that the computation did not cover.
+    """
+    start, stop = spec.chunk_rows(0)
+    inside = 0.0  # s computing the pieces (within the write's time)
+
+    def pieces():
+        nonlocal inside
+        t0 = time.perf_counter()
+        params = spec.chunk_parameters(0)
+        size = files.ROW_GROUP_ROWS
+        for lo in range(0, stop - start, size):
+            hi = min(stop - start, lo + size)
+            table = compute_chunk(spec, 0, timings, (lo, hi), params)
+            summary = chunk_summary(table)
+            inside += time.perf_counter() - t0
+            yield table, summary
+            bar.update(hi - lo)
+            t0 = time.perf_counter()
+
+    t0 = time.perf_counter()
+    _combine(spec, parts, out, log, stages, pieces=pieces())
+    if timings is not None:
+        timings["write_s"] = timings.get("write_s", 0.0) + time.perf_counter() - t0 - inside
+
+
 def _timed(timings: dict | None, key: str, t0: float) -> None:
     """Add the seconds since ``t0`` to ``timings[key]`` (if ``timings`` is a dict)."""
     if timings is not None:
@@ -580,12 +637,13 @@ def _timed(timings: dict | None, key: str, t0: float) -> None:
 
 
 def _combine(spec: SweepSpec, parts: Path, out: Path, log, stages: SweepStages,
-             fresh=None, fresh_digest: str | None = None) -> None:
+             fresh=None, fresh_digest: str | None = None, pieces=None) -> None:
     """Run :func:`vimpact.sweep.store.combine`, then ``stages.finish``.
 
     ``fresh``: the ``(table, summary)`` of every chunk, computed in this process:
     the table is written from them (:func:`vimpact.sweep.store.combine`), with the
-    content hash ``fresh_digest`` of their rows.
+    content hash ``fresh_digest`` of their rows. ``pieces``: the ``(table, summary)``
+    of the row groups of a one-chunk sweep, computed as they are asked for.
 
     The stages' own files
     (``stages.kept``) leave the parts directory first (the directory must hold only
@@ -600,7 +658,7 @@ def _combine(spec: SweepSpec, parts: Path, out: Path, log, stages: SweepStages,
             kept.unlink()
     try:
         store.combine(spec, parts, out, lambda first: explain_paths(spec, first), fresh,
-                      fresh_digest)
+                      fresh_digest, pieces)
     except BaseException:
         if Path(parts).is_dir():
             for name, text in saved.items():
