@@ -15,7 +15,14 @@ import pytest
 from tests.oracles.content_hash import definition_hash
 from tests.sweep import write
 from tests.sweep.faults import FullDisk
-from vimpact.sweep import SweepInterrupted, parts_dir, read_metadata, run_sweep, runner
+from vimpact.sweep import (
+    SweepInterrupted,
+    load_spec,
+    parts_dir,
+    read_metadata,
+    run_sweep,
+    runner,
+)
 from vimpact.tableformat import files
 from vimpact.tableformat.integrity import verify_table
 
@@ -177,3 +184,10 @@ def test_disk_full_while_streaming_keeps_nothing(monkeypatch, tmp_path):
     with pytest.raises(OSError, match="nothing is kept"):
         run_sweep(spec, out=out, progress=False)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["spec.toml"]
+
+
+def test_a_part_of_a_chunk_outside_it_is_refused(tmp_path):
+    spec = load_spec(write(tmp_path, GRID.format(tangential="none")))
+    for part in ((0, 0), (5, 4), (-1, 3), (20, 25)):
+        with pytest.raises(ValueError, match=r"part = .* is not allowed: must be rows"):
+            runner.compute_chunk(spec, 0, None, part)

@@ -420,7 +420,9 @@ def run_sweep(spec_path, out=None, resume: bool = False,
         parts. Without it, existing parts are an error.
     progress : ``None`` (default) a bar on a terminal, a line every ~10 s otherwise
         (:mod:`vimpact.sweep.progress`); a callable is called as
-        ``progress(rows_done, rows_total)`` after every chunk; ``False`` nothing.
+        ``progress(rows_done, rows_total)`` after every chunk (a sweep of one chunk
+        of more than :data:`~vimpact.tableformat.files.ROW_GROUP_ROWS` rows: after
+        every row group of it); ``False`` nothing.
     workers : run the chunks as tasks on a new Dask ``LocalCluster`` of this many
         single-threaded worker processes
     scheduler : address of a running Dask scheduler to run the chunks on

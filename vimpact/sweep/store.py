@@ -13,9 +13,13 @@ Layouts (``layout`` in the spec; ``"auto"``: a file up to
   and ``vimpact table`` read it directly.
 
 Memory is bounded by the chunk size in both layouts: a part is written as it
-is finished, and the file layout is combined one part (one row group) at a time
+is finished, and the file layout is combined one part at a time
 (a table of at most :data:`HOLD_ROWS` rows, no more than the largest chunk the
 runner chooses, is held whole between the check of its parts and its write).
+Row groups: :data:`~vimpact.tableformat.files.ROW_GROUP_ROWS` rows each from the
+first row of each part (one for a part of at most that many rows), in a part and in
+the table alike; a one-chunk sweep's table is written one row group at a time while
+the next is computed (:func:`_write_streamed`), the same bytes as written whole.
 
 Every write is atomic (a temporary file in the same directory, fsync,
 ``os.replace``, fsync of the directory), so a run killed anywhere (kill -9)
@@ -407,7 +411,8 @@ def combine(spec, parts: Path, out: Path, explain_paths, fresh=None,
         _check_written(out / COMMON_METADATA, parts, spec.rows, digest)
         return
     meta = encode_metadata({**spec.metadata(), "paths": paths})
-    # one row group per part, read one at a time: memory bounded by the chunk size
+    # a part's row groups (ROW_GROUP_ROWS rows from its first row), one part read at a
+    # time: memory bounded by the chunk size
 
     def read(chunk):
         if held is not None:  # read for its check

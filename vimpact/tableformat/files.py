@@ -294,9 +294,9 @@ class TableStream:
     """Write a table atomically from its row groups as they are made (a context manager).
 
     ``add(piece)`` hands one row group (a ``pyarrow`` table of ``schema``'s columns, at
-    most :data:`ROW_GROUP_ROWS` rows; every piece but the last exactly that many) to a
-    thread of its own that hashes it (:class:`ContentHash`) and encodes it into the file,
-    and returns once the piece before it is written: the caller computes the next piece
+    most :data:`ROW_GROUP_ROWS` rows; every piece but the last exactly that many) to two
+    threads of its own, one hashes it (:class:`ContentHash`), one encodes it into the
+    file, and returns once the piece before it is written: the caller computes the next piece
     while this one is written (at most one piece waits). ``finish(metadata)`` writes the
     footer with the table's key-value ``metadata``, the content hash of all the pieces
     and the metadata hash (:func:`_footer`) and returns the content hash; the file then
@@ -310,7 +310,7 @@ class TableStream:
         self.path, self.schema = Path(path), schema.remove_metadata()
         self.hasher = ContentHash()
         self.rows = 0
-        self._pending = None
+        self._pending: list = []  # the hash and the write of the last piece added
         self._finished: str | None = None
 
     def __enter__(self) -> TableStream:
@@ -323,7 +323,7 @@ class TableStream:
             self._file = self._stack.enter_context(atomic_file(self.path, str(self.path)))
             self._writer = pq.ParquetWriter(self._file, self.schema, store_schema=False,
                                             **parquet_options(self.schema))
-            self._pool = self._stack.enter_context(ThreadPoolExecutor(1))
+            self._pool = self._stack.enter_context(ThreadPoolExecutor(2))
         except OSError as exc:
             self._stack.__exit__(type(exc), exc, exc.__traceback__)
             raise self._named(exc) from exc
@@ -336,14 +336,13 @@ class TableStream:
         return OSError(exc.errno, f"{exc.strerror or first_line(exc)} while writing "
                        f"{self.path}")
 
-    def _write(self, piece) -> None:
-        self.hasher.update(piece)
-        _detached(self._writer.write_table, piece, row_group_size=ROW_GROUP_ROWS)
-
     def _wait(self) -> None:
-        pending, self._pending = self._pending, None
-        if pending is not None:
-            pending.result()
+        from concurrent.futures import wait
+
+        pending, self._pending = self._pending, []
+        wait(pending)  # both done before an error of either is raised
+        for job in pending:
+            job.result()
 
     def add(self, piece) -> None:
         """Write ``piece`` (the next rows) on the writer thread once the one before is written."""
@@ -359,7 +358,11 @@ class TableStream:
         except OSError as exc:
             raise self._named(exc) from exc
         self.rows += piece.num_rows
-        self._pending = self._pool.submit(self._write, piece)
+        # side by side: the streams of the content hash (one thread: beside the
+        # computation of the next piece) and the Parquet pages
+        self._pending = [self._pool.submit(self.hasher.update, piece, threads=1),
+                         self._pool.submit(_detached, self._writer.write_table, piece,
+                                           row_group_size=ROW_GROUP_ROWS)]
 
     def finish(self, metadata) -> str:
         """Write the footer with ``metadata`` and the hashes; return the content hash."""
@@ -374,12 +377,12 @@ class TableStream:
         return digest
 
     def __exit__(self, kind, exc, tb) -> None:
-        if self._pending is not None:  # an error or an interruption in the block
+        for job in self._pending:  # an error or an interruption in the block
             try:
-                self._pending.result()
+                job.result()
             except BaseException:  # noqa: BLE001 - the block's own error is raised
                 pass
-            self._pending = None
+        self._pending = []
         if self._finished is None:
             # released here, not by a later garbage collection (the error's traceback
             # holds this stream): a writer whose close failed reports it again when freed
