@@ -7,6 +7,9 @@ groups, metadata and content hash, :mod:`tests.oracles.content_hash` row by row)
 interruption between pieces must leave nothing behind.
 """
 
+import threading
+import time
+
 import numpy as np
 import pyarrow as pa
 import pyarrow.parquet as pq
@@ -191,3 +194,44 @@ def test_a_part_of_a_chunk_outside_it_is_refused(tmp_path):
     for part in ((0, 0), (5, 4), (-1, 3), (20, 25)):
         with pytest.raises(ValueError, match=r"part = .* is not allowed: must be rows"):
             runner.compute_chunk(spec, 0, None, part)
+
+
+@pytest.mark.parametrize("threads", [1, 2])
+def test_pieces_share_the_numba_threads(monkeypatch, tmp_path, threads):
+    """On two numba threads two pieces run side by side, one thread each (once the
+    threading layer takes launches from two threads); on one thread, one at a time."""
+    import numba
+
+    if numba.config.NUMBA_NUM_THREADS < 2:  # type: ignore[attr-defined]
+        pytest.skip("one numba thread on this machine")
+    spec = write(tmp_path, GRID.format(tangential="none"))
+    run_sweep(spec, out=tmp_path / "warm.parquet", progress=False)  # a parallel launch
+    if not runner._launches_side_by_side():
+        pytest.skip(f"numba's {numba.threading_layer()} layer: one launch at a time")
+    _pieces(monkeypatch)
+    real, lock = runner.compute_chunk, threading.Lock()
+    active, most, used = [0], [0], []
+
+    def counted(*args):
+        with lock:
+            active[0] += 1
+            most[0] = max(most[0], active[0])
+            used.append(numba.get_num_threads())
+        try:
+            time.sleep(0.05)  # long enough for the next piece to start beside it
+            return real(*args)
+        finally:
+            with lock:
+                active[0] -= 1
+
+    monkeypatch.setattr(runner, "compute_chunk", counted)
+    before = numba.get_num_threads()
+    numba.set_num_threads(threads)
+    try:
+        out = run_sweep(spec, out=tmp_path / "t.parquet", progress=False)
+    finally:
+        numba.set_num_threads(before)
+    assert len(used) == 5 and most[0] == threads
+    assert set(used) == {1}
+    whole = read_metadata(tmp_path / "warm.parquet")  # (one row group)
+    assert read_metadata(out)["content_sha256"] == whole["content_sha256"]

@@ -598,38 +598,95 @@ def _run(spec, spec_path, out, parts, resume, progress, workers, scheduler, shar
     return out
 
 
+#: Row groups of a streamed chunk computed at once at most (:func:`_stream_one_chunk`):
+#: while one is in the kernels (which release the GIL), the other's Python (validation,
+#: results, its table) runs, and their kernels fill each other's idle threads.
+PIECES_IN_FLIGHT = 2
+#: numba threading layers that take parallel launches from several threads at once
+#: (the workqueue layer aborts the process on one).
+CONCURRENT_LAYERS = ("tbb", "omp")
+
+
+def _launches_side_by_side() -> bool:
+    """Whether numba's threading layer takes parallel launches from two threads at once.
+
+    Unknown before this process's first parallel launch: ``False`` then.
+    """
+    import numba
+
+    try:
+        return numba.threading_layer() in CONCURRENT_LAYERS
+    except ValueError:  # no parallel launch yet: the layer is not chosen
+        return False
+
+
 def _stream_one_chunk(spec: SweepSpec, parts: Path, out: Path, log, stages: SweepStages,
                       bar: Progress, timings: dict | None) -> None:
     """Compute the one chunk of a file-layout sweep in row groups, writing each under the next.
 
     The chunk's rows in pieces of :data:`~vimpact.tableformat.files.ROW_GROUP_ROWS`
-    (:func:`compute_chunk` ``part``), each hashed and encoded into the table on a
-    thread of its own while the next is computed (:func:`vimpact.sweep.store.combine`
-    ``pieces``): the same table, byte for byte, as written from the whole chunk. No
-    part: an interruption keeps nothing, as for one chunk written whole. ``timings``:
-    ``write_s`` is the time spent writing that the computation did not cover.
+    (:func:`compute_chunk` ``part``), :data:`PIECES_IN_FLIGHT` at a time on threads of
+    their own (one, until numba's threading layer is known to take launches from several
+    threads, :data:`CONCURRENT_LAYERS`, and with one numba thread), sharing this
+    thread's numba threads (two pieces on two threads: one each, so that neither waits
+    at the end of a launch for the other thread's last rows); each piece, in row order,
+    is hashed and encoded into the table on other threads while the next ones are
+    computed (:func:`vimpact.sweep.store.combine` ``pieces``): the same
+    table, byte for byte, as written from the whole chunk. No part: an interruption
+    keeps nothing, as for one chunk written whole (the pieces in flight are finished
+    first). ``timings``: ``kernel_s`` and ``total_s`` summed over the pieces (pieces
+    side by side: more than the wall time they took); ``pieces_wall_s`` the wall time
+    spent waiting for the pieces (with their tables); ``write_s`` the time spent writing
+    that the computation did not cover.
     """
-    start, stop = spec.chunk_rows(0)
-    inside = 0.0  # s computing the pieces (within the write's time)
+    from collections import deque
+    from concurrent.futures import ThreadPoolExecutor
 
-    def pieces():
+    import numba
+
+    start, stop = spec.chunk_rows(0)
+    size = files.ROW_GROUP_ROWS
+    bounds = [(lo, min(stop - start, lo + size)) for lo in range(0, stop - start, size)]
+    threads = numba.get_num_threads()  # (numba's count is per Python thread)
+    inside = 0.0  # s computing the pieces (within the write's time)
+    params = spec.chunk_parameters(0)
+
+    def piece(lo: int, hi: int, own_threads: int):
+        numba.set_num_threads(own_threads)
+        own: dict = {}
+        table = compute_chunk(spec, 0, own, (lo, hi), params)
+        return table, chunk_summary(table), own
+
+    def pieces(pool):
         nonlocal inside
         t0 = time.perf_counter()
-        params = spec.chunk_parameters(0)
-        size = files.ROW_GROUP_ROWS
-        for lo in range(0, stop - start, size):
-            hi = min(stop - start, lo + size)
-            table = compute_chunk(spec, 0, timings, (lo, hi), params)
-            summary = chunk_summary(table)
+        todo = deque(bounds)
+        running: deque = deque()
+        while todo or running:
+            limit = min(PIECES_IN_FLIGHT, threads) if _launches_side_by_side() else 1
+            while todo and len(running) < limit:  # the threads shared between the pieces
+                running.append((todo[0], pool.submit(piece, *todo.popleft(),
+                                                     max(1, threads // limit))))
+            (lo, hi), future = running.popleft()
+            table, summary, own = future.result()
+            for key, value in own.items():
+                if timings is not None:
+                    timings[key] = timings.get(key, 0.0) + value
             inside += time.perf_counter() - t0
             yield table, summary
             bar.update(hi - lo)
             t0 = time.perf_counter()
 
     t0 = time.perf_counter()
-    _combine(spec, parts, out, log, stages, pieces=pieces())
+    with ThreadPoolExecutor(PIECES_IN_FLIGHT) as pool:
+        made = pieces(pool)
+        try:
+            _combine(spec, parts, out, log, stages, pieces=made)
+        finally:
+            made.close()  # (an error or an interruption: no piece is started after it)
     if timings is not None:
         timings["write_s"] = timings.get("write_s", 0.0) + time.perf_counter() - t0 - inside
+        timings["pieces_wall_s"] = timings.get("pieces_wall_s", 0.0) + inside
 
 
 def _timed(timings: dict | None, key: str, t0: float) -> None:
