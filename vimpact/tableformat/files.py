@@ -295,9 +295,11 @@ class TableStream:
 
     ``add(piece)`` hands one row group (a ``pyarrow`` table of ``schema``'s columns, at
     most :data:`ROW_GROUP_ROWS` rows; every piece but the last exactly that many) to two
-    threads of its own, one hashes it (:class:`ContentHash`), one encodes it into the
-    file, and returns once the piece before it is written: the caller computes the next piece
-    while this one is written (at most one piece waits). ``finish(metadata)`` writes the
+    threads of its own, one hashes the pieces in order (:class:`ContentHash`), one
+    encodes them into the file in order, and returns at once (an error of a piece
+    written before is raised here): the caller computes the next pieces while these
+    are written, and the pieces wait in memory when the writing lags (at most the rows
+    of the table, which the caller holds anyway). ``finish(metadata)`` writes the
     footer with the table's key-value ``metadata``, the content hash of all the pieces
     and the metadata hash (:func:`_footer`) and returns the content hash; the file then
     replaces ``path`` atomically when the ``with`` block ends (:func:`atomic_file`). An
@@ -310,7 +312,7 @@ class TableStream:
         self.path, self.schema = Path(path), schema.remove_metadata()
         self.hasher = ContentHash()
         self.rows = 0
-        self._pending: list = []  # the hash and the write of the last piece added
+        self._pending: list = []  # the hashes and writes of the pieces added
         self._finished: str | None = None
 
     def __enter__(self) -> TableStream:
@@ -323,7 +325,9 @@ class TableStream:
             self._file = self._stack.enter_context(atomic_file(self.path, str(self.path)))
             self._writer = pq.ParquetWriter(self._file, self.schema, store_schema=False,
                                             **parquet_options(self.schema))
-            self._pool = self._stack.enter_context(ThreadPoolExecutor(2))
+            # one thread each: the hash streams and the pages take the pieces in order
+            self._hashing = self._stack.enter_context(ThreadPoolExecutor(1))
+            self._encoding = self._stack.enter_context(ThreadPoolExecutor(1))
         except OSError as exc:
             self._stack.__exit__(type(exc), exc, exc.__traceback__)
             raise self._named(exc) from exc
@@ -337,12 +341,25 @@ class TableStream:
                        f"{self.path}")
 
     def _wait(self) -> None:
+        """Wait for every piece added; raise the first error."""
         from concurrent.futures import wait
 
         pending, self._pending = self._pending, []
-        wait(pending)  # both done before an error of either is raised
+        wait(pending)  # all done before an error of any is raised
         for job in pending:
-            job.result()
+            if not job.cancelled():  # (cancelled by _stop after an error)
+                job.result()
+
+    def _raise_done(self) -> None:
+        """Raise the error of a piece already written, if any (the rest go on)."""
+        if any(job.done() and job.exception() is not None for job in self._pending):
+            self._stop()
+            self._wait()
+
+    def _stop(self) -> None:
+        """Cancel the pieces not started yet."""
+        for job in self._pending:
+            job.cancel()
 
     def add(self, piece) -> None:
         """Write ``piece`` (the next rows) on the writer thread once the one before is written."""
@@ -354,15 +371,15 @@ class TableStream:
                              f"{ROW_GROUP_ROWS} rows (one row group)")
         piece = piece.replace_schema_metadata(None)
         try:
-            self._wait()
+            self._raise_done()
         except OSError as exc:
             raise self._named(exc) from exc
         self.rows += piece.num_rows
         # side by side: the streams of the content hash (one thread: beside the
         # computation of the next piece) and the Parquet pages
-        self._pending = [self._pool.submit(self.hasher.update, piece, threads=1),
-                         self._pool.submit(_detached, self._writer.write_table, piece,
-                                           row_group_size=ROW_GROUP_ROWS)]
+        self._pending += [self._hashing.submit(self.hasher.update, piece, threads=1),
+                          self._encoding.submit(_detached, self._writer.write_table, piece,
+                                                row_group_size=ROW_GROUP_ROWS)]
 
     def finish(self, metadata) -> str:
         """Write the footer with ``metadata`` and the hashes; return the content hash."""
@@ -377,7 +394,8 @@ class TableStream:
         return digest
 
     def __exit__(self, kind, exc, tb) -> None:
-        for job in self._pending:  # an error or an interruption in the block
+        self._stop()  # an error or an interruption in the block: what runs, ends
+        for job in self._pending:
             try:
                 job.result()
             except BaseException:  # noqa: BLE001 - the block's own error is raised
