@@ -4,7 +4,12 @@ All kernels are compiled through :func:`jit`, so that caching and the error
 model are the same everywhere: ``cache=True`` (a fresh clone compiles once,
 later runs load from ``__pycache__``) and ``error_model="numpy"`` (division by
 zero gives inf/NaN like NumPy instead of raising, which the kernels check
-explicitly). No ``fastmath``: the kernels rely on NaN checks. How numba's
+explicitly). No ``fastmath``: the kernels rely on NaN checks. ``nogil=True``:
+a kernel touches no Python object, so a call releases the GIL and other Python
+threads run beside it (a sweep encodes and hashes the rows already computed
+while the kernel computes the next ones). numba's cache does not key on this
+option: a cache compiled before it was set keeps holding the GIL until the
+kernel's source changes or its ``__pycache__`` entries are removed. How numba's
 threads wait between launches is set in :mod:`vimpact.kernels.threads`
 before numba starts them.
 """
@@ -42,4 +47,4 @@ def jit(parallel: bool = False, inline: Literal["never", "always"] = "never",
     if not rewrites:
         wrappers["no_rewrites"] = True
     return numba.njit(cache=True, error_model="numpy", parallel=parallel, inline=inline,
-                      **wrappers)
+                      nogil=True, **wrappers)

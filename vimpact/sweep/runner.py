@@ -104,8 +104,14 @@ def run_batch(spec: SweepSpec, scene_cols: dict, timings: dict | None = None) ->
             timings["total_s"] = timings.get("total_s", 0.0) + time.perf_counter() - t0
 
 
-def compute_chunk(spec: SweepSpec, chunk: int, timings: dict | None = None):
+def compute_chunk(spec: SweepSpec, chunk: int, timings: dict | None = None,
+                  part: tuple[int, int] | None = None, params: dict | None = None):
     """Simulate the rows of ``chunk`` and return them as a ``pyarrow`` table.
+
+    ``part``: ``(lo, hi)``, only the chunk's rows ``lo`` to ``hi - 1`` (counted from its
+    first row): the same rows as the whole chunk's table has there (a row's results do
+    not depend on the other rows). ``params``: the chunk's parameter sets
+    (:meth:`~vimpact.sweep.spec.SweepSpec.chunk_parameters`, made once for its parts).
 
     Columnar: the chunk's parameters (:mod:`vimpact.sweep.parameters`) become scene
     columns of the engine (:func:`run_batch`: what :func:`vimpact.simulate_batch` runs,
@@ -123,8 +129,17 @@ def compute_chunk(spec: SweepSpec, chunk: int, timings: dict | None = None):
     from vimpact.sweep.parameters import engine_columns
 
     start, stop = spec.chunk_rows(chunk)
+    if params is None:
+        params = spec.chunk_parameters(chunk)
+    if part is not None:
+        lo, hi = part
+        if not 0 <= lo < hi <= stop - start:
+            raise ValueError(f"part = {part!r} is not allowed: must be rows (lo, hi) with "
+                             f"0 <= lo < hi <= {stop - start} of chunk {chunk}")
+        views: dict[int, np.ndarray] = {}  # one array of several inputs: one view of it
+        params = {k: views.setdefault(id(v), v[lo:hi]) for k, v in params.items()}
+        start, stop = start + lo, start + hi
     n = stop - start
-    params = spec.chunk_parameters(chunk)
     batches, inputs = engine_columns(spec, params)
     outputs = RESULTS | (ADHESION_RESULTS if spec.has_adhesion else {})
     cols: dict[str, np.ndarray] = {"row": np.arange(start, stop, dtype=np.int64)}
@@ -405,7 +420,9 @@ def run_sweep(spec_path, out=None, resume: bool = False,
         parts. Without it, existing parts are an error.
     progress : ``None`` (default) a bar on a terminal, a line every ~10 s otherwise
         (:mod:`vimpact.sweep.progress`); a callable is called as
-        ``progress(rows_done, rows_total)`` after every chunk; ``False`` nothing.
+        ``progress(rows_done, rows_total)`` after every chunk (a sweep of one chunk
+        of more than :data:`~vimpact.tableformat.files.ROW_GROUP_ROWS` rows: after
+        every row group of it); ``False`` nothing.
     workers : run the chunks as tasks on a new Dask ``LocalCluster`` of this many
         single-threaded worker processes
     scheduler : address of a running Dask scheduler to run the chunks on
@@ -540,6 +557,11 @@ def _run(spec, spec_path, out, parts, resume, progress, workers, scheduler, shar
                 fresh = []
             if spec.n_chunks > 1 or fresh is None:
                 parts.mkdir(parents=True, exist_ok=True)
+            if fresh is not None and spec.n_chunks == 1 and spec.rows > files.ROW_GROUP_ROWS:
+                # one chunk of several row groups: each written while the next is computed
+                _stream_one_chunk(spec, parts, out, log, stages, bar, timings)
+                todo = []
+                finished = True
             for chunk in todo:
                 table = compute_chunk(spec, chunk, timings)
                 summary = chunk_summary(table)
@@ -556,6 +578,9 @@ def _run(spec, spec_path, out, parts, resume, progress, workers, scheduler, shar
                 _timed(timings, "write_s", t0)
                 start, stop = spec.chunk_rows(chunk)
                 bar.update(stop - start)
+        if finished:  # (streamed: the table is written)
+            bar.close()
+            return out
         finished = True
         bar.close()
         if shard is not None:
@@ -573,6 +598,97 @@ def _run(spec, spec_path, out, parts, resume, progress, workers, scheduler, shar
     return out
 
 
+#: Row groups of a streamed chunk computed at once at most (:func:`_stream_one_chunk`):
+#: while one is in the kernels (which release the GIL), the other's Python (validation,
+#: results, its table) runs, and their kernels fill each other's idle threads.
+PIECES_IN_FLIGHT = 2
+#: numba threading layers that take parallel launches from several threads at once
+#: (the workqueue layer aborts the process on one).
+CONCURRENT_LAYERS = ("tbb", "omp")
+
+
+def _launches_side_by_side() -> bool:
+    """Whether numba's threading layer takes parallel launches from two threads at once.
+
+    Unknown before this process's first parallel launch: ``False`` then.
+    """
+    import numba
+
+    try:
+        return numba.threading_layer() in CONCURRENT_LAYERS
+    except ValueError:  # no parallel launch yet: the layer is not chosen
+        return False
+
+
+def _stream_one_chunk(spec: SweepSpec, parts: Path, out: Path, log, stages: SweepStages,
+                      bar: Progress, timings: dict | None) -> None:
+    """Compute the one chunk of a file-layout sweep in row groups, writing each under the next.
+
+    The chunk's rows in pieces of :data:`~vimpact.tableformat.files.ROW_GROUP_ROWS`
+    (:func:`compute_chunk` ``part``), :data:`PIECES_IN_FLIGHT` at a time on threads of
+    their own (one, until numba's threading layer is known to take launches from several
+    threads, :data:`CONCURRENT_LAYERS`, and with one numba thread), sharing this
+    thread's numba threads (two pieces on two threads: one each, so that neither waits
+    at the end of a launch for the other thread's last rows); each piece, in row order,
+    is hashed and encoded into the table on other threads while the next ones are
+    computed (:func:`vimpact.sweep.store.combine` ``pieces``): the same
+    table, byte for byte, as written from the whole chunk. No part: an interruption
+    keeps nothing, as for one chunk written whole (the pieces in flight are finished
+    first). ``timings``: ``kernel_s`` and ``total_s`` summed over the pieces (pieces
+    side by side: more than the wall time they took); ``pieces_wall_s`` the wall time
+    spent waiting for the pieces (with their tables); ``write_s`` the time spent writing
+    that the computation did not cover.
+    """
+    from collections import deque
+    from concurrent.futures import ThreadPoolExecutor
+
+    import numba
+
+    start, stop = spec.chunk_rows(0)
+    size = files.ROW_GROUP_ROWS
+    bounds = [(lo, min(stop - start, lo + size)) for lo in range(0, stop - start, size)]
+    threads = numba.get_num_threads()  # (numba's count is per Python thread)
+    inside = 0.0  # s computing the pieces (within the write's time)
+    params = spec.chunk_parameters(0)
+
+    def piece(lo: int, hi: int, own_threads: int):
+        numba.set_num_threads(own_threads)
+        own: dict = {}
+        table = compute_chunk(spec, 0, own, (lo, hi), params)
+        return table, chunk_summary(table), own
+
+    def pieces(pool):
+        nonlocal inside
+        t0 = time.perf_counter()
+        todo = deque(bounds)
+        running: deque = deque()
+        while todo or running:
+            limit = min(PIECES_IN_FLIGHT, threads) if _launches_side_by_side() else 1
+            while todo and len(running) < limit:  # the threads shared between the pieces
+                running.append((todo[0], pool.submit(piece, *todo.popleft(),
+                                                     max(1, threads // limit))))
+            (lo, hi), future = running.popleft()
+            table, summary, own = future.result()
+            for key, value in own.items():
+                if timings is not None:
+                    timings[key] = timings.get(key, 0.0) + value
+            inside += time.perf_counter() - t0
+            yield table, summary
+            bar.update(hi - lo)
+            t0 = time.perf_counter()
+
+    t0 = time.perf_counter()
+    with ThreadPoolExecutor(PIECES_IN_FLIGHT) as pool:
+        made = pieces(pool)
+        try:
+            _combine(spec, parts, out, log, stages, pieces=made)
+        finally:
+            made.close()  # (an error or an interruption: no piece is started after it)
+    if timings is not None:
+        timings["write_s"] = timings.get("write_s", 0.0) + time.perf_counter() - t0 - inside
+        timings["pieces_wall_s"] = timings.get("pieces_wall_s", 0.0) + inside
+
+
 def _timed(timings: dict | None, key: str, t0: float) -> None:
     """Add the seconds since ``t0`` to ``timings[key]`` (if ``timings`` is a dict)."""
     if timings is not None:
@@ -580,12 +696,13 @@ def _timed(timings: dict | None, key: str, t0: float) -> None:
 
 
 def _combine(spec: SweepSpec, parts: Path, out: Path, log, stages: SweepStages,
-             fresh=None, fresh_digest: str | None = None) -> None:
+             fresh=None, fresh_digest: str | None = None, pieces=None) -> None:
     """Run :func:`vimpact.sweep.store.combine`, then ``stages.finish``.
 
     ``fresh``: the ``(table, summary)`` of every chunk, computed in this process:
     the table is written from them (:func:`vimpact.sweep.store.combine`), with the
-    content hash ``fresh_digest`` of their rows.
+    content hash ``fresh_digest`` of their rows. ``pieces``: the ``(table, summary)``
+    of the row groups of a one-chunk sweep, computed as they are asked for.
 
     The stages' own files
     (``stages.kept``) leave the parts directory first (the directory must hold only
@@ -600,7 +717,7 @@ def _combine(spec: SweepSpec, parts: Path, out: Path, log, stages: SweepStages,
             kept.unlink()
     try:
         store.combine(spec, parts, out, lambda first: explain_paths(spec, first), fresh,
-                      fresh_digest)
+                      fresh_digest, pieces)
     except BaseException:
         if Path(parts).is_dir():
             for name, text in saved.items():

@@ -13,9 +13,13 @@ Layouts (``layout`` in the spec; ``"auto"``: a file up to
   and ``vimpact table`` read it directly.
 
 Memory is bounded by the chunk size in both layouts: a part is written as it
-is finished, and the file layout is combined one part (one row group) at a time
+is finished, and the file layout is combined one part at a time
 (a table of at most :data:`HOLD_ROWS` rows, no more than the largest chunk the
 runner chooses, is held whole between the check of its parts and its write).
+Row groups: :data:`~vimpact.tableformat.files.ROW_GROUP_ROWS` rows each from the
+first row of each part (one for a part of at most that many rows), in a part and in
+the table alike; a one-chunk sweep's table is written one row group at a time while
+the next is computed (:func:`_write_streamed`), the same bytes as written whole.
 
 Every write is atomic (a temporary file in the same directory, fsync,
 ``os.replace``, fsync of the directory), so a run killed anywhere (kill -9)
@@ -63,6 +67,7 @@ from typing import cast
 from vimpact.model.validation import InputError
 from vimpact.sweep.spec import AUTO_CHUNK_ROWS
 from vimpact.tableformat.files import (
+    TableStream,
     fsync_dir,
     refuse_symlink,
     remove_temporaries,
@@ -338,7 +343,7 @@ HOLD_ROWS = AUTO_CHUNK_ROWS[1]
 
 
 def combine(spec, parts: Path, out: Path, explain_paths, fresh=None,
-            fresh_digest: str | None = None) -> None:
+            fresh_digest: str | None = None, pieces=None) -> None:
     """Finish the table from the parts.
 
     Verify every part (:func:`existing_parts`:
@@ -362,10 +367,16 @@ def combine(spec, parts: Path, out: Path, explain_paths, fresh=None,
     :data:`HOLD_ROWS` rows, or one chunk), in chunk order: the table is written from
     them with its content hash computed from the rows in memory (``fresh_digest``, if
     the caller computed it from them as they were made, else here) and the parts are
-    not read (:func:`_write_fresh`); a one-chunk sweep has no part.
+    not read (:func:`_write_fresh`); a one-chunk sweep has no part. ``pieces``: the
+    ``(table, summary)`` of each row group of a one-chunk file-layout table in row
+    order, computed as they are asked for: each is written while the next is computed
+    (:func:`_write_streamed`).
     """
     import pyarrow.parquet as pq
 
+    if pieces is not None:
+        _write_streamed(spec, parts, out, explain_paths, pieces)
+        return
     if fresh is not None:
         _write_fresh(spec, parts, out, explain_paths, fresh, fresh_digest)
         return
@@ -400,7 +411,8 @@ def combine(spec, parts: Path, out: Path, explain_paths, fresh=None,
         _check_written(out / COMMON_METADATA, parts, spec.rows, digest)
         return
     meta = encode_metadata({**spec.metadata(), "paths": paths})
-    # one row group per part, read one at a time: memory bounded by the chunk size
+    # a part's row groups (ROW_GROUP_ROWS rows from its first row), one part read at a
+    # time: memory bounded by the chunk size
 
     def read(chunk):
         if held is not None:  # read for its check
@@ -462,13 +474,7 @@ def _write_fresh(spec, parts: Path, out: Path, explain_paths, fresh: list,
         raise ValueError(f"a file-layout table is written from memory only from all its "
                          f"chunks ({spec.n_chunks} chunk(s), layout {spec.table_layout!r}, "
                          f"{len(fresh)} given)")
-    paths: dict = {}
-    for _, summary_ in fresh:
-        for name, entry in summary_["paths"].items():
-            if name not in paths:
-                paths[name] = {"rows": 0, "first_row": entry["first_row"]}
-            paths[name]["rows"] += entry["rows"]
-    paths = _explained(paths, explain_paths)
+    paths = _explained(_merged_paths(summary_ for _, summary_ in fresh), explain_paths)
     if digest is None and len(tables) > 1:
         whole = ContentHash()
         for table in tables:
@@ -494,6 +500,55 @@ def _write_fresh(spec, parts: Path, out: Path, explain_paths, fresh: list,
     _check_written(out, parts if written else None, spec.rows, digest)
     for path in written:
         path.unlink()
+    if parts.is_dir():
+        _remove_parts_dir(parts)
+
+
+def _merged_paths(summaries) -> dict:
+    """Return the ``paths`` of chunk summaries in row order, merged: rows summed, first row kept."""
+    paths: dict = {}
+    for summary_ in summaries:
+        for name, entry in summary_["paths"].items():
+            if name not in paths:
+                paths[name] = {"rows": 0, "first_row": entry["first_row"]}
+            paths[name]["rows"] += entry["rows"]
+    return paths
+
+
+def _write_streamed(spec, parts: Path, out: Path, explain_paths, pieces) -> None:
+    """Write a one-chunk file-layout table from its row groups as they are computed.
+
+    ``pieces``: ``(table, summary)`` of each row group in row order
+    (:data:`~vimpact.tableformat.files.ROW_GROUP_ROWS` rows each but the last), computed
+    when the loop asks for the next: each is hashed and encoded on a thread
+    (:class:`~vimpact.tableformat.files.TableStream`) while the next is computed. The
+    table is the one :func:`_write_fresh` writes from the whole chunk, byte for byte
+    (the same row groups, metadata and content hash). No part: an interruption or a
+    failed write (disk full) keeps nothing, the chunk is computed again by the next run.
+    """
+    if spec.table_layout != "file" or spec.n_chunks != 1:
+        raise ValueError(f"a table is written from its row groups as they are computed only "
+                         f"for one chunk of a file layout ({spec.n_chunks} chunk(s), layout "
+                         f"{spec.table_layout!r})")
+    out.parent.mkdir(parents=True, exist_ok=True)
+    summaries = []
+    try:
+        with TableStream(out, spec.schema()) as stream:
+            for table, summary_ in pieces:
+                stream.add(table)
+                summaries.append(summary_)
+            if stream.rows != spec.rows:
+                raise ValueError(f"{out}: {stream.rows} rows computed, the sweep has "
+                                 f"{spec.rows}; nothing written")
+            # one chunk's summary lists its paths by name (chunk_summary)
+            paths = _explained(dict(sorted(_merged_paths(summaries).items())), explain_paths)
+            digest = stream.finish(encode_metadata({**spec.metadata(), "paths": paths}))
+    except OSError as exc:
+        full = exc.errno in (errno.ENOSPC, errno.EDQUOT)
+        raise OSError(exc.errno, f"{exc.strerror or first_line(exc)}; the sweep's one chunk "
+                      f"was to be written straight to {out}, nothing is kept: "
+                      f"{'make room and ' if full else ''}run it again") from exc
+    _check_written(out, None, spec.rows, digest)
     if parts.is_dir():
         _remove_parts_dir(parts)
 

@@ -39,6 +39,12 @@ COMPRESSION = "zstd"
 WRITE_BATCH_ROWS = 65536
 #: Key-value metadata key of the Arrow schema that pyarrow stores in a Parquet footer.
 ARROW_SCHEMA_KEY = b"ARROW:schema"
+#: Rows of one Parquet row group at most: every table and part is written in row groups of
+#: this many rows from its first row (one part or chunk after another), the last one
+#: shorter. A sweep's chunk is computed in pieces of this many rows, each written (encoded
+#: and hashed) while the next one is computed (:class:`TableStream`); the file is the same
+#: bytes either way. A table of at most this many rows is one row group.
+ROW_GROUP_ROWS = 25_000
 
 
 def parquet_options(schema) -> dict:
@@ -197,11 +203,13 @@ def write_atomic(table, path: Path, *, schema_only: bool = False, more=(),
                         if again is not None:
                             again.update(piece)
                         writer.write_table(piece if k == 0 else
-                                           piece.replace_schema_metadata(table.schema.metadata))
+                                           piece.replace_schema_metadata(table.schema.metadata),
+                                           row_group_size=ROW_GROUP_ROWS)
             else:
                 if again is not None:
                     again.update(table)
-                pq.write_table(table, f, **parquet_options(table.schema))
+                pq.write_table(table, f, row_group_size=ROW_GROUP_ROWS,
+                               **parquet_options(table.schema))
             if again is not None and again.hexdigest() != content_sha256:
                 raise Damaged(f"the rows written to {path} do not give the content hash "
                               f"{str(content_sha256)[:12]}... (data "
@@ -220,11 +228,11 @@ def _write_hashing(table, path: Path) -> str:
     the pages are encoded (SHA-256 and the Parquet writer both release the GIL), and
     the key-value metadata (the table's, the content hash, the metadata hash, and the
     Arrow schema with all of them, ``ARROW:schema``, as the writer would store it)
-    goes into the footer when the file is closed. The file reads back as the one
-    :func:`write_atomic` writes otherwise: the same columns, schema and metadata.
+    goes into the footer when the file is closed (:func:`_footer`). The file reads back
+    as the one :func:`write_atomic` writes otherwise: the same columns, schema and
+    metadata; it is the same bytes as :class:`TableStream` writes from the same rows.
     Returns the content hash.
     """
-    import base64
     from concurrent.futures import ThreadPoolExecutor
 
     import pyarrow.parquet as pq
@@ -234,19 +242,185 @@ def _write_hashing(table, path: Path) -> str:
         try:
             with atomic_file(path, str(path)) as f:
                 # no schema stored at the start: the footer gets it, with the hashes
-                with pq.ParquetWriter(f, table.schema, store_schema=False,
+                with pq.ParquetWriter(f, table.schema.remove_metadata(), store_schema=False,
                                       **parquet_options(table.schema)) as writer:
-                    writer.write_table(table)
+                    writer.write_table(table.replace_schema_metadata(None),
+                                       row_group_size=ROW_GROUP_ROWS)
                     digest = hashing.result()
-                    meta = dict(table.schema.metadata or {})
-                    meta[(META_PREFIX + CONTENT_HASH_KEY).encode()] = digest.encode()
-                    meta = dict(with_metadata_hash(table.schema.with_metadata(meta)).metadata)
-                    stored = base64.b64encode(table.schema.with_metadata(meta).serialize())
-                    writer.add_key_value_metadata({**meta, ARROW_SCHEMA_KEY: stored})
+                    writer.add_key_value_metadata(
+                        _footer(table.schema, table.schema.metadata, digest))
         except OSError as exc:
             raise OSError(exc.errno, f"{exc.strerror or first_line(exc)} while writing "
                           f"{path}") from exc
     return digest
+
+
+def _footer(schema, metadata, digest: str) -> dict:
+    """Return the footer key-value metadata of a table written without a schema at the start.
+
+    ``metadata`` (the table's key-value metadata), the content hash ``digest``, the
+    metadata hash, and the Arrow schema with all of them (``ARROW:schema``, as the
+    writer would store it).
+    """
+    import base64
+
+    meta = dict(metadata or {})
+    meta[(META_PREFIX + CONTENT_HASH_KEY).encode()] = digest.encode()
+    meta = dict(with_metadata_hash(schema.with_metadata(meta)).metadata)
+    stored = base64.b64encode(schema.with_metadata(meta).serialize())
+    return {**meta, ARROW_SCHEMA_KEY: stored}
+
+
+def _detached(call, *args, **kwargs):
+    """Return ``call(*args, **kwargs)``; an ``OSError`` as a new one, without its traceback.
+
+    The traceback of an error in a Parquet writer's call holds the writer (a local of
+    its frames), and a writer freed after a failed write reports the error again,
+    formatting a traceback from C: freed by a later garbage collection, that can
+    happen inside a parse of Python source (an import), which CPython 3.11 before
+    3.11.8 then fails (``AST constructor recursion depth mismatch``). With the error
+    detached, the writer is freed where its owner lets it go.
+    """
+    failed = None
+    try:
+        return call(*args, **kwargs)
+    except OSError as exc:
+        failed = (exc.errno, exc.strerror or first_line(exc))
+    del call, args, kwargs  # (the raised error's frame holds no writer)
+    raise OSError(*failed)
+
+
+class TableStream:
+    """Write a table atomically from its row groups as they are made (a context manager).
+
+    ``add(piece)`` hands one row group (a ``pyarrow`` table of ``schema``'s columns, at
+    most :data:`ROW_GROUP_ROWS` rows; every piece but the last exactly that many) to two
+    threads of its own, one hashes the pieces in order (:class:`ContentHash`), one
+    encodes them into the file in order, and returns at once (an error of a piece
+    written before is raised here): the caller computes the next pieces while these
+    are written, and the pieces wait in memory when the writing lags (at most the rows
+    of the table, which the caller holds anyway). ``finish(metadata)`` writes the
+    footer with the table's key-value ``metadata``, the content hash of all the pieces
+    and the metadata hash (:func:`_footer`) and returns the content hash; the file then
+    replaces ``path`` atomically when the ``with`` block ends (:func:`atomic_file`). An
+    error or an interruption in the block leaves no file (an earlier ``path`` stays).
+    The bytes are those :func:`write_atomic` writes for the same rows in one table of at
+    least :data:`~vimpact.tableformat.integrity.PARALLEL_HASH_BYTES` (:func:`_write_hashing`).
+    """
+
+    def __init__(self, path, schema):
+        self.path, self.schema = Path(path), schema.remove_metadata()
+        self.hasher = ContentHash()
+        self.rows = 0
+        self._pending: list = []  # the hashes and writes of the pieces added
+        self._finished: str | None = None
+
+    def __enter__(self) -> TableStream:
+        from concurrent.futures import ThreadPoolExecutor
+
+        import pyarrow.parquet as pq
+
+        self._stack = contextlib.ExitStack()
+        try:
+            self._file = self._stack.enter_context(atomic_file(self.path, str(self.path)))
+            self._writer = pq.ParquetWriter(self._file, self.schema, store_schema=False,
+                                            **parquet_options(self.schema))
+            # one thread each: the hash streams and the pages take the pieces in order
+            self._hashing = self._stack.enter_context(ThreadPoolExecutor(1))
+            self._encoding = self._stack.enter_context(ThreadPoolExecutor(1))
+        except OSError as exc:
+            self._stack.__exit__(type(exc), exc, exc.__traceback__)
+            raise self._named(exc) from exc
+        except BaseException as exc:
+            self._stack.__exit__(type(exc), exc, exc.__traceback__)
+            raise
+        return self
+
+    def _named(self, exc: OSError) -> OSError:
+        return OSError(exc.errno, f"{exc.strerror or first_line(exc)} while writing "
+                       f"{self.path}")
+
+    def _wait(self) -> None:
+        """Wait for every piece added; raise the first error."""
+        from concurrent.futures import wait
+
+        pending, self._pending = self._pending, []
+        wait(pending)  # all done before an error of any is raised
+        for job in pending:
+            if not job.cancelled():  # (cancelled by _stop after an error)
+                job.result()
+
+    def _raise_done(self) -> None:
+        """Raise the error of a piece already written, if any (the rest go on)."""
+        if any(job.done() and job.exception() is not None for job in self._pending):
+            self._stop()
+            self._wait()
+
+    def _stop(self) -> None:
+        """Cancel the pieces not started yet."""
+        for job in self._pending:
+            job.cancel()
+
+    def add(self, piece) -> None:
+        """Write ``piece`` (the next rows) on the writer thread once the one before is written."""
+        if self._finished is not None:
+            raise ValueError(f"TableStream of {self.path}: add after finish")
+        if self.rows % ROW_GROUP_ROWS or piece.num_rows > ROW_GROUP_ROWS:
+            raise ValueError(f"TableStream of {self.path}: a piece of {piece.num_rows} rows "
+                             f"after {self.rows}: every piece but the last has "
+                             f"{ROW_GROUP_ROWS} rows (one row group)")
+        piece = piece.replace_schema_metadata(None)
+        try:
+            self._raise_done()
+        except OSError as exc:
+            raise self._named(exc) from exc
+        self.rows += piece.num_rows
+        # side by side: the streams of the content hash (one thread: beside the
+        # computation of the next piece) and the Parquet pages
+        self._pending += [self._hashing.submit(self.hasher.update, piece, threads=1),
+                          self._encoding.submit(_detached, self._writer.write_table, piece,
+                                                row_group_size=ROW_GROUP_ROWS)]
+
+    def finish(self, metadata) -> str:
+        """Write the footer with ``metadata`` and the hashes; return the content hash."""
+        try:
+            self._wait()
+            digest = self.hasher.hexdigest()
+            self._writer.add_key_value_metadata(_footer(self.schema, metadata, digest))
+            _detached(self._writer.close)
+        except OSError as exc:
+            raise self._named(exc) from exc
+        self._finished = digest
+        return digest
+
+    def __exit__(self, kind, exc, tb) -> None:
+        self._stop()  # an error or an interruption in the block: what runs, ends
+        for job in self._pending:
+            try:
+                job.result()
+            except BaseException:  # noqa: BLE001 - the block's own error is raised
+                pass
+        self._pending = []
+        if self._finished is None:
+            # released here, not by a later garbage collection (the error's traceback
+            # holds this stream): a writer whose close failed reports it again when freed
+            writer, self._writer = self._writer, None
+            try:
+                writer.close()
+            except Exception:  # noqa: BLE001 - the temporary file is removed anyway
+                pass
+            del writer
+            if kind is None:  # left without finish(): nothing replaces path
+                kind, exc = ValueError, ValueError(
+                    f"TableStream of {self.path}: closed before finish(); nothing written")
+                self._stack.__exit__(kind, exc, None)
+                raise exc
+        try:
+            self._stack.__exit__(kind, exc, tb)
+        except OSError as err:
+            if kind is None:
+                raise self._named(err) from err
+            raise
 
 
 def remove_temporaries(directory: Path, name: str = "") -> None:
@@ -342,5 +516,6 @@ class OutputLock:
 
 
 
-__all__ = ["COMPRESSION", "OutputLock", "atomic_file", "fsync_dir", "parquet_options",
-           "refuse_symlink", "remove_temporaries", "write_atomic"]
+__all__ = ["COMPRESSION", "ROW_GROUP_ROWS", "OutputLock", "TableStream", "atomic_file",
+           "fsync_dir", "parquet_options", "refuse_symlink", "remove_temporaries",
+           "write_atomic"]

@@ -60,12 +60,15 @@ class ContentHash:
         self.rows = 0
         self._streams: list[tuple] = []
 
-    def update(self, table, also: ContentHash | None = None) -> ContentHash:
+    def update(self, table, also: ContentHash | None = None,
+               threads: int | None = None) -> ContentHash:
         """Add the rows of the ``pyarrow`` table (or record batch) ``table``.
 
         Same column names, in the same order, as the rows before. ``also``: a second
         hash that receives the same rows (e.g. a part's own hash and the hash of the
-        whole table), from one canonical form of each column.
+        whole table), from one canonical form of each column. ``threads``: how many
+        threads hash the streams at most (default: :func:`_hash_threads`; 1 on a
+        thread that runs beside other work, e.g. the kernels).
         """
         names = list(table.column_names)
         hashers = [self] if also is None else [self, also]
@@ -96,7 +99,8 @@ class ContentHash:
                     jobs.extend(zip(streams[1:], pieces[1:]))
                 else:
                     jobs.extend(zip(streams, pieces))
-        threads = _hash_threads(sum(_size(piece) for _, piece in jobs))
+        threads = min(_hash_threads(sum(_size(piece) for _, piece in jobs)),
+                      threads or MAX_HASH_THREADS)
         if threads > 1:
             from concurrent.futures import ThreadPoolExecutor
 
