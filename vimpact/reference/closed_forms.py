@@ -11,6 +11,7 @@
 
 from __future__ import annotations
 
+import functools
 import math
 from typing import NamedTuple
 
@@ -289,8 +290,14 @@ class _Event:
         return self.fn(t, y)
 
 
+@functools.lru_cache(maxsize=512)
 def _kv_single(tau_hat: float, rtol: float) -> tuple[float, float, float]:
-    """One Kelvin-Voigt continuum impact; see :func:`kelvin_voigt_continuum`."""
+    """One Kelvin-Voigt continuum impact; see :func:`kelvin_voigt_continuum`.
+
+    Deterministic in its two floats and 10-70 ms of CPU a call: kept for the
+    process (a few hundred bytes each), so the tests that ask for the same
+    ``q1`` and ``rtol`` again get the same numbers without solving again.
+    """
     a = 1.25                # Hertz force coefficient, 5/4
     c = 1.875 * tau_hat     # viscous coefficient, 15/8 tau_hat
     atol = 1e-4 * rtol
