@@ -151,11 +151,14 @@ def write_table(path: str | None = None) -> str:
                          for i in range(0, len(values), 4))
 
     spline = CubicSpline(la, np.array(e)).c
+    if not np.array_equal(spline[3], e[:-1]):  # (a spline's constant terms are its points)
+        raise RuntimeError("the spline's constant terms are not the solved points")
     doc = tab.__doc__.strip()
     text = (f'"""{doc}\n"""\n\nLOG_ALPHA = {tab.LOG_ALPHA!r}\nN = {tab.N}\n\n'
             f"E_CLIPPED = (\n{rows(e)}\n)\n\n"
             "# SPLINE[k][i]: coefficient of (log10 alpha - breakpoint i)^(3 - k) on interval i\n"
-            "SPLINE = (\n" + "\n".join(f"  (\n{rows(c)}\n  )," for c in spline) + "\n)\n")
+            "SPLINE = (\n" + "".join(f"  (\n{rows(c)}\n  ),\n" for c in spline[:3])
+            + "  E_CLIPPED[:-1],  # (the constant terms are the solved points)\n)\n")
     path = path or tab.__file__
     with open(path, "w") as fh:
         fh.write(text)
