@@ -560,8 +560,9 @@ def _run(spec, spec_path, out, parts, resume, progress, workers, scheduler, shar
             if fresh is not None and spec.n_chunks == 1 and spec.rows > files.ROW_GROUP_ROWS:
                 # one chunk of several row groups: each written while the next is computed
                 _stream_one_chunk(spec, parts, out, log, stages, bar, timings)
-                todo = []
                 finished = True
+                bar.close()
+                return out
             for chunk in todo:
                 table = compute_chunk(spec, chunk, timings)
                 summary = chunk_summary(table)
@@ -578,9 +579,6 @@ def _run(spec, spec_path, out, parts, resume, progress, workers, scheduler, shar
                 _timed(timings, "write_s", t0)
                 start, stop = spec.chunk_rows(chunk)
                 bar.update(stop - start)
-        if finished:  # (streamed: the table is written)
-            bar.close()
-            return out
         finished = True
         bar.close()
         if shard is not None:

@@ -224,35 +224,15 @@ def write_atomic(table, path: Path, *, schema_only: bool = False, more=(),
 def _write_hashing(table, path: Path) -> str:
     """Write ``table`` as :func:`write_atomic` does, hashing its rows while Parquet encodes them.
 
-    The content hash (:class:`ContentHash`) is computed on a thread of its own while
-    the pages are encoded (SHA-256 and the Parquet writer both release the GIL), and
-    the key-value metadata (the table's, the content hash, the metadata hash, and the
-    Arrow schema with all of them, ``ARROW:schema``, as the writer would store it)
-    goes into the footer when the file is closed (:func:`_footer`). The file reads back
-    as the one :func:`write_atomic` writes otherwise: the same columns, schema and
-    metadata; it is the same bytes as :class:`TableStream` writes from the same rows.
-    Returns the content hash.
+    Its row groups go through a :class:`TableStream` (the content hash on one thread,
+    the pages on another, the key-value metadata with the hashes and the Arrow schema
+    in the footer, :func:`_footer`). The file reads back as the one :func:`write_atomic`
+    writes otherwise: the same columns, schema and metadata. Returns the content hash.
     """
-    from concurrent.futures import ThreadPoolExecutor
-
-    import pyarrow.parquet as pq
-
-    with ThreadPoolExecutor(1) as pool:
-        hashing = pool.submit(content_hash, table)
-        try:
-            with atomic_file(path, str(path)) as f:
-                # no schema stored at the start: the footer gets it, with the hashes
-                with pq.ParquetWriter(f, table.schema.remove_metadata(), store_schema=False,
-                                      **parquet_options(table.schema)) as writer:
-                    writer.write_table(table.replace_schema_metadata(None),
-                                       row_group_size=ROW_GROUP_ROWS)
-                    digest = hashing.result()
-                    writer.add_key_value_metadata(
-                        _footer(table.schema, table.schema.metadata, digest))
-        except OSError as exc:
-            raise OSError(exc.errno, f"{exc.strerror or first_line(exc)} while writing "
-                          f"{path}") from exc
-    return digest
+    with TableStream(path, table.schema) as stream:
+        for start in range(0, table.num_rows, ROW_GROUP_ROWS):
+            stream.add(table.slice(start, ROW_GROUP_ROWS))
+        return stream.finish(table.schema.metadata)
 
 
 def _footer(schema, metadata, digest: str) -> dict:
@@ -304,8 +284,8 @@ class TableStream:
     and the metadata hash (:func:`_footer`) and returns the content hash; the file then
     replaces ``path`` atomically when the ``with`` block ends (:func:`atomic_file`). An
     error or an interruption in the block leaves no file (an earlier ``path`` stays).
-    The bytes are those :func:`write_atomic` writes for the same rows in one table of at
-    least :data:`~vimpact.tableformat.integrity.PARALLEL_HASH_BYTES` (:func:`_write_hashing`).
+    :func:`write_atomic` writes a table of at least
+    :data:`~vimpact.tableformat.integrity.PARALLEL_HASH_BYTES` through it (:func:`_write_hashing`).
     """
 
     def __init__(self, path, schema):
