@@ -22,6 +22,7 @@ import numpy as np
 import pytest
 
 from tests.oracles import continuum_data
+from tests.oracles.continuum_data import kappa_of
 from vimpact.kernels.continuum_maxwell import maxwell_stick_batch, maxwell_stick_impact
 from vimpact.kernels.layout import (
     N_OUT,
@@ -48,10 +49,6 @@ from vimpact.reference.continuum_scipy import maxwell_continuum_reference
 
 MAX_STEPS = 1_000_000
 NO_REC = np.zeros((0, N_REC))
-
-
-def kappa_of(nu):
-    return 2.0 * (1.0 - nu) / (2.0 - nu)
 
 
 def run(tau0=0.0, g=(), tau=(), nu=0.3, mu_t=3.5, tangential=True, rtol=1e-12,
