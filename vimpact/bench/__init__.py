@@ -61,7 +61,9 @@ def title(name: str) -> str:
     """Return the ``TITLE`` of benchmark ``name``, read from its source.
 
     ``TITLE`` of benchmark ``name``, read from its source without importing
-    it (``vimpact bench list`` stays fast); empty if it has none.
+    it (``vimpact bench list`` stays fast): the first top-level statement that
+    assigns a string constant to ``TITLE`` (only that statement is parsed, not
+    the module); empty if it has none.
     """
     import ast
 
@@ -69,12 +71,21 @@ def title(name: str) -> str:
     if spec is None or not spec.origin or not spec.origin.endswith(".py"):
         return ""
     with open(spec.origin, encoding="utf-8") as f:
-        tree = ast.parse(f.read())
-    for node in tree.body:
-        if (isinstance(node, ast.Assign) and any(isinstance(t, ast.Name) and t.id == "TITLE"
-                                                 for t in node.targets)
-                and isinstance(node.value, ast.Constant)):
-            return str(node.value.value)
+        lines = f.read().splitlines()
+    for k, line in enumerate(lines):
+        if not line.startswith("TITLE"):
+            continue
+        for end in range(k + 1, len(lines) + 1):  # the statement may span lines
+            try:
+                tree = ast.parse("\n".join(lines[k:end]))
+            except SyntaxError:
+                continue
+            node = tree.body[0] if tree.body else None
+            if (isinstance(node, ast.Assign) and any(isinstance(t, ast.Name) and t.id == "TITLE"
+                                                     for t in node.targets)
+                    and isinstance(node.value, ast.Constant)):
+                return str(node.value.value)
+            break
     return ""
 
 
