@@ -25,14 +25,24 @@ class _Parser(argparse.ArgumentParser):
         self.exit(2, f"{self.prog}: error: {message}\n")
 
 
-def build_parser() -> argparse.ArgumentParser:
-    """Return the full ``vimpact`` parser (every subcommand registered)."""
+def build_parser(argv: list[str] | None = None) -> argparse.ArgumentParser:
+    """Return the ``vimpact`` parser.
+
+    Parameters
+    ----------
+    argv : the arguments the parser is built for. When the first names a subcommand,
+        only that subcommand is registered (argparse then never shows the others:
+        their options, help lines and checks are not built, a few milliseconds per
+        command); otherwise (``None``, ``--help``, ``--version``, an unknown command)
+        every subcommand is.
+    """
     parser = _Parser(prog="vimpact", description=(
         "Coefficients of restitution of a sphere hitting a viscoelastic "
         "half-space (method of dimensionality reduction)."))
     parser.add_argument("--version", action="version", version=f"vimpact {__version__}")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
-    for name in SUBCOMMANDS:
+    names = (argv[0],) if argv and argv[0] in SUBCOMMANDS else SUBCOMMANDS
+    for name in names:
         importlib.import_module(f"vimpact.cli.{name}").add_parser(sub)
     return parser
 
@@ -64,8 +74,8 @@ def _is_number(text: str) -> bool:
 
 def main(argv: list[str] | None = None) -> int:
     """Run the command line with ``argv`` (default ``sys.argv[1:]``); returns the exit code."""
-    parser = build_parser()
-    args = parser.parse_args(_negative_values(sys.argv[1:] if argv is None else list(argv)))
+    argv = _negative_values(sys.argv[1:] if argv is None else list(argv))
+    args = build_parser(argv).parse_args(argv)
     try:
         return args.func(args)
     except BrokenPipeError:  # the reader went away (``| head``): stop quietly
