@@ -147,3 +147,26 @@ def test_building_the_parser_and_refusing_bad_input_load_neither_numba_nor_panda
                          text=True, check=True).stdout
     steps = json.loads(out)
     assert steps == [["parser", None, []], [bad[0], 2, []], [bad[1], 2, []]], steps
+
+
+def _subcommand_parsers(parser):
+    """``{name: parser}`` of the subcommands registered on ``parser``."""
+    import argparse
+
+    (action,) = [a for a in parser._actions if isinstance(a, argparse._SubParsersAction)]
+    return action.choices
+
+
+def test_a_command_builds_the_same_subcommand_parser_as_the_full_parser():
+    """A command builds only its subcommand, and builds it as the full parser does."""
+    from vimpact.cli.main import SUBCOMMANDS, build_parser
+
+    full = _subcommand_parsers(build_parser())
+    assert sorted(full) == sorted(SUBCOMMANDS)
+    for name in SUBCOMMANDS:
+        own = _subcommand_parsers(build_parser([name, "--anything"]))
+        assert list(own) == [name]
+        assert own[name].format_help() == full[name].format_help()
+    # no subcommand first: all of them (top-level help lists each with its help line)
+    for argv in ([], ["--help"], ["--version"], ["bogus"], ["-h", "simulate"]):
+        assert sorted(_subcommand_parsers(build_parser(argv))) == sorted(SUBCOMMANDS)
