@@ -473,6 +473,8 @@ def _record_ended(live: np.ndarray, x: np.ndarray, v: np.ndarray, ux: np.ndarray
     written into ``e`` and ``wend``, and they leave ``live`` (all updated in place).
     """
     ended = live & (x <= 0.0)
+    if not ended.any():  # (most steps: nothing to record; none live: no points at all)
+        return not live.size
     e[ended] = -v[ended]
     wend[ended] = (ux - om)[ended]
     live &= ~ended
