@@ -90,6 +90,11 @@ def test_refresh_rewrites_outputs_and_keeps_everything_else(tmp_path):
         f"   $ {cmd}",
         "   ...",
         "   ```", "",
+        "2. Stale in a list:", "",
+        "   ```text",
+        f"   $ {cmd}",
+        "   stale",
+        "   ```", "",
         "```text",
         f"$ {cmd}",
         "stale",
@@ -98,9 +103,10 @@ def test_refresh_rewrites_outputs_and_keeps_everything_else(tmp_path):
         ">>> 6 * 7",
         "41",
         "```", ""]), encoding="utf-8")
-    assert len(refresh_file(page)) == 2  # the abbreviated block still matches
+    assert len(refresh_file(page)) == 3  # the abbreviated block still matches
     text = page.read_text(encoding="utf-8")
     assert text.startswith("Prose stays.\n") and "   ...\n   ```\n" in text
+    assert "\n     e_z " in text and "\n  e_z " in text  # in the list and outside it
     assert "stale" not in text and "\n>>> 6 * 7\n42\n" in text
     shell = [b for b in ex.blocks(page) if b.is_shell]
     assert all(not ex.shell_failures(b) for b in shell)
