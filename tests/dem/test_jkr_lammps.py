@@ -40,7 +40,7 @@ def test_pair_law_is_the_wall_law_of_the_effective_sphere():
     assert (equal.R, equal.m) == pytest.approx((R1 / 2.0, _mass(R1) / 2.0), rel=1e-15)
 
 
-def test_lammps_pair_collision_follows_the_effective_law():
+def test_lammps_pair_collision_follows_the_effective_law(one_lammps_process):
     """Two unequal spheres head on in LAMMPS (pair_coeff jkr): they stick below the law's
     sticking velocity and rebound with the law's e_z above it; sphere 1 alone on a
     wall (its own radius and mass) would not (e_z off by about 0.06 at 0.1 m/s)."""
@@ -67,7 +67,7 @@ WALL = dict(E=2.25e6, eta_n0=49757.3, nu=0.5, cohesion=0.29492, k_t=1.65772e6, x
             mu_s=0.5)
 
 
-def test_lammps_caps_the_jkr_tangential_force_at_the_raised_limit():
+def test_lammps_caps_the_jkr_tangential_force_at_the_raised_limit(one_lammps_process):
     """An oblique (45 deg) jkr wall impact in LAMMPS gives the beta_x of the stepped law with
     LAMMPS' cap mu_s |F_ne + 2 F_pulloff|, not of the cap the tangential constants were fitted
     with (the normal force clipped at zero): beta_x -0.43 instead of 0.24 at 0.03 m/s."""

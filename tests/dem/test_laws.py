@@ -19,6 +19,39 @@ def test_linear_law_ending_at_zero_force_is_the_closed_form(zeta):
     assert t == pytest.approx(float(ref.t_star), rel=1e-8)
 
 
+#: (zeta, w_t, zeta_t): the tangential oscillator below, at, just around and above critical
+#: damping, without damping and without a spring, under normal contacts from undamped to
+#: critically damped (Yade's range: zeta < 1)
+CLOSED_FORM_CASES = [(0.0, 1.7, 0.0), (0.05, 0.5, 0.3), (0.3, 3.0, 0.8), (0.7, 1.0, 0.9999999),
+                     (0.999, 1.0, 1.0), (0.9995, 1.7, 1.0000001), (1.0, 0.5, 3.0),
+                     (0.3, 0.0, 0.0), (0.5, 5.0, 1.3)]
+
+
+@pytest.mark.parametrize("zeta, w_t, zeta_t", CLOSED_FORM_CASES)
+def test_linear_law_ending_at_zero_force_in_closed_form_is_the_ode(zeta, w_t, zeta_t):
+    """The closed form Yade's fit uses is the ODE integrated by DOP853 (rtol 1e-11) to that
+    integration's error, normal and tangential."""
+    ode = laws.linear_spring_dashpot(zeta, "force", (w_t, zeta_t))
+    e, beta, t = laws.linear_spring_dashpot_force_end(zeta, (w_t, zeta_t))
+    assert e == pytest.approx(ode[0], abs=1e-8)
+    assert beta == pytest.approx(ode[1], abs=1e-8)
+    assert t == pytest.approx(ode[2], rel=1e-8)
+    assert math.isnan(laws.linear_spring_dashpot_force_end(zeta)[1])
+
+
+def test_linear_tangential_closed_form_under_strong_damping():
+    """At zeta = 30 the ODE's end-of-contact event drifts (1e-5 with a fast tangential
+    oscillator); the tangential velocity integrated tightly up to the closed-form contact
+    time is the closed form's, in every damping regime of the oscillator."""
+    from scipy.integrate import solve_ivp
+
+    for w_t, zeta_t in ((10.0, 0.0), (3.0, 1.3), (1.0, 1.0), (10.0, 20.0)):
+        _, beta, t = laws.linear_spring_dashpot_force_end(30.0, (w_t, zeta_t))
+        sol = solve_ivp(lambda _, y: [y[1], -(w_t * w_t * y[0] + 2.0 * zeta_t * w_t * y[1])],
+                        (0.0, t), [0.0, 1.0], method="DOP853", rtol=1e-13, atol=1e-16)
+        assert beta == pytest.approx(-sol.y[1, -1], abs=1e-13)
+
+
 @pytest.mark.parametrize("e_in", [0.1, 0.5, 0.9, 0.999])
 def test_linear_law_ending_at_zero_overlap_restitutes_its_input(e_in):
     """The DEM formula zeta = |ln e| / sqrt(pi^2 + ln^2 e) with the contact ending at zero

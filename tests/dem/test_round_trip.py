@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 from tests.dem.codes import need
+from tests.dem.conftest import one_lammps_process_in
 from vimpact.dem import lammps
 from vimpact.dem.export import export
 from vimpact.dem.laws import hertz_contact_time
@@ -64,8 +65,9 @@ COLLISIONS = [(key, v, steps) for key in ("a-floor", "a-b") for v in (0.1, 1.0)
 
 
 @pytest.fixture(scope="module")
-def lammps_collisions(lammps_export):
-    """LAMMPS' e of each of :data:`COLLISIONS` (one LAMMPS run each, in one process)."""
+def lammps_collisions(lammps_export, _lammps_worker):
+    """LAMMPS' e of each of :data:`COLLISIONS` (one LAMMPS run each, in the session's LAMMPS
+    worker process: tests/dem/conftest.py)."""
     need(_NO_LAMMPS, "LAMMPS")
     fits = {f.contact.key: f for f in lammps_export.fits}
     runs = []
@@ -73,7 +75,9 @@ def lammps_collisions(lammps_export):
         f = fits[key]
         R, m = f.contact.nominal()
         runs.append((f, v, float(hertz_contact_time(f.params["E_star_Pa"], R, m, v)), steps))
-    return dict(zip(COLLISIONS, lammps.lammps_restitutions(runs)))
+    with pytest.MonkeyPatch.context() as mp:
+        one_lammps_process_in(mp, _lammps_worker)
+        return dict(zip(COLLISIONS, lammps.lammps_restitutions(runs)))
 
 
 @pytest.mark.parametrize("key", ["a-floor", "a-b"])
@@ -152,7 +156,7 @@ def test_lammps_hertz_material_wall_is_a_body_of_the_particles_material():
     assert t_contact / t_hertz(E / (1 - nu**2)) == pytest.approx(2**0.4, rel=1e-3)
 
 
-def test_lammps_runs_the_exported_files_at_every_size_level():
+def test_lammps_runs_the_exported_files_at_every_size_level(one_lammps_process):
     """What users paste: the settings, the per-type pair_coeff lines and the wall groups and
     fixes, included unchanged in the documented order, with particles of every type at every
     size level (a size range, so LAMMPS' mass scaling of the damping enters)."""
@@ -176,7 +180,8 @@ def oblique_rows_against_vimpact(rows, ob):
     return [(r, key[(round(r["v"], 12), r["angle"])]) for r in rows]
 
 
-def test_lammps_oblique_wall_impacts_give_the_reported_beta(problem, lammps_export):
+def test_lammps_oblique_wall_impacts_give_the_reported_beta(problem, lammps_export,
+                                                          one_lammps_process):
     """The exported LAMMPS files, run on oblique wall impacts with the set-up's friction at
     the report's speeds and impact angles: LAMMPS' beta (from its velocities) is the
     report's prediction to its time-step error, shrinking with the step, and it lies

@@ -77,38 +77,18 @@ def test_exported_yade_file_defines_every_pair_and_one_variable_set(exported):
             assert all(f"{k}=" in ln for k in ("tc", "en", "et", "frictionAngle"))
 
 
-def test_yade_normal_law_and_its_closed_form_agree_far_within_the_screen():
-    """``_en_for`` takes the closed form's side of ``target`` when it is more than
-    ``EN_SCREEN`` away: that is the integrated law's side only if the two differ by less.
-    They do, by far, at walls and between spheres over en in [1e-6, 1]."""
+@pytest.mark.parametrize("target, q", [(0.8123, 0.5), (0.3, 1.0), (0.999, 0.5)])
+def test_yade_en_search_ends_where_the_integrated_law_restitutes_the_target(target, q):
+    """The bisection (on Yade's law in closed form) ends on neighbouring numbers around the
+    ``en`` whose restitution is ``target``, at a wall (q = 1/2) and between spheres; the
+    law integrated as an ODE (:func:`vimpact.dem.laws.linear_spring_dashpot`, clipped at
+    zero force) restitutes ``target`` there to its integration error."""
     import math
 
-    import numpy as np
+    from vimpact.dem import laws, linear
 
-    from vimpact.dem import linear
-    from vimpact.reference.closed_forms import linear_model_zeta
-
-    worst = 0.0
-    for q in (0.5, 1.0):
-        for en in np.concatenate([np.geomspace(1e-6, 1.0, 16), [0.3, 0.9, 0.999999]]):
-            zeta = -math.sqrt(q) * math.log(en) / math.sqrt(math.pi**2 + linear.ln2(en))
-            e_law = yade.yade_law(1.0, float(en), 1.0, q, 3.5, tangential=False)[0]
-            worst = max(worst, abs(e_law - float(linear_model_zeta(zeta).e)))
-    assert worst < 0.1 * yade.EN_SCREEN, worst
-
-
-def test_yade_en_search_takes_the_steps_of_the_plain_bisection():
-    """The screened search ends on the very ``en`` of the bisection that solves the law at
-    every step (at a wall: q = 1/2)."""
-    target, q = 0.8123, 0.5
-
-    def e_of(en):
-        return yade.yade_law(1.0, en, 1.0, q, 3.5, tangential=False)[0]
-
-    lo, hi = 1e-6, 1.0
-    for _ in range(80):
-        mid = 0.5 * (lo + hi)
-        if mid in (lo, hi):
-            break
-        lo, hi = (mid, hi) if e_of(mid) < target else (lo, mid)
-    assert yade._en_for(target, q) == 0.5 * (lo + hi)
+    en = yade._en_for(target, q)
+    assert yade.yade_law(1.0, en, 1.0, q, 3.5, tangential=False)[0] == pytest.approx(
+        target, abs=1e-13)
+    zeta = -math.sqrt(q) * math.log(en) / math.sqrt(math.pi**2 + linear.ln2(en))
+    assert laws.linear_spring_dashpot(zeta, "force")[0] == pytest.approx(target, abs=1e-8)

@@ -79,26 +79,34 @@ def test_refresh_rewrites_outputs_and_keeps_everything_else(tmp_path):
     abbreviations (``...``) kept, prose untouched."""
     from tests.docs.refresh import refresh_file
 
-    table = "sweeps/tables/kelvin_voigt_table.parquet"
+    # a command of many output lines that takes milliseconds (the tutorial's first impact)
+    cmd = ("vimpact simulate --E 20e6 --nu 0.49 --eta 53.4077 --R 0.005 --m 0.000575959 "
+           "--vz0 1 --vx0 0.5 --tangential none")
     page = tmp_path / "page.md"
     page.write_text("\n".join([
         "Prose stays.", "",
         "1. In a list:", "",
         "   ```console",
-        f"   $ vimpact table lookup {table} --Q1 0.1 --nu 0.5",
+        f"   $ {cmd}",
         "   ...",
         "   ```", "",
+        "2. Stale in a list:", "",
+        "   ```text",
+        f"   $ {cmd}",
+        "   stale",
+        "   ```", "",
         "```text",
-        f"$ vimpact table lookup {table} --Q1 0.1 --nu 0.5",
+        f"$ {cmd}",
         "stale",
         "```", "",
         "```pycon",
         ">>> 6 * 7",
         "41",
         "```", ""]), encoding="utf-8")
-    assert len(refresh_file(page)) == 2  # the abbreviated block still matches
+    assert len(refresh_file(page)) == 3  # the abbreviated block still matches
     text = page.read_text(encoding="utf-8")
     assert text.startswith("Prose stays.\n") and "   ...\n   ```\n" in text
+    assert "\n     e_z " in text and "\n  e_z " in text  # in the list and outside it
     assert "stale" not in text and "\n>>> 6 * 7\n42\n" in text
     shell = [b for b in ex.blocks(page) if b.is_shell]
     assert all(not ex.shell_failures(b) for b in shell)

@@ -473,6 +473,8 @@ def _record_ended(live: np.ndarray, x: np.ndarray, v: np.ndarray, ux: np.ndarray
     written into ``e`` and ``wend``, and they leave ``live`` (all updated in place).
     """
     ended = live & (x <= 0.0)
+    if not ended.any():  # (most steps: nothing to record; none live: no points at all)
+        return not live.size
     e[ended] = -v[ended]
     wend[ended] = (ux - om)[ended]
     live &= ~ended
@@ -623,6 +625,48 @@ def linear_spring_dashpot(zeta: float, ends: str = "overlap", tangential=None
     y = sol.y_events[0][0]
     beta = -float(y[3]) if tangential is not None else math.nan
     return abs(float(y[1])), beta, float(sol.t_events[0][0])
+
+
+def linear_spring_dashpot_force_end(zeta: float, tangential=None) -> tuple[float, float, float]:
+    """Return :func:`linear_spring_dashpot` ``(zeta, "force", tangential)`` in closed form.
+
+    The contact ends when the force does: contact time and ``e`` of the linear model
+    (:func:`vimpact.reference.closed_forms.linear_model_zeta`,
+    docs/physics.md#linear-model); the tangential oscillator (``x'' + 2 zeta_t w_t x' +
+    w_t^2 x = 0``, ``x(0) = 0``, ``x'(0) = 1``) is linear and independent of the normal
+    one, so ``beta = -x'(t_contact)`` with
+    ``x'(t) = exp(-a t) (C - a t S)``, ``a = zeta_t w_t``, and ``C = cos(y)``,
+    ``S = sin(y) / y`` with ``y = w_t sqrt(1 - zeta_t^2) t`` below critical damping,
+    ``cosh`` and ``sinh`` of ``y = w_t sqrt(zeta_t^2 - 1) t`` above it (``C = S = 1`` at
+    it). Same arguments and units as :func:`linear_spring_dashpot`, about 50 times
+    faster; for ``zeta <= 1`` (Yade's range) within 1e-8 of its integration
+    (tests/dem/test_laws.py), whose event time has errors of about 1e-9 itself (more
+    under strong damping: 1e-5 at ``zeta = 30`` with a fast tangential oscillator).
+    """
+    from vimpact.reference.closed_forms import linear_model_zeta
+
+    z = float(zeta)
+    if not z >= 0.0:
+        raise ValueError(f"zeta = {zeta!r} is not allowed: must be >= 0")
+    ref = linear_model_zeta(z)
+    t, e = float(ref.t_star), float(ref.e)
+    if tangential is None:
+        return e, math.nan, t
+    wt, zt = (float(x) for x in tangential)
+    a = zt * wt
+    if zt < 1.0:
+        y = wt * math.sqrt((1.0 - zt) * (1.0 + zt)) * t
+        w = math.exp(-a * t) * (math.cos(y) - a * t * (math.sin(y) / y if y > 0.0 else 1.0))
+    elif zt == 1.0:
+        w = math.exp(-a * t) * (1.0 - a * t)
+    else:
+        y = wt * math.sqrt((zt - 1.0) * (zt + 1.0)) * t
+        if y < 1.0:
+            w = math.exp(-a * t) * (math.cosh(y) - a * t * (math.sinh(y) / y if y > 0.0 else 1.0))
+        else:  # exp(+-y - a t) <= 1: no overflow of cosh, sinh for strong damping
+            up, down = math.exp(y - a * t), math.exp(-y - a * t)
+            w = 0.5 * (up + down) - a * t * 0.5 * (up - down) / y
+    return e, -w, t
 
 
 def zeta_of_restitution(e: float) -> float:

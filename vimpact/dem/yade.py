@@ -68,6 +68,9 @@ def yade_law(tc: float, en: float, et: float, q: float, F: float, m: float = 1.0
              tangential: bool = True) -> tuple[float, float, float]:
     """Return what Yade's linear law restitutes: ``(e, beta, contact time)``, contact time in s.
 
+    In closed form (:func:`vimpact.dem.laws.linear_spring_dashpot_force_end`: the
+    normal force clipped at zero, the tangential spring and dashpot in stick).
+
     Parameters
     ----------
     tc : s; en, et : Yade's inputs, in (0, 1]
@@ -86,7 +89,7 @@ def yade_law(tc: float, en: float, et: float, q: float, F: float, m: float = 1.0
     if tangential:
         w_t = math.sqrt(ks * F / m)
         tan = (w_t / w0, cs * F / (2.0 * m * w_t))
-    e, beta, t = laws.linear_spring_dashpot(zeta, "force", tan)
+    e, beta, t = laws.linear_spring_dashpot_force_end(zeta, tan)
     return e, beta, t / w0
 
 
@@ -155,32 +158,14 @@ def yade_oblique_many(cases: list[dict[str, Any]], steps: int | None = None) -> 
     return np.split(beta, np.cumsum([np.size(cs["w0"]) for cs in cases])[:-1])
 
 
-#: a bound on |e| of Yade's normal law integrated (:func:`yade_law`) minus its closed form
-#: (:func:`vimpact.reference.closed_forms.linear_model_zeta`): at most 2.5e-9 apart over 200
-#: en in [1e-6, 1] at walls and between spheres (tests/dem/test_yade.py checks a sample)
-EN_SCREEN = 1e-7
-
-
 def _en_for(target: float, q: float) -> float:
     """Yade's ``en`` input for which it restitutes ``target`` (normal law only).
 
-    Bisection on ``en`` with the integrated law (:func:`yade_law`). A step whose
-    closed-form restitution lies more than :data:`EN_SCREEN` from ``target`` takes
-    the side the closed form says, which is the side the integrated law says (they
-    differ by less); only the steps closer than that solve the law. Same steps, same
-    result, about half the solves.
+    Bisection on ``en`` with Yade's law (:func:`yade_law`, in closed form) down to
+    neighbouring numbers.
     """
-    from vimpact.reference.closed_forms import linear_model_zeta
-
     def e_of(en: float) -> float:
         return yade_law(1.0, en, 1.0, q, 3.5, tangential=False)[0]
-
-    def below(en: float) -> bool:  # e_of(en) < target
-        zeta = -math.sqrt(q) * math.log(en) / math.sqrt(math.pi**2 + linear.ln2(en))
-        e = float(linear_model_zeta(zeta).e)
-        if abs(e - target) > EN_SCREEN:
-            return e < target
-        return e_of(en) < target
 
     lo, hi = 1e-6, 1.0
     if target >= 1.0:
@@ -191,7 +176,7 @@ def _en_for(target: float, q: float) -> float:
         mid = 0.5 * (lo + hi)
         if mid in (lo, hi):  # lo and hi are neighbouring numbers: no step changes them
             break
-        lo, hi = (mid, hi) if below(mid) else (lo, mid)
+        lo, hi = (mid, hi) if e_of(mid) < target else (lo, mid)
     return 0.5 * (lo + hi)
 
 
