@@ -125,6 +125,21 @@ def test_table_as_dataframe_and_kelvin_voigt_rows_in_a_standard_solid_table(tabl
         plot_figure("5.2", tmp_path / "d.png", table=[tables["fig5_2"], tables["fig5_2"]])
 
 
+def test_kelvin_voigt_curve_is_the_closed_form(tables, tmp_path, drawn):
+    """The continuum curve of fig. 5.2 (drawn at rtol 1e-8) is the closed form at its
+    default rtol 1e-12 to 1e-7, at every fourth point and the ends of the table's range
+    (rtol 1e-6 would be 1e-6 off there)."""
+    from vimpact.reference.closed_forms import kelvin_voigt_continuum
+
+    plot_figure("fig5_2", tmp_path / "a.png", table=tables["fig5_2"])
+    q1, e_z = curve(drawn[-1], "Kelvin-Voigt continuum (1-DOF ODE)")
+    kv = RestitutionTable.open(tables["fig5_2"]).data
+    assert q1[0] == kv.Q1.min() and q1[-1] == kv.Q1.max()
+    at = [*range(0, len(q1), 4), len(q1) - 1]
+    exact = kelvin_voigt_continuum(q1[at]).e_z
+    assert np.abs(e_z[at] - exact).max() < 1e-7
+
+
 def test_figure_errors(tables, tmp_path):
     with pytest.raises(ValueError, match="sweeps/fig5_2_3_kelvin_voigt_nu.toml"):
         plot_figure("fig5_2", tmp_path / "x.png")
