@@ -1,7 +1,9 @@
 """A one-chunk sweep written in row groups while it is computed (files.TableStream).
 
 The rows of a chunk of more than ``ROW_GROUP_ROWS`` rows are computed in pieces of that
-many rows and each piece is hashed and encoded on a thread while the next is computed.
+many rows and each piece is hashed and encoded on a thread while the next is computed
+(the stream itself takes pieces of any rows and encodes a row group once its rows are
+all there).
 The table must be the one written from the whole chunk, byte for byte (the same row
 groups, metadata and content hash, :mod:`tests.oracles.content_hash` row by row), and an
 interruption between pieces must leave nothing behind.
@@ -139,19 +141,35 @@ def test_table_stream_bytes_equal_write_atomic(monkeypatch, tmp_path):
     assert pq.ParquetFile(streamed).metadata.num_row_groups == 5
 
 
-def test_table_stream_refuses_a_piece_off_the_row_groups_and_keeps_the_old_file(
-        monkeypatch, tmp_path):
+@pytest.mark.parametrize("cuts", [[0, 3, 7, 8, 10, 18], [0, 9, 18], [0, 1, 2, 3, 4, 17, 18]],
+                         ids=["across_row_groups", "two_halves", "ones_then_rest"])
+def test_table_stream_joins_pieces_into_the_same_row_groups(monkeypatch, tmp_path, cuts):
+    """Pieces of any rows, across row groups: the file of the rows written whole."""
+    _pieces(monkeypatch, 4)
+    n = 18
+    table = pa.table({"row": np.arange(n), "x": np.linspace(0.0, 1.0, n),
+                      "text": pa.array(["a", None, "bc"] * 6, type=pa.string())})
+    meta = {b"vimpact.spec": b"{}"}
+    plain = tmp_path / "plain.parquet"
+    digest = files.write_atomic(table.replace_schema_metadata(meta), plain)
+    streamed = tmp_path / "streamed.parquet"
+    with files.TableStream(streamed, table.schema) as stream:
+        for lo, hi in zip(cuts[:-1], cuts[1:]):
+            stream.add(table.slice(lo, hi - lo))
+        assert stream.finish(meta) == digest == definition_hash(table)
+    assert plain.read_bytes() == streamed.read_bytes()
+    assert pq.ParquetFile(streamed).metadata.num_row_groups == 5
+
+
+def test_table_stream_closed_before_finish_keeps_the_old_file(monkeypatch, tmp_path):
     _pieces(monkeypatch, 4)
     table = pa.table({"x": np.arange(10.0)})
     path = tmp_path / "t.parquet"
     path.write_bytes(b"earlier")
-    with pytest.raises(ValueError, match="every piece but the last has 4 rows"):
+    with pytest.raises(ValueError, match="closed before finish"):
         with files.TableStream(path, table.schema) as stream:
             stream.add(table.slice(0, 3))
             stream.add(table.slice(3, 4))
-    with pytest.raises(ValueError, match="closed before finish"):
-        with files.TableStream(path, table.schema) as stream:
-            stream.add(table.slice(0, 4))
     assert path.read_bytes() == b"earlier"
     assert [p.name for p in tmp_path.iterdir()] == ["t.parquet"]  # no temporary left
 

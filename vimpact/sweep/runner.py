@@ -627,15 +627,19 @@ def _stream_one_chunk(spec: SweepSpec, parts: Path, out: Path, log, stages: Swee
     their own (one, until numba's threading layer is known to take launches from several
     threads, :data:`CONCURRENT_LAYERS`, and with one numba thread), sharing this
     thread's numba threads (two pieces on two threads: one each, so that neither waits
-    at the end of a launch for the other thread's last rows); each piece, in row order,
-    is hashed and encoded into the table on other threads while the next ones are
-    computed (:func:`vimpact.sweep.store.combine` ``pieces``): the same
-    table, byte for byte, as written from the whole chunk. No part: an interruption
-    keeps nothing, as for one chunk written whole (the pieces in flight are finished
-    first). ``timings``: ``kernel_s`` and ``total_s`` summed over the pieces (pieces
-    side by side: more than the wall time they took); ``pieces_wall_s`` the wall time
-    spent waiting for the pieces (with their tables); ``write_s`` the time spent writing
-    that the computation did not cover.
+    at the end of a launch for the other thread's last rows), as many again queued
+    behind them, so that a thread that finishes its piece takes the next at once (not
+    after the pieces before it are taken); each piece, in row order, is hashed and
+    encoded into the table on other threads while the next ones are computed
+    (:func:`vimpact.sweep.store.combine` ``pieces``): the same table, byte for byte, as
+    written from the whole chunk. Finer pieces (half a row group, or a quarter of the
+    last, for a shorter tail once the kernels end) cost more CPU (the fixed Python and
+    hashing of every piece) than their shorter tail saved on 2 cores. No part: an
+    interruption keeps nothing, as for one chunk written whole (the pieces running are
+    finished first, the ones queued are not started). ``timings``: ``kernel_s`` and
+    ``total_s`` summed over the pieces (pieces side by side: more than the wall time
+    they took); ``pieces_wall_s`` the wall time spent waiting for the pieces (with their
+    tables); ``write_s`` the time spent writing that the computation did not cover.
     """
     from collections import deque
     from concurrent.futures import ThreadPoolExecutor
@@ -660,20 +664,25 @@ def _stream_one_chunk(spec: SweepSpec, parts: Path, out: Path, log, stages: Swee
         t0 = time.perf_counter()
         todo = deque(bounds)
         running: deque = deque()
-        while todo or running:
-            limit = min(PIECES_IN_FLIGHT, threads) if _launches_side_by_side() else 1
-            while todo and len(running) < limit:  # the threads shared between the pieces
-                running.append((todo[0], pool.submit(piece, *todo.popleft(),
-                                                     max(1, threads // limit))))
-            (lo, hi), future = running.popleft()
-            table, summary, own = future.result()
-            for key, value in own.items():
-                if timings is not None:
-                    timings[key] = timings.get(key, 0.0) + value
-            inside += time.perf_counter() - t0
-            yield table, summary
-            bar.update(hi - lo)
-            t0 = time.perf_counter()
+        try:
+            while todo or running:
+                limit = min(PIECES_IN_FLIGHT, threads) if _launches_side_by_side() else 1
+                ahead = 2 * limit if limit > 1 else 1  # (the pool runs `limit` of them)
+                while todo and len(running) < ahead:  # the threads shared between the pieces
+                    running.append((todo[0], pool.submit(piece, *todo.popleft(),
+                                                         max(1, threads // limit))))
+                (lo, hi), future = running.popleft()
+                table, summary, own = future.result()
+                for key, value in own.items():
+                    if timings is not None:
+                        timings[key] = timings.get(key, 0.0) + value
+                inside += time.perf_counter() - t0
+                yield table, summary
+                bar.update(hi - lo)
+                t0 = time.perf_counter()
+        finally:
+            for _, future in running:  # queued, not started: never started
+                future.cancel()
 
     t0 = time.perf_counter()
     with ThreadPoolExecutor(PIECES_IN_FLIGHT) as pool:
