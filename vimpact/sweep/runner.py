@@ -629,7 +629,8 @@ def _stream_one_chunk(spec: SweepSpec, parts: Path, out: Path, log, stages: Swee
     thread's numba threads (two pieces on two threads: one each, so that neither waits
     at the end of a launch for the other thread's last rows), as many again queued
     behind them, so that a thread that finishes its piece takes the next at once (not
-    after the pieces before it are taken); each piece, in row order, is hashed and
+    after the pieces before it are taken), the first ones while the table's file and
+    writer are set up; each piece, in row order, is hashed and
     encoded into the table on other threads while the next ones are computed
     (:func:`vimpact.sweep.store.combine` ``pieces``): the same table, byte for byte, as
     written from the whole chunk. Finer pieces (half a row group, or a quarter of the
@@ -659,38 +660,41 @@ def _stream_one_chunk(spec: SweepSpec, parts: Path, out: Path, log, stages: Swee
         table = compute_chunk(spec, 0, own, (lo, hi), params)
         return table, chunk_summary(table), own
 
+    todo = deque(bounds)
+    running: deque = deque()  # ((lo, hi), future) of the pieces submitted, in row order
+
+    def submit(pool) -> None:
+        limit = min(PIECES_IN_FLIGHT, threads) if _launches_side_by_side() else 1
+        ahead = 2 * limit if limit > 1 else 1  # (the pool runs `limit` of them)
+        while todo and len(running) < ahead:  # the threads shared between the pieces
+            running.append((todo[0], pool.submit(piece, *todo.popleft(),
+                                                 max(1, threads // limit))))
+
     def pieces(pool):
         nonlocal inside
         t0 = time.perf_counter()
-        todo = deque(bounds)
-        running: deque = deque()
-        try:
-            while todo or running:
-                limit = min(PIECES_IN_FLIGHT, threads) if _launches_side_by_side() else 1
-                ahead = 2 * limit if limit > 1 else 1  # (the pool runs `limit` of them)
-                while todo and len(running) < ahead:  # the threads shared between the pieces
-                    running.append((todo[0], pool.submit(piece, *todo.popleft(),
-                                                         max(1, threads // limit))))
-                (lo, hi), future = running.popleft()
-                table, summary, own = future.result()
-                for key, value in own.items():
-                    if timings is not None:
-                        timings[key] = timings.get(key, 0.0) + value
-                inside += time.perf_counter() - t0
-                yield table, summary
-                bar.update(hi - lo)
-                t0 = time.perf_counter()
-        finally:
-            for _, future in running:  # queued, not started: never started
-                future.cancel()
+        while todo or running:
+            submit(pool)
+            (lo, hi), future = running.popleft()
+            table, summary, own = future.result()
+            for key, value in own.items():
+                if timings is not None:
+                    timings[key] = timings.get(key, 0.0) + value
+            inside += time.perf_counter() - t0
+            yield table, summary
+            bar.update(hi - lo)
+            t0 = time.perf_counter()
 
     t0 = time.perf_counter()
     with ThreadPoolExecutor(PIECES_IN_FLIGHT) as pool:
+        submit(pool)  # the first pieces start while the table's file and writer are made
         made = pieces(pool)
         try:
             _combine(spec, parts, out, log, stages, pieces=made)
         finally:
             made.close()  # (an error or an interruption: no piece is started after it)
+            for _, future in running:  # queued, not started: never started
+                future.cancel()
     if timings is not None:
         timings["write_s"] = timings.get("write_s", 0.0) + time.perf_counter() - t0 - inside
         timings["pieces_wall_s"] = timings.get("pieces_wall_s", 0.0) + inside
