@@ -105,7 +105,8 @@ def run_batch(spec: SweepSpec, scene_cols: dict, timings: dict | None = None) ->
 
 
 def compute_chunk(spec: SweepSpec, chunk: int, timings: dict | None = None,
-                  part: tuple[int, int] | None = None, params: dict | None = None):
+                  part: tuple[int, int] | None = None, params: dict | None = None,
+                  summary: dict | None = None):
     """Simulate the rows of ``chunk`` and return them as a ``pyarrow`` table.
 
     ``part``: ``(lo, hi)``, only the chunk's rows ``lo`` to ``hi - 1`` (counted from its
@@ -121,6 +122,8 @@ def compute_chunk(spec: SweepSpec, chunk: int, timings: dict | None = None,
     NaN outputs and a message in ``error``.
     ``timings`` (a dict) receives ``kernel_s`` (s in the kernels) and ``total_s`` (s
     in the engine: validation, routing, kernels, results) summed over calls.
+    ``summary`` (a dict) receives :func:`chunk_summary` of the table, counted from the
+    status and path codes (no string compared).
     """
     import pyarrow as pa
 
@@ -211,6 +214,8 @@ def compute_chunk(spec: SweepSpec, chunk: int, timings: dict | None = None,
         vc0 = inputs["v_x0_m_s"]
     guard_nan(cols, status, error, (vc0 == 0.0) | (spec.tangential == "none"),
               finished_codes(status))
+    if summary is not None:
+        summary.update(_coded_summary(status, path, path_names, start))
     labels = {"model": _repeated(inputs["model"], n),
               "path": _decoded(path, path_names), "status": _decoded(status, STATUS_NAMES),
               "error": pa.array(error, type=pa.string())}
@@ -218,6 +223,26 @@ def compute_chunk(spec: SweepSpec, chunk: int, timings: dict | None = None,
     arrays = [labels[c] if c in labels else pa.array(cols[c], type=f.type)
               for c, f in zip(spec.columns(), schema)]
     return pa.Table.from_arrays(arrays, schema=schema)
+
+
+def _coded_summary(status: np.ndarray, path: np.ndarray, path_names: list[str],
+                   start: int) -> dict:
+    """Return :func:`chunk_summary` of rows ``start, start + 1, ...`` from their codes.
+
+    ``status``: codes into :data:`~vimpact.engine.result.STATUS_NAMES`; ``path``: codes
+    into ``path_names`` (``-1``: none). The same dict as from the table's text columns.
+    """
+    from vimpact.engine.result import STATUS_NAMES
+
+    counts = np.bincount(status.astype(np.intp), minlength=len(STATUS_NAMES))
+    per_status = {STATUS_NAMES[c]: int(counts[c]) for c in np.flatnonzero(counts)}
+    per_path = {}
+    if len(path_names):
+        rows = np.bincount(path.astype(np.intp) + 1, minlength=len(path_names) + 1)[1:]
+        for c in np.flatnonzero(rows):
+            per_path[path_names[c]] = {"rows": int(rows[c]),
+                                       "first_row": start + int(np.argmax(path == c))}
+    return {"counts": dict(sorted(per_status.items())), "paths": dict(sorted(per_path.items()))}
 
 
 def _decoded(codes: np.ndarray, names):
@@ -322,8 +347,8 @@ def explain_paths(spec: SweepSpec, first_rows: dict[str, int]) -> dict[str, list
 
 def run_chunk(spec: SweepSpec, chunk: int, parts: str) -> dict:
     """Compute ``chunk``, write its part file atomically, return its summary (a task)."""
-    table = compute_chunk(spec, chunk)
-    summary = chunk_summary(table)
+    summary: dict = {}
+    table = compute_chunk(spec, chunk, summary=summary)
     store.write_part(spec, table, Path(parts), chunk, summary)
     start, stop = spec.chunk_rows(chunk)
     return {"chunk": chunk, "rows": stop - start, **summary}
@@ -564,8 +589,8 @@ def _run(spec, spec_path, out, parts, resume, progress, workers, scheduler, shar
                 bar.close()
                 return out
             for chunk in todo:
-                table = compute_chunk(spec, chunk, timings)
-                summary = chunk_summary(table)
+                summary: dict = {}
+                table = compute_chunk(spec, chunk, timings, summary=summary)
                 t0 = time.perf_counter()
                 own = None  # a part's hash and the table's from one canonical form
                 if fresh is not None:
@@ -657,8 +682,9 @@ def _stream_one_chunk(spec: SweepSpec, parts: Path, out: Path, log, stages: Swee
     def piece(lo: int, hi: int, own_threads: int):
         numba.set_num_threads(own_threads)
         own: dict = {}
-        table = compute_chunk(spec, 0, own, (lo, hi), params)
-        return table, chunk_summary(table), own
+        summary: dict = {}
+        table = compute_chunk(spec, 0, own, (lo, hi), params, summary)
+        return table, summary, own
 
     todo = deque(bounds)
     running: deque = deque()  # ((lo, hi), future) of the pieces submitted, in row order
