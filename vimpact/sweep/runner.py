@@ -348,7 +348,7 @@ def explain_paths(spec: SweepSpec, first_rows: dict[str, int]) -> dict[str, list
 def run_chunk(spec: SweepSpec, chunk: int, parts: str) -> dict:
     """Compute ``chunk``, write its part file atomically, return its summary (a task)."""
     summary: dict = {}
-    table = compute_chunk(spec, chunk, summary=summary)
+    table = compute_chunk(spec, chunk, None, None, None, summary)
     store.write_part(spec, table, Path(parts), chunk, summary)
     start, stop = spec.chunk_rows(chunk)
     return {"chunk": chunk, "rows": stop - start, **summary}
@@ -590,7 +590,7 @@ def _run(spec, spec_path, out, parts, resume, progress, workers, scheduler, shar
                 return out
             for chunk in todo:
                 summary: dict = {}
-                table = compute_chunk(spec, chunk, timings, summary=summary)
+                table = compute_chunk(spec, chunk, timings, None, None, summary)
                 t0 = time.perf_counter()
                 own = None  # a part's hash and the table's from one canonical form
                 if fresh is not None:
@@ -788,11 +788,15 @@ def seconds_per_row(spec: SweepSpec, probe_chunks: int = 8,
     part of the time taken. Returns the wall time per row of the last batch and its rows.
     A first batch whose time per row is at most ``enough`` (s) is the answer: with the
     batch's fixed cost in it, the true cost is lower still (what a caller that only
-    asks "at most this?" needs).
+    asks "at most this?" needs); such a batch runs before the kernels are warmed (a
+    compilation in it would only have made it slower), which it then spares when they
+    were loaded already.
     """
     from vimpact.sweep.parameters import engine_columns
 
-    warm_kernels(spec)
+    warm = enough <= 0.0  # (with `enough`: the first batch first, warmed only if too slow)
+    if warm:
+        warm_kernels(spec)
     per_place = 8
     most = max(8, -(-PROBE_ROWS // probe_chunks))
     while True:
@@ -809,8 +813,13 @@ def seconds_per_row(spec: SweepSpec, probe_chunks: int = 8,
             except Exception:  # noqa: BLE001 - the chunk will record it
                 pass
         took = timings.get("total_s", 0.0)
-        if took >= PROBE_SECONDS or rows >= min(PROBE_ROWS, spec.rows) or per_place >= most \
-                or took <= enough * rows:
+        if took <= enough * rows:
+            return max(took, 1e-9) / max(rows, 1), rows
+        if not warm:  # a compilation may be in it: the same rows again, warm
+            warm_kernels(spec)
+            warm = True
+            continue
+        if took >= PROBE_SECONDS or rows >= min(PROBE_ROWS, spec.rows) or per_place >= most:
             return max(took, 1e-9) / max(rows, 1), rows
         # straight to the rows that take PROBE_SECONDS at this cost (a tenth more)
         per_place = min(most, max(2 * per_place,
