@@ -227,34 +227,6 @@ def test_the_probe_of_a_sweep_that_is_surely_one_chunk_stops_at_its_first_batch(
     assert two["probe_rows"] > 64 and two["probe_rows"] * 1e-4 + 1e-3 >= runner.PROBE_SECONDS
 
 
-def test_the_first_probe_batch_of_a_one_chunk_sweep_runs_before_the_kernels_are_warmed(
-        tmp_path, monkeypatch):
-    """A first batch cheap enough is the answer (no warm-up); one slowed by a
-    compilation (its first call 10 s here) is measured again once the kernels are
-    warmed, without it."""
-    warmed, calls = [], []
-
-    def engine(spec, cols, timings=None):
-        calls.append(len(cols["nu"]))
-        if timings is not None:
-            slow = 10.0 if len(calls) == 1 and compiles else 0.0
-            timings["total_s"] = timings.get("total_s", 0.0) + slow + 1e-4 * len(cols["nu"])
-        return {}
-
-    monkeypatch.setattr(runner, "run_batch", engine)
-    monkeypatch.setattr(runner, "warm_kernels", lambda spec: warmed.append(1))
-    spec = load_spec(write(tmp_path, GRID.format(chunk="").replace("num = 20", "num = 1000")))
-    compiles = False
-    one = runner.choose_chunk_size(spec)
-    assert (warmed, calls, one["probe_rows"]) == ([], [64], 64)
-    assert one["seconds_per_row"] == pytest.approx(1e-4) and one["chunk_size"] == 2000
-    calls.clear()
-    compiles = True
-    again = runner.choose_chunk_size(spec)
-    assert (warmed, calls) == ([1], [64, 64])
-    assert again["seconds_per_row"] == pytest.approx(1e-4) and again["chunk_size"] == 2000
-
-
 def test_workers_on_a_small_sweep_says_so(tmp_path, monkeypatch, capsys):
     """One stderr line, then the run goes on as asked (here the cluster is replaced
     by running the chunks in process)."""

@@ -788,15 +788,11 @@ def seconds_per_row(spec: SweepSpec, probe_chunks: int = 8,
     part of the time taken. Returns the wall time per row of the last batch and its rows.
     A first batch whose time per row is at most ``enough`` (s) is the answer: with the
     batch's fixed cost in it, the true cost is lower still (what a caller that only
-    asks "at most this?" needs); such a batch runs before the kernels are warmed (a
-    compilation in it would only have made it slower), which it then spares when they
-    were loaded already.
+    asks "at most this?" needs).
     """
     from vimpact.sweep.parameters import engine_columns
 
-    warm = enough <= 0.0  # (with `enough`: the first batch first, warmed only if too slow)
-    if warm:
-        warm_kernels(spec)
+    warm_kernels(spec)
     per_place = 8
     most = max(8, -(-PROBE_ROWS // probe_chunks))
     while True:
@@ -813,13 +809,8 @@ def seconds_per_row(spec: SweepSpec, probe_chunks: int = 8,
             except Exception:  # noqa: BLE001 - the chunk will record it
                 pass
         took = timings.get("total_s", 0.0)
-        if took <= enough * rows:
-            return max(took, 1e-9) / max(rows, 1), rows
-        if not warm:  # a compilation may be in it: the same rows again, warm
-            warm_kernels(spec)
-            warm = True
-            continue
-        if took >= PROBE_SECONDS or rows >= min(PROBE_ROWS, spec.rows) or per_place >= most:
+        if took >= PROBE_SECONDS or rows >= min(PROBE_ROWS, spec.rows) or per_place >= most \
+                or took <= enough * rows:
             return max(took, 1e-9) / max(rows, 1), rows
         # straight to the rows that take PROBE_SECONDS at this cost (a tenth more)
         per_place = min(most, max(2 * per_place,
