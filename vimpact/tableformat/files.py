@@ -292,12 +292,11 @@ class TableStream:
     one encodes a row group into the file as soon as its :data:`ROW_GROUP_ROWS` rows are
     all there (its pieces joined: the same bytes as the rows added in one piece) and puts
     it on the disk (``fdatasync``: the fsync of the finished file, after the last rows,
-    has only the last row group and the footer left: for the default 1e5-row sweep
-    table, the close, fsync and rename after the last rows took 0.9 ms instead of 2.3
-    ms, medians side by side). The
-    caller computes the next pieces while these are written, and the pieces wait in
-    memory when the writing lags (at most the rows of the table, which the caller holds
-    anyway). ``finish(metadata)`` writes the
+    has only the last row group and the footer left; for the default 1e5-row sweep
+    table the close, fsync and rename after the last rows took 0.9 ms instead of 2.3
+    ms, medians side by side). The caller computes the next pieces while these are
+    written, and the pieces wait in memory when the writing lags (at most the rows of
+    the table, which the caller holds anyway). ``finish(metadata)`` writes the
     footer with the table's key-value ``metadata``, the content hash of all the pieces
     and the metadata hash (:func:`_footer`) and returns the content hash; the file then
     replaces ``path`` atomically when the ``with`` block ends (:func:`atomic_file`). An
