@@ -196,6 +196,27 @@ def test_interruption_between_pieces_keeps_nothing_and_runs_again(monkeypatch, t
     assert out.read_bytes() == clean.read_bytes()
 
 
+def test_an_interruption_starts_no_piece_beyond_the_ones_queued(monkeypatch, tmp_path):
+    """Pieces run and queued ahead (at most twice the pieces side by side) may finish;
+    none is submitted after the interruption: the last piece is never computed."""
+    _pieces(monkeypatch)
+    spec = write(tmp_path, GRID.format(tangential="none"))
+    real, parts = runner.compute_chunk, []
+
+    def recorded(*args):
+        parts.append(args[3])
+        return real(*args)
+
+    def interrupt(done, total):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(runner, "compute_chunk", recorded)
+    with pytest.raises(SweepInterrupted):
+        run_sweep(spec, out=tmp_path / "t.parquet", progress=interrupt)
+    assert 1 <= len(parts) <= 2 * runner.PIECES_IN_FLIGHT and (20, 24) not in parts
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["spec.toml"]
+
+
 def test_disk_full_while_streaming_keeps_nothing(monkeypatch, tmp_path):
     _pieces(monkeypatch)
     spec = write(tmp_path, GRID.format(tangential="none"))
