@@ -235,6 +235,23 @@ def test_a_part_of_a_chunk_outside_it_is_refused(tmp_path):
             runner.compute_chunk(spec, 0, None, part)
 
 
+@pytest.mark.parametrize("text", [GRID.format(tangential="none"), RANDOM],
+                         ids=["grid", "random"])
+def test_a_parts_parameter_sets_are_the_chunks_there(tmp_path, text):
+    """A part's parameter sets, made for its rows (a grid) or cut from the chunk's
+    draws (random): the chunk's values in those rows, bit for bit."""
+    spec = load_spec(write(tmp_path, text))
+    whole = spec.chunk_parameters(0)
+    n = len(whole["nu"])
+    for lo, hi in ((0, n), (0, 1), (3, 11), (n - 2, n)):
+        part = spec.chunk_parameters(0, (lo, hi))
+        assert part.keys() == whole.keys()
+        for k, v in whole.items():
+            assert part[k].tobytes() == v[lo:hi].tobytes(), (k, lo, hi)
+    with pytest.raises(ValueError, match=r"part = \(5, 5\) is not allowed"):
+        spec.chunk_parameters(0, (5, 5))
+
+
 @pytest.mark.parametrize("threads", [1, 2])
 def test_pieces_share_the_numba_threads(monkeypatch, tmp_path, threads):
     """On two numba threads two pieces run side by side, one thread each (once the
