@@ -269,3 +269,25 @@ def test_chunk_summary_counts_as_numpy_does():
     assert list(got["paths"].items()) == [
         (str(lab), {"rows": int(c), "first_row": int(rows[has][f])})
         for lab, f, c in zip(labels, first, count)]
+
+
+@pytest.mark.parametrize("text", ["grid_oblique", "random_with_invalid"])
+def test_summary_from_the_codes_is_the_tables(tmp_path, text):
+    """compute_chunk's summary, counted from its status and path codes, against
+    chunk_summary of the table it returns (whole chunks and parts of them)."""
+    from tests.sweep.test_pipelined import GRID, RANDOM
+
+    name, text = text, {"grid_oblique": GRID.format(tangential="auto"),
+            # nu beyond 0.5 in some rows: invalid rows, with no path
+            "random_with_invalid": RANDOM.replace("nu = [0.0, 0.5]", "nu = [0.3, 0.7]")}[text]
+    spec = load_spec(write(tmp_path, text))
+    seen = set()
+    for chunk in range(spec.n_chunks):
+        start, stop = spec.chunk_rows(chunk)
+        for part in (None, (1, stop - start)):
+            summary: dict = {}
+            table = runner.compute_chunk(spec, chunk, None, part, None, summary)
+            assert summary == runner.chunk_summary(table)
+            seen |= set(summary["counts"])
+    if name == "random_with_invalid":  # rows without a path, several statuses
+        assert "invalid" in seen and len(seen) > 1

@@ -17,6 +17,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 import pyarrow as pa
 import pyarrow.parquet as pq
@@ -97,6 +98,46 @@ def test_content_hash_follows_its_definition_with_and_without_nulls():
     two_chunks = pa.concat_tables([table.slice(0, 3), table.slice(3)])
     for t in (table, two_chunks, table.slice(2, 4), two_chunks.slice(1, 5), table.slice(7)):
         assert integrity.content_hash(t) == definition_hash(t)
+
+
+@pytest.mark.parametrize("shared_rows", [1, 4, 10**9], ids=["always", "mixed", "never"])
+def test_content_hash_of_equal_columns_hashed_once_follows_its_definition(monkeypatch,
+                                                                          shared_rows):
+    """Streams fed the same bytes are hashed once and copied: columns equal throughout
+    (zeros, NaN, a repeated string), equal in the first rows only, equal from a later
+    piece on after differing before, a NaN of another payload, the same values in int64
+    and float64 bytes, nulls in one of two otherwise equal columns; hashed whole, in
+    pieces cut in several ways (pieces below ``SHARED_STREAM_ROWS`` rows fed stream by
+    stream between shared ones), and as two hashes at once: the definition's digest."""
+    monkeypatch.setattr(integrity, "SHARED_STREAM_ROWS", shared_rows)
+    n = 12
+    zeros, nan = np.zeros(n), np.full(n, np.nan)
+    other_nan = nan.view(np.uint64).copy()
+    other_nan[5] |= 1  # another NaN payload in one row: other bytes
+    later = np.where(np.arange(n) < 5, np.arange(n, dtype=float), 0.0)  # = zeros from row 5
+    first = np.where(np.arange(n) < 7, 0.0, 1.0)  # = zeros in rows 0..6 only
+    short = np.where(np.arange(n) < 3, np.arange(n) + 1.0, 0.0)  # = zeros from row 3
+    table = pa.table({
+        "a": zeros, "b": zeros.copy(), "c": nan, "d": nan.copy(),
+        "e": other_nan.view(np.float64), "f": later, "g": first, "h": later.copy(),
+        "k": short,
+        "i": pa.array(np.zeros(n, dtype=np.int64)), "j": pa.array([0.0] * 11 + [None]),
+        "s": pa.array(["ok"] * n, pa.string()), "t": pa.array(["ok"] * n, pa.string()),
+        "u": pa.array(["ok"] * 6 + [None] * 6, pa.string()),
+        "w": pa.array([None] * n, pa.string())})
+    digest = definition_hash(table)
+    assert integrity.content_hash(table) == digest
+    for cuts in ([0, 5, n], [0, 3, 7, 8, n], list(range(n + 1)), [0, 7, n], [0, 3, n]):
+        pieces, also = integrity.ContentHash(), integrity.ContentHash()
+        for lo, hi in zip(cuts[:-1], cuts[1:]):
+            pieces.update(table.slice(lo, hi - lo), also=also if lo else None)
+        assert pieces.hexdigest() == digest, cuts
+        assert also.hexdigest() == definition_hash(table.slice(cuts[1])), cuts
+    # the same digest on several hashing threads (streams fed side by side)
+    monkeypatch.setattr(integrity, "PARALLEL_HASH_BYTES", 0)
+    assert integrity._hash_threads(1) > 1 or integrity.MAX_HASH_THREADS == 1 \
+        or len(integrity.os.sched_getaffinity(0)) == 1
+    assert integrity.ContentHash().update(table, threads=4).hexdigest() == digest
 
 
 @pytest.mark.parametrize("change", ["value", "nan payload", "null", "string", "name", "order"])

@@ -1,7 +1,9 @@
 """A one-chunk sweep written in row groups while it is computed (files.TableStream).
 
 The rows of a chunk of more than ``ROW_GROUP_ROWS`` rows are computed in pieces of that
-many rows and each piece is hashed and encoded on a thread while the next is computed.
+many rows and each piece is hashed and encoded on a thread while the next is computed
+(the stream itself takes pieces of any rows and encodes a row group once its rows are
+all there).
 The table must be the one written from the whole chunk, byte for byte (the same row
 groups, metadata and content hash, :mod:`tests.oracles.content_hash` row by row), and an
 interruption between pieces must leave nothing behind.
@@ -139,19 +141,35 @@ def test_table_stream_bytes_equal_write_atomic(monkeypatch, tmp_path):
     assert pq.ParquetFile(streamed).metadata.num_row_groups == 5
 
 
-def test_table_stream_refuses_a_piece_off_the_row_groups_and_keeps_the_old_file(
-        monkeypatch, tmp_path):
+@pytest.mark.parametrize("cuts", [[0, 3, 7, 8, 10, 18], [0, 9, 18], [0, 1, 2, 3, 4, 17, 18]],
+                         ids=["across_row_groups", "two_halves", "ones_then_rest"])
+def test_table_stream_joins_pieces_into_the_same_row_groups(monkeypatch, tmp_path, cuts):
+    """Pieces of any rows, across row groups: the file of the rows written whole."""
+    _pieces(monkeypatch, 4)
+    n = 18
+    table = pa.table({"row": np.arange(n), "x": np.linspace(0.0, 1.0, n),
+                      "text": pa.array(["a", None, "bc"] * 6, type=pa.string())})
+    meta = {b"vimpact.spec": b"{}"}
+    plain = tmp_path / "plain.parquet"
+    digest = files.write_atomic(table.replace_schema_metadata(meta), plain)
+    streamed = tmp_path / "streamed.parquet"
+    with files.TableStream(streamed, table.schema) as stream:
+        for lo, hi in zip(cuts[:-1], cuts[1:]):
+            stream.add(table.slice(lo, hi - lo))
+        assert stream.finish(meta) == digest == definition_hash(table)
+    assert plain.read_bytes() == streamed.read_bytes()
+    assert pq.ParquetFile(streamed).metadata.num_row_groups == 5
+
+
+def test_table_stream_closed_before_finish_keeps_the_old_file(monkeypatch, tmp_path):
     _pieces(monkeypatch, 4)
     table = pa.table({"x": np.arange(10.0)})
     path = tmp_path / "t.parquet"
     path.write_bytes(b"earlier")
-    with pytest.raises(ValueError, match="every piece but the last has 4 rows"):
+    with pytest.raises(ValueError, match="closed before finish"):
         with files.TableStream(path, table.schema) as stream:
             stream.add(table.slice(0, 3))
             stream.add(table.slice(3, 4))
-    with pytest.raises(ValueError, match="closed before finish"):
-        with files.TableStream(path, table.schema) as stream:
-            stream.add(table.slice(0, 4))
     assert path.read_bytes() == b"earlier"
     assert [p.name for p in tmp_path.iterdir()] == ["t.parquet"]  # no temporary left
 
@@ -178,6 +196,27 @@ def test_interruption_between_pieces_keeps_nothing_and_runs_again(monkeypatch, t
     assert out.read_bytes() == clean.read_bytes()
 
 
+def test_an_interruption_starts_no_piece_beyond_the_ones_queued(monkeypatch, tmp_path):
+    """Pieces run and queued ahead (at most twice the pieces side by side) may finish;
+    none is submitted after the interruption: the last piece is never computed."""
+    _pieces(monkeypatch)
+    spec = write(tmp_path, GRID.format(tangential="none"))
+    real, parts = runner.compute_chunk, []
+
+    def recorded(*args):
+        parts.append(args[3])
+        return real(*args)
+
+    def interrupt(done, total):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(runner, "compute_chunk", recorded)
+    with pytest.raises(SweepInterrupted):
+        run_sweep(spec, out=tmp_path / "t.parquet", progress=interrupt)
+    assert 1 <= len(parts) <= 2 * runner.PIECES_IN_FLIGHT and (20, 24) not in parts
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["spec.toml"]
+
+
 def test_disk_full_while_streaming_keeps_nothing(monkeypatch, tmp_path):
     _pieces(monkeypatch)
     spec = write(tmp_path, GRID.format(tangential="none"))
@@ -194,6 +233,23 @@ def test_a_part_of_a_chunk_outside_it_is_refused(tmp_path):
     for part in ((0, 0), (5, 4), (-1, 3), (20, 25)):
         with pytest.raises(ValueError, match=r"part = .* is not allowed: must be rows"):
             runner.compute_chunk(spec, 0, None, part)
+
+
+@pytest.mark.parametrize("text", [GRID.format(tangential="none"), RANDOM],
+                         ids=["grid", "random"])
+def test_a_parts_parameter_sets_are_the_chunks_there(tmp_path, text):
+    """A part's parameter sets, made for its rows (a grid) or cut from the chunk's
+    draws (random): the chunk's values in those rows, bit for bit."""
+    spec = load_spec(write(tmp_path, text))
+    whole = spec.chunk_parameters(0)
+    n = len(whole["nu"])
+    for lo, hi in ((0, n), (0, 1), (3, 11), (n - 2, n)):
+        part = spec.chunk_parameters(0, (lo, hi))
+        assert part.keys() == whole.keys()
+        for k, v in whole.items():
+            assert part[k].tobytes() == v[lo:hi].tobytes(), (k, lo, hi)
+    with pytest.raises(ValueError, match=r"part = \(5, 5\) is not allowed"):
+        spec.chunk_parameters(0, (5, 5))
 
 
 @pytest.mark.parametrize("threads", [1, 2])

@@ -46,16 +46,29 @@ def chunk_generator(seed: int, chunk: int) -> np.random.Generator:
     return np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(chunk,)))
 
 
-def chunk_parameters(spec, chunk: int) -> dict[str, np.ndarray]:
+def chunk_parameters(spec, chunk: int, part: tuple[int, int] | None = None
+                     ) -> dict[str, np.ndarray]:
     """Return the parameter sets of ``chunk`` of ``spec``: one array per input.
 
     Grid mode: the axis values of rows ``chunk_rows(chunk)``. Random mode: the
     drawn physical inputs, ``G_arm<i>_Pa`` and ``tau_arm<i>_s`` for Prony arms.
+    ``part``: ``(lo, hi)``, only the chunk's rows ``lo`` to ``hi - 1`` (counted from its
+    first row, ``0 <= lo < hi <=`` its rows): the same values as the chunk's there (a
+    grid's made for those rows only; a random chunk's drawn whole, then cut: its draws
+    follow each other).
     """
     if not 0 <= chunk < spec.n_chunks:
         raise ValueError(f"chunk = {chunk} is not allowed: must be in [0, {spec.n_chunks - 1}]")
     start, stop = spec.chunk_rows(chunk)
     n = stop - start
+    if part is not None:
+        lo, hi = part
+        if not 0 <= lo < hi <= n:
+            raise ValueError(f"part = {part!r} is not allowed: must be rows (lo, hi) with "
+                             f"0 <= lo < hi <= {n} of chunk {chunk}")
+        if spec.mode != "grid":
+            return {k: v[lo:hi] for k, v in chunk_parameters(spec, chunk).items()}
+        start, stop = start + lo, start + hi
     if spec.mode == "grid":
         names = list(spec.axes)
         shape = tuple(len(spec.axes[k]) for k in names)

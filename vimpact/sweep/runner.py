@@ -105,13 +105,15 @@ def run_batch(spec: SweepSpec, scene_cols: dict, timings: dict | None = None) ->
 
 
 def compute_chunk(spec: SweepSpec, chunk: int, timings: dict | None = None,
-                  part: tuple[int, int] | None = None, params: dict | None = None):
+                  part: tuple[int, int] | None = None, params: dict | None = None,
+                  summary: dict | None = None):
     """Simulate the rows of ``chunk`` and return them as a ``pyarrow`` table.
 
     ``part``: ``(lo, hi)``, only the chunk's rows ``lo`` to ``hi - 1`` (counted from its
     first row): the same rows as the whole chunk's table has there (a row's results do
     not depend on the other rows). ``params``: the chunk's parameter sets
-    (:meth:`~vimpact.sweep.spec.SweepSpec.chunk_parameters`, made once for its parts).
+    (:meth:`~vimpact.sweep.spec.SweepSpec.chunk_parameters`, made once for its parts;
+    made here if ``None``, of a part's rows only).
 
     Columnar: the chunk's parameters (:mod:`vimpact.sweep.parameters`) become scene
     columns of the engine (:func:`run_batch`: what :func:`vimpact.simulate_batch` runs,
@@ -121,6 +123,8 @@ def compute_chunk(spec: SweepSpec, chunk: int, timings: dict | None = None,
     NaN outputs and a message in ``error``.
     ``timings`` (a dict) receives ``kernel_s`` (s in the kernels) and ``total_s`` (s
     in the engine: validation, routing, kernels, results) summed over calls.
+    ``summary`` (a dict) receives :func:`chunk_summary` of the table, counted from the
+    status and path codes (no string compared).
     """
     import pyarrow as pa
 
@@ -129,16 +133,17 @@ def compute_chunk(spec: SweepSpec, chunk: int, timings: dict | None = None,
     from vimpact.sweep.parameters import engine_columns
 
     start, stop = spec.chunk_rows(chunk)
-    if params is None:
-        params = spec.chunk_parameters(chunk)
-    if part is not None:
+    if params is None:  # (of the part's rows only, if a part)
+        params = spec.chunk_parameters(chunk, part)
+    elif part is not None:
         lo, hi = part
         if not 0 <= lo < hi <= stop - start:
             raise ValueError(f"part = {part!r} is not allowed: must be rows (lo, hi) with "
                              f"0 <= lo < hi <= {stop - start} of chunk {chunk}")
         views: dict[int, np.ndarray] = {}  # one array of several inputs: one view of it
         params = {k: views.setdefault(id(v), v[lo:hi]) for k, v in params.items()}
-        start, stop = start + lo, start + hi
+    if part is not None:
+        start, stop = start + part[0], start + part[1]
     n = stop - start
     batches, inputs = engine_columns(spec, params)
     outputs = RESULTS | (ADHESION_RESULTS if spec.has_adhesion else {})
@@ -211,6 +216,8 @@ def compute_chunk(spec: SweepSpec, chunk: int, timings: dict | None = None,
         vc0 = inputs["v_x0_m_s"]
     guard_nan(cols, status, error, (vc0 == 0.0) | (spec.tangential == "none"),
               finished_codes(status))
+    if summary is not None:
+        summary.update(_coded_summary(status, path, path_names, start))
     labels = {"model": _repeated(inputs["model"], n),
               "path": _decoded(path, path_names), "status": _decoded(status, STATUS_NAMES),
               "error": pa.array(error, type=pa.string())}
@@ -218,6 +225,26 @@ def compute_chunk(spec: SweepSpec, chunk: int, timings: dict | None = None,
     arrays = [labels[c] if c in labels else pa.array(cols[c], type=f.type)
               for c, f in zip(spec.columns(), schema)]
     return pa.Table.from_arrays(arrays, schema=schema)
+
+
+def _coded_summary(status: np.ndarray, path: np.ndarray, path_names: list[str],
+                   start: int) -> dict:
+    """Return :func:`chunk_summary` of rows ``start, start + 1, ...`` from their codes.
+
+    ``status``: codes into :data:`~vimpact.engine.result.STATUS_NAMES`; ``path``: codes
+    into ``path_names`` (``-1``: none). The same dict as from the table's text columns.
+    """
+    from vimpact.engine.result import STATUS_NAMES
+
+    counts = np.bincount(status.astype(np.intp), minlength=len(STATUS_NAMES))
+    per_status = {STATUS_NAMES[c]: int(counts[c]) for c in np.flatnonzero(counts)}
+    per_path = {}
+    if len(path_names):
+        rows = np.bincount(path.astype(np.intp) + 1, minlength=len(path_names) + 1)[1:]
+        for c in np.flatnonzero(rows):
+            per_path[path_names[c]] = {"rows": int(rows[c]),
+                                       "first_row": start + int(np.argmax(path == c))}
+    return {"counts": dict(sorted(per_status.items())), "paths": dict(sorted(per_path.items()))}
 
 
 def _decoded(codes: np.ndarray, names):
@@ -322,8 +349,8 @@ def explain_paths(spec: SweepSpec, first_rows: dict[str, int]) -> dict[str, list
 
 def run_chunk(spec: SweepSpec, chunk: int, parts: str) -> dict:
     """Compute ``chunk``, write its part file atomically, return its summary (a task)."""
-    table = compute_chunk(spec, chunk)
-    summary = chunk_summary(table)
+    summary: dict = {}
+    table = compute_chunk(spec, chunk, None, None, None, summary)
     store.write_part(spec, table, Path(parts), chunk, summary)
     start, stop = spec.chunk_rows(chunk)
     return {"chunk": chunk, "rows": stop - start, **summary}
@@ -564,8 +591,8 @@ def _run(spec, spec_path, out, parts, resume, progress, workers, scheduler, shar
                 bar.close()
                 return out
             for chunk in todo:
-                table = compute_chunk(spec, chunk, timings)
-                summary = chunk_summary(table)
+                summary: dict = {}
+                table = compute_chunk(spec, chunk, timings, None, None, summary)
                 t0 = time.perf_counter()
                 own = None  # a part's hash and the table's from one canonical form
                 if fresh is not None:
@@ -627,15 +654,20 @@ def _stream_one_chunk(spec: SweepSpec, parts: Path, out: Path, log, stages: Swee
     their own (one, until numba's threading layer is known to take launches from several
     threads, :data:`CONCURRENT_LAYERS`, and with one numba thread), sharing this
     thread's numba threads (two pieces on two threads: one each, so that neither waits
-    at the end of a launch for the other thread's last rows); each piece, in row order,
-    is hashed and encoded into the table on other threads while the next ones are
-    computed (:func:`vimpact.sweep.store.combine` ``pieces``): the same
-    table, byte for byte, as written from the whole chunk. No part: an interruption
-    keeps nothing, as for one chunk written whole (the pieces in flight are finished
-    first). ``timings``: ``kernel_s`` and ``total_s`` summed over the pieces (pieces
-    side by side: more than the wall time they took); ``pieces_wall_s`` the wall time
-    spent waiting for the pieces (with their tables); ``write_s`` the time spent writing
-    that the computation did not cover.
+    at the end of a launch for the other thread's last rows), as many again queued
+    behind them, so that a thread that finishes its piece takes the next at once (not
+    after the pieces before it are taken), the first ones while the table's file and
+    writer are set up; each piece, in row order, is hashed and
+    encoded into the table on other threads while the next ones are computed
+    (:func:`vimpact.sweep.store.combine` ``pieces``): the same table, byte for byte, as
+    written from the whole chunk. Finer pieces (half a row group, or a quarter of the
+    last, for a shorter tail once the kernels end) cost more CPU (the fixed Python and
+    hashing of every piece) than their shorter tail saved on 2 cores. No part: an
+    interruption keeps nothing, as for one chunk written whole (the pieces running are
+    finished first, the ones queued are not started). ``timings``: ``kernel_s`` and
+    ``total_s`` summed over the pieces (pieces side by side: more than the wall time
+    they took); ``pieces_wall_s`` the wall time spent waiting for the pieces (with their
+    tables); ``write_s`` the time spent writing that the computation did not cover.
     """
     from collections import deque
     from concurrent.futures import ThreadPoolExecutor
@@ -647,24 +679,33 @@ def _stream_one_chunk(spec: SweepSpec, parts: Path, out: Path, log, stages: Swee
     bounds = [(lo, min(stop - start, lo + size)) for lo in range(0, stop - start, size)]
     threads = numba.get_num_threads()  # (numba's count is per Python thread)
     inside = 0.0  # s computing the pieces (within the write's time)
-    params = spec.chunk_parameters(0)
+    # a random chunk's draws follow each other: made once for its pieces; a grid's
+    # parameter sets are made by each piece for its own rows (2.7-5 ms for 1e5 rows
+    # before the first piece could start)
+    params = spec.chunk_parameters(0) if spec.mode != "grid" else None
 
     def piece(lo: int, hi: int, own_threads: int):
         numba.set_num_threads(own_threads)
         own: dict = {}
-        table = compute_chunk(spec, 0, own, (lo, hi), params)
-        return table, chunk_summary(table), own
+        summary: dict = {}
+        table = compute_chunk(spec, 0, own, (lo, hi), params, summary)
+        return table, summary, own
+
+    todo = deque(bounds)
+    running: deque = deque()  # ((lo, hi), future) of the pieces submitted, in row order
+
+    def submit(pool) -> None:
+        limit = min(PIECES_IN_FLIGHT, threads) if _launches_side_by_side() else 1
+        ahead = 2 * limit if limit > 1 else 1  # (the pool runs `limit` of them)
+        while todo and len(running) < ahead:  # the threads shared between the pieces
+            running.append((todo[0], pool.submit(piece, *todo.popleft(),
+                                                 max(1, threads // limit))))
 
     def pieces(pool):
         nonlocal inside
         t0 = time.perf_counter()
-        todo = deque(bounds)
-        running: deque = deque()
         while todo or running:
-            limit = min(PIECES_IN_FLIGHT, threads) if _launches_side_by_side() else 1
-            while todo and len(running) < limit:  # the threads shared between the pieces
-                running.append((todo[0], pool.submit(piece, *todo.popleft(),
-                                                     max(1, threads // limit))))
+            submit(pool)
             (lo, hi), future = running.popleft()
             table, summary, own = future.result()
             for key, value in own.items():
@@ -677,11 +718,14 @@ def _stream_one_chunk(spec: SweepSpec, parts: Path, out: Path, log, stages: Swee
 
     t0 = time.perf_counter()
     with ThreadPoolExecutor(PIECES_IN_FLIGHT) as pool:
+        submit(pool)  # the first pieces start while the table's file and writer are made
         made = pieces(pool)
         try:
             _combine(spec, parts, out, log, stages, pieces=made)
         finally:
             made.close()  # (an error or an interruption: no piece is started after it)
+            for _, future in running:  # queued, not started: never started
+                future.cancel()
     if timings is not None:
         timings["write_s"] = timings.get("write_s", 0.0) + time.perf_counter() - t0 - inside
         timings["pieces_wall_s"] = timings.get("pieces_wall_s", 0.0) + inside

@@ -503,10 +503,11 @@ class SweepSpec:
         return h.hexdigest()
 
     # ---- parameter sets ---------------------------------------------------
-    def chunk_parameters(self, chunk: int) -> dict[str, np.ndarray]:
+    def chunk_parameters(self, chunk: int, part: tuple[int, int] | None = None
+                         ) -> dict[str, np.ndarray]:
         """Return the parameter sets of ``chunk`` (:func:`vimpact.sweep.parameters.chunk_parameters`)."""
         from vimpact.sweep.parameters import chunk_parameters
-        return chunk_parameters(self, chunk)
+        return chunk_parameters(self, chunk, part)
 
     def parameters(self) -> dict[str, np.ndarray]:
         """Return all parameter sets, chunk after chunk.

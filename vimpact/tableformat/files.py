@@ -41,9 +41,10 @@ WRITE_BATCH_ROWS = 65536
 ARROW_SCHEMA_KEY = b"ARROW:schema"
 #: Rows of one Parquet row group at most: every table and part is written in row groups of
 #: this many rows from its first row (one part or chunk after another), the last one
-#: shorter. A sweep's chunk is computed in pieces of this many rows, each written (encoded
-#: and hashed) while the next one is computed (:class:`TableStream`); the file is the same
-#: bytes either way. A table of at most this many rows is one row group.
+#: shorter. A sweep's one chunk is computed in pieces of at most this many rows, each
+#: hashed, and each row group encoded, while the next pieces are computed
+#: (:class:`TableStream`); the file is the same bytes either way. A table of at most this
+#: many rows is one row group.
 ROW_GROUP_ROWS = 25_000
 
 
@@ -271,15 +272,17 @@ def _detached(call, *args, **kwargs):
 
 
 class TableStream:
-    """Write a table atomically from its row groups as they are made (a context manager).
+    """Write a table atomically from its rows as they are made (a context manager).
 
-    ``add(piece)`` hands one row group (a ``pyarrow`` table of ``schema``'s columns, at
-    most :data:`ROW_GROUP_ROWS` rows; every piece but the last exactly that many) to two
-    threads of its own, one hashes the pieces in order (:class:`ContentHash`), one
-    encodes them into the file in order, and returns at once (an error of a piece
-    written before is raised here): the caller computes the next pieces while these
-    are written, and the pieces wait in memory when the writing lags (at most the rows
-    of the table, which the caller holds anyway). ``finish(metadata)`` writes the
+    ``add(piece)`` hands the next rows (a ``pyarrow`` table of ``schema``'s columns, any
+    number of rows) to two threads of its own and returns at once (an error of a piece
+    written before is raised here): one hashes the pieces in order as they come
+    (:class:`ContentHash`: the hash of the rows does not depend on how they are cut),
+    one encodes a row group into the file as soon as its :data:`ROW_GROUP_ROWS` rows are
+    all there (its pieces joined: the same bytes as the rows added in one piece). The
+    caller computes the next pieces while these are written, and the pieces wait in
+    memory when the writing lags (at most the rows of the table, which the caller holds
+    anyway). ``finish(metadata)`` writes the
     footer with the table's key-value ``metadata``, the content hash of all the pieces
     and the metadata hash (:func:`_footer`) and returns the content hash; the file then
     replaces ``path`` atomically when the ``with`` block ends (:func:`atomic_file`). An
@@ -292,6 +295,8 @@ class TableStream:
         self.path, self.schema = Path(path), schema.remove_metadata()
         self.hasher = ContentHash()
         self.rows = 0
+        self._held: list = []  # the rows added but not yet handed to the encoder
+        self._held_rows = 0
         self._pending: list = []  # the hashes and writes of the pieces added
         self._finished: str | None = None
 
@@ -342,28 +347,41 @@ class TableStream:
             job.cancel()
 
     def add(self, piece) -> None:
-        """Write ``piece`` (the next rows) on the writer thread once the one before is written."""
+        """Hash ``piece`` (the next rows) and encode the row groups it completes, on the threads."""
         if self._finished is not None:
             raise ValueError(f"TableStream of {self.path}: add after finish")
-        if self.rows % ROW_GROUP_ROWS or piece.num_rows > ROW_GROUP_ROWS:
-            raise ValueError(f"TableStream of {self.path}: a piece of {piece.num_rows} rows "
-                             f"after {self.rows}: every piece but the last has "
-                             f"{ROW_GROUP_ROWS} rows (one row group)")
         piece = piece.replace_schema_metadata(None)
         try:
             self._raise_done()
         except OSError as exc:
             raise self._named(exc) from exc
+        if not piece.num_rows:
+            return
         self.rows += piece.num_rows
-        # side by side: the streams of the content hash (one thread: beside the
-        # computation of the next piece) and the Parquet pages
-        self._pending += [self._hashing.submit(self.hasher.update, piece, threads=1),
-                          self._encoding.submit(_detached, self._writer.write_table, piece,
-                                                row_group_size=ROW_GROUP_ROWS)]
+        # side by side: the stream of the content hash (one thread: beside the
+        # computation of the next piece) and the Parquet pages of a full row group
+        self._pending.append(self._hashing.submit(self.hasher.update, piece, threads=1))
+        self._held.append(piece)
+        self._held_rows += piece.num_rows
+        while self._held_rows >= ROW_GROUP_ROWS:
+            self._encode(ROW_GROUP_ROWS)
+
+    def _encode(self, rows: int) -> None:
+        """Hand the first ``rows`` rows held (one row group) to the encoding thread."""
+        import pyarrow as pa
+
+        held = self._held[0] if len(self._held) == 1 else pa.concat_tables(self._held)
+        self._held = [held.slice(rows)] if held.num_rows > rows else []
+        self._held_rows = held.num_rows - rows
+        self._pending.append(self._encoding.submit(_detached, self._writer.write_table,
+                                                   held.slice(0, rows),
+                                                   row_group_size=ROW_GROUP_ROWS))
 
     def finish(self, metadata) -> str:
         """Write the footer with ``metadata`` and the hashes; return the content hash."""
         try:
+            if self._held_rows:  # the last row group (shorter)
+                self._encode(self._held_rows)
             self._wait()
             digest = self.hasher.hexdigest()
             self._writer.add_key_value_metadata(_footer(self.schema, metadata, digest))
