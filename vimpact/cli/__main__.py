@@ -2,6 +2,6 @@
 
 import sys
 
-from vimpact.cli.main import main
+from vimpact.cli.main import run
 
-sys.exit(main())
+sys.exit(run())
