@@ -46,6 +46,21 @@ def chunk_generator(seed: int, chunk: int) -> np.random.Generator:
     return np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(chunk,)))
 
 
+def part_rows(part: tuple[int, int], rows: int, chunk: int) -> tuple[int, int]:
+    """Return ``part`` (``(lo, hi)``: rows ``lo`` to ``hi - 1`` of a chunk of ``rows``).
+
+    Raises
+    ------
+    ValueError
+        unless ``0 <= lo < hi <= rows``.
+    """
+    lo, hi = part
+    if not 0 <= lo < hi <= rows:
+        raise ValueError(f"part = {part!r} is not allowed: must be rows (lo, hi) with "
+                         f"0 <= lo < hi <= {rows} of chunk {chunk}")
+    return lo, hi
+
+
 def chunk_parameters(spec, chunk: int, part: tuple[int, int] | None = None
                      ) -> dict[str, np.ndarray]:
     """Return the parameter sets of ``chunk`` of ``spec``: one array per input.
@@ -62,10 +77,7 @@ def chunk_parameters(spec, chunk: int, part: tuple[int, int] | None = None
     start, stop = spec.chunk_rows(chunk)
     n = stop - start
     if part is not None:
-        lo, hi = part
-        if not 0 <= lo < hi <= n:
-            raise ValueError(f"part = {part!r} is not allowed: must be rows (lo, hi) with "
-                             f"0 <= lo < hi <= {n} of chunk {chunk}")
+        lo, hi = part_rows(part, n, chunk)
         if spec.mode != "grid":
             return {k: v[lo:hi] for k, v in chunk_parameters(spec, chunk).items()}
         start, stop = start + lo, start + hi

@@ -130,16 +130,13 @@ def compute_chunk(spec: SweepSpec, chunk: int, timings: dict | None = None,
 
     from vimpact.engine.result import STATUS_CODE, STATUS_NAMES
     from vimpact.engine.unpack import finished_codes
-    from vimpact.sweep.parameters import engine_columns
+    from vimpact.sweep.parameters import engine_columns, part_rows
 
     start, stop = spec.chunk_rows(chunk)
     if params is None:  # (of the part's rows only, if a part)
         params = spec.chunk_parameters(chunk, part)
     elif part is not None:
-        lo, hi = part
-        if not 0 <= lo < hi <= stop - start:
-            raise ValueError(f"part = {part!r} is not allowed: must be rows (lo, hi) with "
-                             f"0 <= lo < hi <= {stop - start} of chunk {chunk}")
+        lo, hi = part_rows(part, stop - start, chunk)
         views: dict[int, np.ndarray] = {}  # one array of several inputs: one view of it
         params = {k: views.setdefault(id(v), v[lo:hi]) for k, v in params.items()}
     if part is not None:
