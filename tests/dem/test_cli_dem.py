@@ -158,3 +158,17 @@ def test_json_gives_the_tangential_residual_over_the_impact_angles(code_run):
         assert 0.0 < c["residual_beta_x"]["rms"] <= c["residual_beta_x"]["max_abs"] < 0.1
     report = (folder / "report_lammps.md").read_text()
     assert "impact angles 5, 15, 30, 45, 60, 75 deg" in report
+
+
+def test_the_figure_has_a_beta_row_when_any_contact_represents_beta():
+    """A contact fitted over its oblique impacts only (no full-stick curve: MercuryDPM's
+    with friction) still gets the beta_x row; none represented: no row."""
+    from types import SimpleNamespace as Fit
+
+    from vimpact.dem.report import beta_row
+
+    oblique_only = Fit(res_beta_x="residual", beta_x=None, beta_oblique=[0.1])
+    absent = Fit(res_beta_x=None, beta_x=None, beta_oblique=None)
+    assert beta_row([oblique_only, oblique_only])
+    assert beta_row([absent, oblique_only])
+    assert not beta_row([absent, absent])

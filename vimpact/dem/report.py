@@ -37,6 +37,16 @@ def _margins(n: int, rows: int) -> dict[str, float]:
                 wspace=m["column"] / axes_w, hspace=m["row"] / axes_h)
 
 
+def beta_row(fits: list[ContactFit]) -> bool:
+    """Whether the figure has a ``beta_x`` row: some contact's ``beta_x`` is represented.
+
+    Represented means it has a ``beta_x`` residual (over the oblique impacts with its
+    friction, or over the full-stick curve), as the report's table says; a contact
+    fitted over oblique impacts only has no full-stick curve, and is drawn all the same.
+    """
+    return any(f.res_beta_x is not None for f in fits)
+
+
 def figure(code: str, problem: DemProblem, targets: dict[str, Targets],
            fits: list[ContactFit], out: Path) -> Path:
     """Write the comparison figure to ``out`` (PNG)."""
@@ -44,7 +54,7 @@ def figure(code: str, problem: DemProblem, targets: dict[str, Targets],
     from matplotlib.figure import Figure
 
     n = len(fits)
-    rows = 2 if any(f.has_beta_x for f in fits) else 1
+    rows = 2 if beta_row(fits) else 1
     fig = Figure(figsize=(PANEL_IN[0] * n, PANEL_IN[1] * rows))
     FigureCanvasAgg(fig)
     axes = fig.subplots(rows, n, squeeze=False, gridspec_kw=_margins(n, rows))
