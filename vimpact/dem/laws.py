@@ -645,10 +645,7 @@ def linear_spring_dashpot_force_end(zeta: float, tangential=None) -> tuple[float
     """
     from vimpact.reference.closed_forms import linear_model_zeta
 
-    z = float(zeta)
-    if not z >= 0.0:
-        raise ValueError(f"zeta = {zeta!r} is not allowed: must be >= 0")
-    ref = linear_model_zeta(z)
+    ref = linear_model_zeta(float(zeta))  # (refuses a zeta that is not finite and >= 0)
     t, e = float(ref.t_star), float(ref.e)
     if tangential is None:
         return e, math.nan, t
