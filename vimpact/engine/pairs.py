@@ -8,6 +8,7 @@ equivalent scenes (:func:`vimpact.engine.simulate.simulate`,
 
 from __future__ import annotations
 
+import inspect
 import math
 from collections.abc import Sequence
 
@@ -130,15 +131,16 @@ def pair_restitutions(curves: Sequence[tuple[Body, Body | Wall, object, dict]], 
     scenes: list[Scene] = []
     bounds = []
     for body1, other, speeds, options in curves:
-        unknown = sorted(set(options) - {"tangential", "vc_ratio", "mu"})
-        require("options", unknown, not unknown, "keywords among tangential, vc_ratio, mu")
+        unknown = sorted(set(options) - set(_CURVE_DEFAULTS))
+        require("options", unknown, not unknown,
+                "keywords among " + ", ".join(_CURVE_DEFAULTS))
+        options = {**_CURVE_DEFAULTS, **options}
         speeds = np.asarray(speeds, dtype=float)
         require("speeds", speeds, speeds.ndim == 1 and speeds.size > 0
                 and bool(np.all(speeds > 0)) and bool(np.all(np.isfinite(speeds))),
                 "a non-empty 1-D array of finite speeds > 0")
-        tangential = bool(options.get("tangential", False))
-        vc_ratio = float(options.get("vc_ratio", 1.0))
-        mu = options.get("mu", math.inf)
+        tangential, vc_ratio, mu = (bool(options["tangential"]), float(options["vc_ratio"]),
+                                    options["mu"])
         base = pair_scene(Body(body1.material, body1.R, body1.m, body1.Theta, v_z=1.0,
                                rotation=body1.rotation),
                           other if isinstance(other, Wall) else
@@ -160,3 +162,10 @@ def pair_restitutions(curves: Sequence[tuple[Body, Body | Wall, object, dict]], 
         part.insert(0, "v_z0", speeds)
         out.append(part)
     return out
+
+
+#: the options of one curve of :func:`pair_restitutions` and their defaults: the keywords
+#: of :func:`pair_restitution` (its signature is their one home)
+_CURVE_DEFAULTS = {name: p.default for name, p in
+                   inspect.signature(pair_restitution).parameters.items()
+                   if p.kind is inspect.Parameter.KEYWORD_ONLY and name != "numerics"}
